@@ -1,0 +1,381 @@
+#include "engine/assembly.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <climits>
+#include <cmath>
+#include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "materials/errors.h"
+
+namespace pneufem {
+
+namespace {
+
+// Greedy colouring of elements so that elements of one colour share no node.
+std::vector<std::vector<int>> colour_elements(const Mesh& mesh) {
+  const int ne = mesh.num_elements(), npe = mesh.npe();
+  std::vector<std::vector<int>> node_colours(mesh.num_nodes());
+  std::vector<std::vector<int>> colours;
+  std::vector<char> used;
+  for (int e = 0; e < ne; ++e) {
+    const int* n = mesh.element(e);
+    used.assign(colours.size() + 1, 0);
+    for (int a = 0; a < npe; ++a)
+      for (int c : node_colours[n[a]]) used[c] = 1;
+    int c = 0;
+    while (used[c]) ++c;
+    if (c == static_cast<int>(colours.size())) colours.emplace_back();
+    colours[c].push_back(e);
+    for (int a = 0; a < npe; ++a) node_colours[n[a]].push_back(c);
+  }
+  return colours;
+}
+
+void atomic_min(std::atomic<int>& target, int v) {
+  int cur = target.load();
+  while (v < cur && !target.compare_exchange_weak(cur, v)) {
+  }
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
+}  // namespace
+
+Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry(model.mesh)) {
+  const Mesh& mesh = model.mesh;
+  const int ne = mesh.num_elements(), nn = mesh.num_nodes(), npe = mesh.npe();
+  colours_ = colour_elements(mesh);
+
+  state_offset_.assign(ne + 1, 0);
+  for (int e = 0; e < ne; ++e)
+    state_offset_[e + 1] = state_offset_[e] + static_cast<std::size_t>(geom_.nqp) * model.material_of(e).state_size();
+
+  mass_ = Eigen::VectorXd::Zero(nn);
+  const auto frac = lumped_mass_fractions(mesh.type);
+  for (int e = 0; e < ne; ++e) {
+    const double m = model.parts[model.element_part[e]].density_kg_m3 * geom_.volume[e];
+    const int* n = mesh.element(e);
+    for (int a = 0; a < npe; ++a) mass_[n[a]] += frac[a] * m;
+  }
+
+  // Node adjacency (including self), sorted.
+  std::vector<std::vector<int>> adj(nn);
+  for (int e = 0; e < ne; ++e) {
+    const int* n = mesh.element(e);
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b) adj[n[a]].push_back(n[b]);
+  }
+  adj_ptr_.assign(nn + 1, 0);
+  for (int i = 0; i < nn; ++i) {
+    auto& v = adj[i];
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    adj_ptr_[i + 1] = adj_ptr_[i] + static_cast<int>(v.size());
+  }
+  adj_.reserve(adj_ptr_.back());
+  for (auto& v : adj) adj_.insert(adj_.end(), v.begin(), v.end());
+  // Pair slots: position of node a in adj(b).
+  pair_slot_.resize(static_cast<std::size_t>(ne) * npe * npe);
+  for (int e = 0; e < ne; ++e) {
+    const int* n = mesh.element(e);
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b) {
+        const int* first = adj_.data() + adj_ptr_[n[b]];
+        const int* last = adj_.data() + adj_ptr_[n[b] + 1];
+        pair_slot_[(static_cast<std::size_t>(e) * npe + a) * npe + b] =
+            static_cast<std::uint16_t>(std::lower_bound(first, last, n[a]) - first);
+      }
+  }
+  // CSC column pointers: column 3*b + k holds the 3 * |adj(b)| rows of b's neighbours.
+  col_ptr_.assign(3 * nn + 1, 0);
+  for (int b = 0; b < nn; ++b)
+    for (int k = 0; k < 3; ++k) col_ptr_[3 * b + k + 1] = col_ptr_[3 * b + k] + 3 * (adj_ptr_[b + 1] - adj_ptr_[b]);
+
+  // Pressure faces in outward order: the Abaqus face order has an inward right-hand normal,
+  // so swap the 2nd and 3rd corner (and the mid-edge nodes accordingly).
+  const int npf = nodes_per_face(mesh.type);
+  pface_nodes_.reserve(model.pressure_faces.size() * npf);
+  for (const FaceRef& f : model.pressure_faces) {
+    const int* ln = face_local_nodes(mesh.type, f.local_face);
+    const int* n = mesh.element(f.element);
+    if (npf == 3) {
+      for (int k : {0, 2, 1}) pface_nodes_.push_back(n[ln[k]]);
+    } else {
+      for (int k : {0, 2, 1, 5, 4, 3}) pface_nodes_.push_back(n[ln[k]]);
+    }
+  }
+}
+
+std::vector<double> Assembler::initial_state() const {
+  std::vector<double> s(state_size(), 0.0);
+  const int ne = model_.mesh.num_elements();
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = model_.material_of(e);
+    const int ss = mat.state_size();
+    if (ss == 0) continue;
+    for (int q = 0; q < geom_.nqp; ++q)
+      mat.init_state(std::span<double>(s).subspan(state_offset_[e] + static_cast<std::size_t>(q) * ss, ss));
+  }
+  return s;
+}
+
+SparseMatrix Assembler::tangent_pattern() const {
+  const int nn = model_.mesh.num_nodes();
+  SparseMatrix K(3 * nn, 3 * nn);
+  K.resizeNonZeros(col_ptr_.back());
+  int* outer = K.outerIndexPtr();
+  int* inner = K.innerIndexPtr();
+  std::copy(col_ptr_.begin(), col_ptr_.end(), outer);
+  for (int b = 0; b < nn; ++b)
+    for (int k = 0; k < 3; ++k) {
+      int p = col_ptr_[3 * b + k];
+      for (int s = adj_ptr_[b]; s < adj_ptr_[b + 1]; ++s)
+        for (int i = 0; i < 3; ++i) inner[p++] = 3 * adj_[s] + i;
+    }
+  std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
+  return K;
+}
+
+void Assembler::internal(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
+                         std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const {
+  if (model_.mesh.type == ElementType::Tet4)
+    internal_impl<4, 1>(u, ts, state_old, state_new, f_int, K, energy);
+  else
+    internal_impl<10, 4>(u, ts, state_old, state_new, f_int, K, energy);
+}
+
+template <int NPE, int NQP>
+void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
+                              std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K,
+                              double* energy) const {
+  const Mesh& mesh = model_.mesh;
+  const int ne = mesh.num_elements();
+  if (f_int) f_int->setZero(num_dofs());
+  if (K) {
+    if (K->nonZeros() != col_ptr_.back()) *K = tangent_pattern();
+    std::fill(K->valuePtr(), K->valuePtr() + K->nonZeros(), 0.0);
+  }
+  std::vector<double> elem_energy;
+  if (energy) elem_energy.assign(ne, 0.0);
+  std::atomic<int> bad{INT_MAX};
+  const bool tangent = K != nullptr;
+  const bool has_state = state_size() > 0;
+
+  auto kernel = [&](int e) {
+    const int* n = mesh.element(e);
+    Eigen::Matrix<double, 3, NPE> x;
+    for (int a = 0; a < NPE; ++a) x.col(a) = mesh.X[n[a]] + u.template segment<3>(3 * n[a]);
+    std::array<Mat3, NQP> F;
+    for (int q = 0; q < NQP; ++q) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));  // column a = dN_a/dX
+      F[q] = x * g.transpose();
+      const double J = F[q].determinant();
+      if (!(J > 0.0) || !std::isfinite(J)) {
+        atomic_min(bad, e);
+        return;
+      }
+    }
+    std::array<PointResponse, NQP> resp;
+    const Material& mat = model_.material_of(e);
+    const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
+    mat.evaluate(F, ts, has_state ? state_old.subspan(o0, o1 - o0) : std::span<const double>{},
+                 has_state && !state_new.empty() ? state_new.subspan(o0, o1 - o0) : std::span<double>{}, resp, tangent);
+    Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
+    double psi = 0.0;
+    for (int q = 0; q < NQP; ++q) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));
+      const double w = geom_.w(e, q);
+      const Mat3 P = resp[q].P();
+      if (!P.allFinite()) {
+        atomic_min(bad, e);
+        return;
+      }
+      fe.noalias() += w * P * g;
+      psi += w * resp[q].psi();
+    }
+    if (energy) elem_energy[e] = psi;
+    if (f_int)
+      for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
+    if (!tangent) return;
+    double* val = K->valuePtr();
+    for (int q = 0; q < NQP; ++q) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));
+      const double w = geom_.w(e, q);
+      const Mat9 A = w * resp[q].A();
+      for (int b = 0; b < NPE; ++b) {
+        // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
+        Eigen::Matrix<double, 9, 3> T;
+        for (int k = 0; k < 3; ++k)
+          T.col(k) = A.col(flat(k, 0)) * g(0, b) + A.col(flat(k, 1)) * g(1, b) + A.col(flat(k, 2)) * g(2, b);
+        for (int a = 0; a < NPE; ++a) {
+          // K_ab(i, k) = sum_J g_a[J] T(iJ, k)
+          const int slot = pair_slot_[(static_cast<std::size_t>(e) * NPE + a) * NPE + b];
+          for (int k = 0; k < 3; ++k) {
+            double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
+            for (int i = 0; i < 3; ++i)
+              col[i] += g(0, a) * T(flat(i, 0), k) + g(1, a) * T(flat(i, 1), k) + g(2, a) * T(flat(i, 2), k);
+          }
+        }
+      }
+    }
+  };
+
+  for (const auto& colour : colours_) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, colour.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) kernel(colour[i]);
+    });
+  }
+  if (bad.load() != INT_MAX) {
+    const int e = bad.load();
+    std::ostringstream s;
+    s << "element " << mesh.element_ids[e] << " (region '" << mesh.region_names[mesh.region[e]]
+      << "') inverted or produced a non-finite stress (det F <= 0) at t = " << ts.time_s
+      << " s. Hint: the load step is too large or the actuator is past its ballooning limit; "
+         "reduce the step (explicit: smaller dt_safety; static: smaller max_increment), refine the "
+         "mesh near this element, or check its material constants.";
+    throw PhysicsError(s.str(), e, ts.time_s);
+  }
+  if (energy) {
+    double sum = 0.0;
+    for (double v : elem_energy) sum += v;  // serial: deterministic
+    *energy = sum;
+  }
+}
+
+void Assembler::point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
+                                std::span<PointResponse> out) const {
+  const Mesh& mesh = model_.mesh;
+  const int npe = mesh.npe();
+  const int* n = mesh.element(e);
+  for (int q = 0; q < geom_.nqp; ++q) {
+    const double* g = geom_.grad(e, q);
+    Mat3 Fq = Mat3::Zero();
+    for (int a = 0; a < npe; ++a) {
+      const Eigen::Vector3d xa = mesh.X[n[a]] + u.segment<3>(3 * n[a]);
+      Fq += xa * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+    }
+    F[q] = Fq;
+  }
+  const Material& mat = model_.material_of(e);
+  std::vector<double> scratch(state.size());
+  mat.evaluate(F.first(geom_.nqp), TimeStep{}, state, scratch, out.first(geom_.nqp), false);
+}
+
+void Assembler::add_pressure(const Eigen::VectorXd& u, double p, Eigen::VectorXd& f_ext, SparseMatrix* K) const {
+  if (p == 0.0 || pface_nodes_.empty()) return;
+  const Mesh& mesh = model_.mesh;
+  const int npf = nodes_per_face(mesh.type);
+  const auto rule = tri_rule();
+  const std::size_t nf = model_.pressure_faces.size();
+  std::array<double, 6> N{};
+  std::array<double, 12> dN{};
+  std::array<Eigen::Vector3d, 6> x;
+  Eigen::Matrix<double, 18, 18> Kf;
+  for (std::size_t f = 0; f < nf; ++f) {
+    const int* fn = pface_nodes_.data() + f * npf;
+    for (int a = 0; a < npf; ++a) x[a] = mesh.X[fn[a]] + u.segment<3>(3 * fn[a]);
+    if (K) Kf.setZero();
+    for (const QuadPoint& qp : rule) {
+      tri_shape(mesh.type, qp.xi, qp.eta, N.data(), dN.data());
+      Eigen::Vector3d xs = Eigen::Vector3d::Zero(), xt = Eigen::Vector3d::Zero();
+      for (int a = 0; a < npf; ++a) {
+        xs += dN[2 * a] * x[a];
+        xt += dN[2 * a + 1] * x[a];
+      }
+      const Eigen::Vector3d c = xs.cross(xt);  // outward area vector density
+      for (int a = 0; a < npf; ++a) f_ext.segment<3>(3 * fn[a]) -= p * qp.w * N[a] * c;
+      if (K) {
+        const Eigen::Matrix3d Ss = skew(xs), St = skew(xt);
+        // d f_a / d x_b = -p w N_a (dN_b/deta [xs]x - dN_b/dxi [xt]x); K_t -= d f_ext/dx
+        for (int a = 0; a < npf; ++a)
+          for (int b = 0; b < npf; ++b)
+            Kf.block<3, 3>(3 * a, 3 * b) += p * qp.w * N[a] * (dN[2 * b + 1] * Ss - dN[2 * b] * St);
+      }
+    }
+    if (!K) continue;
+    // Symmetrise: for a closed cavity the assembled load stiffness is symmetric, so this is exact
+    // there; for open surfaces it keeps a symmetric (approximate-Newton) tangent.
+    const Eigen::Matrix<double, 18, 18> Ks = 0.5 * (Kf + Kf.transpose());
+    double* val = K->valuePtr();
+    for (int b = 0; b < npf; ++b)
+      for (int a = 0; a < npf; ++a) {
+        const int* first = adj_.data() + adj_ptr_[fn[b]];
+        const int* last = adj_.data() + adj_ptr_[fn[b] + 1];
+        const int slot = static_cast<int>(std::lower_bound(first, last, fn[a]) - first);
+        for (int k = 0; k < 3; ++k) {
+          double* col = val + col_ptr_[3 * fn[b] + k] + 3 * slot;
+          for (int i = 0; i < 3; ++i) col[i] += Ks(3 * a + i, 3 * b + k);
+        }
+      }
+  }
+}
+
+double Assembler::cavity_volume(const Eigen::VectorXd& u) const {
+  const Mesh& mesh = model_.mesh;
+  const int npf = nodes_per_face(mesh.type);
+  std::array<double, 6> N{};
+  std::array<double, 12> dN{};
+  double V = 0.0;
+  for (std::size_t f = 0; f < model_.pressure_faces.size(); ++f) {
+    const int* fn = pface_nodes_.data() + f * npf;
+    for (const QuadPoint& qp : tri_rule()) {
+      tri_shape(mesh.type, qp.xi, qp.eta, N.data(), dN.data());
+      Eigen::Vector3d xq = Eigen::Vector3d::Zero(), xs = Eigen::Vector3d::Zero(), xt = Eigen::Vector3d::Zero();
+      for (int a = 0; a < npf; ++a) {
+        const Eigen::Vector3d xa = mesh.X[fn[a]] + u.segment<3>(3 * fn[a]);
+        xq += N[a] * xa;
+        xs += dN[2 * a] * xa;
+        xt += dN[2 * a + 1] * xa;
+      }
+      V -= qp.w * xq.dot(xs.cross(xt)) / 3.0;  // cavity normal = -(solid outward normal)
+    }
+  }
+  return V;
+}
+
+void Assembler::add_gravity(Eigen::VectorXd& f_ext) const {
+  const Eigen::Vector3d& g = model_.gravity_m_s2;
+  if (g.isZero()) return;
+  const Mesh& mesh = model_.mesh;
+  const auto rule = tet_rule(mesh.type);
+  const int npe = mesh.npe();
+  std::vector<double> N(npe), dN(3 * npe);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const double rho = model_.parts[model_.element_part[e]].density_kg_m3;
+    const int* n = mesh.element(e);
+    for (int q = 0; q < geom_.nqp; ++q) {
+      tet_shape(mesh.type, rule[q].xi, rule[q].eta, rule[q].zeta, N.data(), dN.data());
+      for (int a = 0; a < npe; ++a) f_ext.segment<3>(3 * n[a]) += rho * geom_.w(e, q) * N[a] * g;
+    }
+  }
+}
+
+void Assembler::apply_constraints(SparseMatrix& K, double diag) const {
+  const auto& fixed = model_.fixed;
+  for (int c = 0; c < K.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(K, c); it; ++it)
+      if (fixed[it.row()] || fixed[c]) it.valueRef() = (it.row() == c) ? diag : 0.0;
+}
+
+void Assembler::zero_fixed(Eigen::VectorXd& v) const {
+  for (int i = 0; i < v.size(); ++i)
+    if (model_.fixed[i]) v[i] = 0.0;
+}
+
+Eigen::VectorXd Assembler::row_abs_sums(const SparseMatrix& K) const {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(K.rows());
+  for (int c = 0; c < K.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(K, c); it; ++it) r[it.row()] += std::abs(it.value());
+  return r;
+}
+
+}  // namespace pneufem

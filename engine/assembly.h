@@ -1,0 +1,94 @@
+#pragma once
+// Whole-mesh loops: internal forces, tangent stiffness, strain energy, follower pressure,
+// gravity and lumped mass. This is the only place in the engine that knows about threads.
+//
+// Determinism: elements are greedily coloured so that no two elements of one colour share a
+// node. Colours run one after another and the elements of a colour run in parallel (TBB),
+// scattering straight into the global vectors/matrix. Every global entry therefore receives
+// its contributions in the same order (colour order) whatever the number of threads, so the
+// results are bit-for-bit identical for 1 and N threads, without atomics or per-thread buffers.
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "engine/model.h"
+#include "engine/tet_element.h"
+
+namespace pneufem {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+class Assembler {
+ public:
+  explicit Assembler(const Model& model);
+
+  const Model& model() const { return model_; }
+  const ElementGeometry& geometry() const { return geom_; }
+  int num_dofs() const { return model_.num_dofs(); }
+  int num_colours() const { return static_cast<int>(colours_.size()); }
+
+  /// Material history layout: doubles per element (all its quadrature points) and offsets.
+  std::size_t state_size() const { return state_offset_.back(); }
+  std::span<const double> element_state(std::span<const double> all, int e) const {
+    return all.subspan(state_offset_[e], state_offset_[e + 1] - state_offset_[e]);
+  }
+  std::vector<double> initial_state() const;
+
+  /// Lumped nodal mass (kg), one value per node.
+  const Eigen::VectorXd& lumped_mass() const { return mass_; }
+
+  /// Evaluates the internal force vector f_int(u) (N), the tangent dF/du (N/m, pattern of
+  /// tangent_pattern(); fixed dofs are NOT applied) and the stored energy (J) for the requested
+  /// outputs (nullptr = skip). Material history: reads `state_old`, writes the trial state into
+  /// `state_new` (may be empty when state_size() == 0). Throws PhysicsError naming the first
+  /// element (lowest index) with det F <= 0 or a non-finite stress.
+  void internal(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
+                std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
+
+  /// Adds the follower-pressure load of pressure p (Pa, positive pushes into the solid) on the
+  /// model's pressure faces to f_ext, and, when K is given, subtracts the (symmetrised) load
+  /// stiffness d f_ext / du from K.
+  void add_pressure(const Eigen::VectorXd& u, double p_Pa, Eigen::VectorXd& f_ext, SparseMatrix* K) const;
+  /// Adds the consistent gravity load int rho N_a g dV.
+  void add_gravity(Eigen::VectorXd& f_ext) const;
+  /// Volume enclosed by the pressure faces in the deformed configuration (m^3); exact for a
+  /// closed cavity (or one closed by symmetry planes through the origin).
+  double cavity_volume(const Eigen::VectorXd& u) const;
+
+  /// Sparse pattern of the tangent (full symmetric storage, all 3x3 node blocks).
+  SparseMatrix tangent_pattern() const;
+  /// Zeroes the rows and columns of fixed dofs, puts `diag` on their diagonal.
+  void apply_constraints(SparseMatrix& K, double diag) const;
+  /// Zeroes the fixed entries of a vector.
+  void zero_fixed(Eigen::VectorXd& v) const;
+
+  /// Per-node upper bound on the row sums of |K| for the current (or given) tangent; used for
+  /// stable-step estimates (Gershgorin) and for the fictitious masses of dynamic relaxation.
+  Eigen::VectorXd row_abs_sums(const SparseMatrix& K) const;
+
+  /// Deformation gradients and responses at the element's quadrature points (for output).
+  void point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
+                       std::span<PointResponse> out) const;
+
+ private:
+  template <int NPE, int NQP>
+  void internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
+                     std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
+
+  const Model& model_;
+  ElementGeometry geom_;
+  std::vector<std::vector<int>> colours_;       ///< element indices per colour
+  std::vector<std::size_t> state_offset_;       ///< per element (size ne + 1)
+  Eigen::VectorXd mass_;
+  // Tangent scatter: adjacency of each node (sorted) and, for element e and local pair (a, b),
+  // the position of node a in the adjacency list of node b.
+  std::vector<int> adj_ptr_, adj_;
+  std::vector<std::uint16_t> pair_slot_;
+  std::vector<int> col_ptr_;  ///< CSC column pointers of the pattern
+  // Pressure faces in outward node order (global node ids), npf nodes per face.
+  std::vector<int> pface_nodes_;
+};
+
+}  // namespace pneufem

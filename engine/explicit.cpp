@@ -1,0 +1,163 @@
+#include "engine/explicit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "materials/errors.h"
+
+namespace pneufem {
+
+double EnergyBalance::relative_error() const {
+  const double scale = std::max({std::abs(external_work_J), kinetic_J, std::abs(internal_J), 1e-300});
+  return std::abs(external_work_J - kinetic_J - internal_J - damping_J) / scale;
+}
+
+ExplicitIntegrator::ExplicitIntegrator(const Assembler& assembler, ExplicitOptions options)
+    : asm_(assembler), opt_(options) {
+  const int n = asm_.num_dofs();
+  m_ = asm_.lumped_mass();
+  stats_.physical_mass_kg = m_.sum();
+  u_ = Eigen::VectorXd::Zero(n);
+  v_ = Eigen::VectorXd::Zero(n);
+  state_ = asm_.initial_state();
+  trial_ = state_;
+  K_ = asm_.tangent_pattern();
+}
+
+Eigen::VectorXd ExplicitIntegrator::external(double t, const PressureFn& pressure) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(asm_.num_dofs());
+  asm_.add_pressure(u_, pressure(t), f, nullptr);
+  asm_.add_gravity(f);
+  return f;
+}
+
+double ExplicitIntegrator::estimate_stable_dt() {
+  asm_.internal(u_, TimeStep{t_, 0.0}, state_, trial_, nullptr, &K_, nullptr);
+  const Eigen::VectorXd rows = asm_.row_abs_sums(K_);
+  const int nn = asm_.model().mesh.num_nodes();
+  double w2max = 0.0;
+  // Mass scaling: node i needs m_i >= rows_i * (dt_target / (2 safety))^2.
+  const double need = opt_.target_dt_s > 0 ? std::pow(opt_.target_dt_s / (2.0 * opt_.dt_safety), 2) : 0.0;
+  const Eigen::VectorXd& m_phys = asm_.lumped_mass();
+  for (int i = 0; i < nn; ++i) {
+    double r = 0.0;
+    for (int k = 0; k < 3; ++k)
+      if (!asm_.model().fixed[3 * i + k]) r = std::max(r, rows[3 * i + k]);
+    if (need > 0.0) m_[i] = std::max(m_[i], std::max(m_phys[i], r * need));
+    if (r > 0.0) w2max = std::max(w2max, r / m_[i]);
+  }
+  stats_.added_mass_kg = m_.sum() - stats_.physical_mass_kg;
+  ++stats_.stability_estimates;
+  return w2max > 0.0 ? opt_.dt_safety * 2.0 / std::sqrt(w2max) : 1.0;
+}
+
+void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int observe_every,
+                             const std::function<void(double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& observer) {
+  const int n = asm_.num_dofs();
+  const auto& fixed = asm_.model().fixed;
+  Eigen::VectorXd minv(n);
+  auto refresh_mass = [&] {
+    for (int i = 0; i < n; ++i) minv[i] = fixed[i] ? 0.0 : 1.0 / m_[i / 3];
+  };
+  if (dt_ == 0.0 || stats_.steps % std::max(1, opt_.stability_interval) == 0) dt_ = estimate_stable_dt();
+  refresh_mass();
+  Eigen::VectorXd f_int, f_ext = external(t_, pressure);
+  double IE = 0.0;
+  asm_.internal(u_, TimeStep{t_, 0.0}, state_, trial_, &f_int, nullptr, &IE);
+  const double a = opt_.damping_alpha_1_s;
+  long local_steps = 0;
+  while (t_ < t_end - 1e-15) {
+    if (local_steps > 0 && local_steps % std::max(1, opt_.stability_interval) == 0) {
+      dt_ = estimate_stable_dt();
+      refresh_mass();
+    }
+    const double dt = std::min(dt_, t_end - t_);
+    stats_.dt_s = dt_;
+    stats_.dt_min_s = stats_.dt_min_s == 0.0 ? dt_ : std::min(stats_.dt_min_s, dt_);
+    // v^{n+1/2}
+    const Eigen::VectorXd v_old = v_;
+    v_ = ((1.0 - 0.5 * a * dt) * v_ + dt * minv.cwiseProduct(f_ext - f_int)) / (1.0 + 0.5 * a * dt);
+    const Eigen::VectorXd du = dt * v_;
+    // Energy: trapezoidal external work, damping work with the mid-step velocity.
+    const Eigen::VectorXd f_ext_old = f_ext;
+    u_ += du;
+    t_ += dt;
+    f_ext = external(t_, pressure);
+    asm_.internal(u_, TimeStep{t_, dt}, state_, trial_, &f_int, nullptr, &IE);
+    state_.swap(trial_);
+    energy_.external_work_J += 0.5 * du.dot(f_ext_old + f_ext);
+    Eigen::VectorXd mv(n);
+    for (int i = 0; i < n; ++i) mv[i] = m_[i / 3] * v_[i];
+    energy_.damping_J += a * du.dot(mv);
+    energy_.internal_J = IE;
+    // Kinetic energy at the integer step (average of the half-step velocities).
+    const Eigen::VectorXd vn = 0.5 * (v_old + v_);
+    double KE = 0.0;
+    for (int i = 0; i < n; ++i) KE += 0.5 * m_[i / 3] * vn[i] * vn[i];
+    energy_.kinetic_J = KE;
+    ++stats_.steps;
+    ++local_steps;
+    if (!v_.allFinite()) {
+      std::ostringstream s;
+      s << "explicit integration became unstable at t = " << t_ << " s (non-finite velocity). Hint: reduce "
+           "solver.dt_safety or enable mass scaling (solver.target_dt_s).";
+      throw PhysicsError(s.str(), -1, t_);
+    }
+    if (observer && (local_steps % std::max(1, observe_every) == 0 || t_ >= t_end - 1e-15)) observer(t_, u_, v_);
+  }
+}
+
+RelaxationReport relax(const Assembler& asmb, double p, const TimeStep& ts, std::span<const double> s_old,
+                       std::span<double> s_new, Eigen::VectorXd& u, const RelaxationOptions& opt) {
+  const int n = asmb.num_dofs();
+  const auto& fixed = asmb.model().fixed;
+  SparseMatrix K = asmb.tangent_pattern();
+  Eigen::VectorXd f_int, f_ext(n), v = Eigen::VectorXd::Zero(n), minv(n);
+  RelaxationReport rep;
+  auto residual = [&](bool tangent) {
+    f_ext.setZero();
+    asmb.internal(u, ts, s_old, s_new, &f_int, tangent ? &K : nullptr, nullptr);
+    asmb.add_pressure(u, p, f_ext, tangent ? &K : nullptr);
+    asmb.add_gravity(f_ext);
+    Eigen::VectorXd R = f_ext - f_int;  // out-of-balance force
+    asmb.zero_fixed(R);
+    rep.reference_N = std::max({rep.reference_N, f_ext.norm(), f_int.norm()});
+    return R;
+  };
+  auto update_masses = [&] {
+    const Eigen::VectorXd rows = asmb.row_abs_sums(K);
+    for (int i = 0; i < n; ++i) minv[i] = fixed[i] ? 0.0 : 1.0 / (opt.mass_factor * rows[i] + 1e-300);
+  };
+  Eigen::VectorXd R = residual(true);
+  update_masses();
+  double KE_prev = 0.0;
+  for (rep.iterations = 0; rep.iterations < opt.max_iterations; ++rep.iterations) {
+    rep.residual_N = R.norm();
+    if (!std::isfinite(rep.residual_N)) throw PhysicsError("dynamic relaxation diverged (non-finite residual)", -1, ts.time_s);
+    if (rep.residual_N <= opt.rel_tol * rep.reference_N + opt.abs_tol_N) {
+      rep.converged = true;
+      return rep;
+    }
+    v += minv.cwiseProduct(R);  // dt = 1
+    double KE = 0.0;
+    for (int i = 0; i < n; ++i)
+      if (minv[i] > 0) KE += 0.5 * v[i] * v[i] / minv[i];
+    if (KE < KE_prev) {
+      // Kinetic-energy peak passed: the configuration is near a local minimum of the energy
+      // along the current path, so restart from rest there (kinetic damping).
+      v.setZero();
+      KE = 0.0;
+      ++rep.kinetic_peaks;
+    } else {
+      u += v;
+    }
+    KE_prev = KE;
+    const bool refresh = (rep.iterations + 1) % opt.mass_update_interval == 0;
+    R = residual(refresh);
+    if (refresh) update_masses();
+  }
+  return rep;
+}
+
+}  // namespace pneufem

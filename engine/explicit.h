@@ -1,0 +1,110 @@
+#pragma once
+// Explicit central-difference time integration (real dynamics) and dynamic relaxation
+// (quasi-static equilibrium with fictitious masses), both on the lumped mass of the Assembler.
+//
+// Central difference with mass-proportional damping (Belytschko, Liu & Moran 2014, box 6.1):
+//   v^{n+1/2} = [(1 - a dt/2) v^{n-1/2} + dt M^{-1} (f_ext^n - f_int^n)] / (1 + a dt/2)
+//   u^{n+1}   = u^n + dt v^{n+1/2}
+// Stable step: dt <= 2/omega_max; omega_max^2 <= max_i sum_j |K_ij| / m_i (Gershgorin applied to
+// M^{-1} K, similar to the symmetric M^{-1/2} K M^{-1/2}), with K the current tangent, so the
+// bound holds for the nonlinear material and the follower load at the state it is evaluated.
+// Selective mass scaling raises only the masses of nodes that would force dt below the target
+// (the stiff fabric layer), and the added mass is reported.
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/assembly.h"
+
+namespace pneufem {
+
+struct ExplicitOptions {
+  double dt_safety = 0.8;          ///< fraction of the Gershgorin stable step used
+  double target_dt_s = 0.0;        ///< > 0: mass-scale nodes so the stable step is >= this
+  double damping_alpha_1_s = 0.0;  ///< mass-proportional damping coefficient a (1/s)
+  int stability_interval = 200;    ///< steps between stable-step re-estimates
+};
+
+struct EnergyBalance {
+  double kinetic_J = 0.0;
+  double internal_J = 0.0;
+  double external_work_J = 0.0;
+  double damping_J = 0.0;
+  /// |W_ext - KE - IE - W_damp| / max(W_ext, KE, IE, tiny): should stay small (< 1e-2).
+  double relative_error() const;
+};
+
+struct ExplicitStats {
+  long steps = 0;
+  double dt_s = 0.0;
+  double dt_min_s = 0.0;
+  double added_mass_kg = 0.0;  ///< mass added by selective mass scaling
+  double physical_mass_kg = 0.0;
+  long stability_estimates = 0;
+};
+
+class ExplicitIntegrator {
+ public:
+  using PressureFn = std::function<double(double /*time_s*/)>;
+  ExplicitIntegrator(const Assembler& assembler, ExplicitOptions options);
+
+  /// Integrates from the current time to t_end. `observer(t, u, v)` is called every
+  /// `observe_every` steps and at the end. Throws PhysicsError on inversion / instability.
+  void run(double t_end, const PressureFn& pressure, int observe_every,
+           const std::function<void(double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& observer);
+
+  /// Estimates the stable step at the current state and applies mass scaling when configured.
+  double estimate_stable_dt();
+
+  double time() const { return t_; }
+  Eigen::VectorXd& u() { return u_; }
+  Eigen::VectorXd& v() { return v_; }
+  std::vector<double>& state() { return state_; }
+  const EnergyBalance& energy() const { return energy_; }
+  const ExplicitStats& stats() const { return stats_; }
+  const Eigen::VectorXd& nodal_mass() const { return m_; }
+
+ private:
+  Eigen::VectorXd external(double t, const PressureFn& pressure) const;
+
+  const Assembler& asm_;
+  ExplicitOptions opt_;
+  Eigen::VectorXd m_;  ///< nodal (possibly scaled) masses, one per node
+  Eigen::VectorXd u_, v_;
+  std::vector<double> state_, trial_;
+  double t_ = 0.0;
+  double dt_ = 0.0;
+  SparseMatrix K_;
+  EnergyBalance energy_;
+  ExplicitStats stats_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+struct RelaxationOptions {
+  double rel_tol = 1e-8;           ///< same residual criterion as the static solver
+  double abs_tol_N = 1e-12;
+  long max_iterations = 2'000'000;
+  double mass_factor = 0.3;        ///< m_i = mass_factor * sum_j |K_ij| (>= 1/4 for dt = 1)
+  int mass_update_interval = 500;  ///< iterations between fictitious-mass updates
+};
+
+struct RelaxationReport {
+  bool converged = false;
+  long iterations = 0;
+  long kinetic_peaks = 0;
+  double residual_N = 0.0;
+  double reference_N = 0.0;
+};
+
+/// Dynamic relaxation with kinetic damping (Cundall 1976; Underwood 1983): pseudo-time step 1,
+/// per-node fictitious masses from the Gershgorin bound of the current tangent, velocities reset
+/// at every kinetic-energy peak. Converges to R(u) = 0 with the static solver's criterion, from
+/// the warm start u. Reads the committed state, writes the trial state.
+RelaxationReport relax(const Assembler& assembler, double p_Pa, const TimeStep& ts,
+                       std::span<const double> state_committed, std::span<double> state_trial,
+                       Eigen::VectorXd& u, const RelaxationOptions& options = {});
+
+}  // namespace pneufem

@@ -1,0 +1,91 @@
+#include "engine/load_history.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "materials/errors.h"
+
+namespace pneufem {
+
+double TrialLoad::pressure(double t) const {
+  if (time_s.empty()) return 0.0;
+  if (t <= time_s.front()) return pressure_Pa.front();
+  if (t >= time_s.back()) return pressure_Pa.back();
+  const auto it = std::upper_bound(time_s.begin(), time_s.end(), t);
+  const std::size_t i = static_cast<std::size_t>(it - time_s.begin());
+  const double t0 = time_s[i - 1], t1 = time_s[i];
+  const double w = (t - t0) / (t1 - t0);
+  return (1.0 - w) * pressure_Pa[i - 1] + w * pressure_Pa[i];
+}
+
+LoadHistory staircase(double p_max, double dp, double hold_s, double ramp_s, int trials, double mark_s,
+                      double rest_s, double output_every_s) {
+  auto bad = [](const std::string& key, const std::string& what) {
+    throw InputError("load." + key + ": " + what);
+  };
+  if (!(dp > 0)) bad("step_kPa", "must be > 0");
+  if (!(p_max >= 0)) bad("max_kPa", "must be >= 0");
+  if (!(hold_s > 0)) bad("hold_s", "must be > 0");
+  if (!(ramp_s >= 0 && ramp_s < hold_s)) bad("ramp_s", "must be >= 0 and shorter than hold_s");
+  if (trials < 1) bad("trials", "must be >= 1");
+  if (!(mark_s >= ramp_s && mark_s <= hold_s)) bad("mark_s", "must lie within the hold, after the ramp");
+  const int nlev = static_cast<int>(std::floor(p_max / dp + 1e-9)) + 1;
+  TrialLoad tl;
+  double prev = 0.0;
+  tl.time_s.push_back(0.0);
+  tl.pressure_Pa.push_back(0.0);
+  for (int k = 0; k < nlev; ++k) {
+    const double level = k * dp;
+    const double t0 = k * hold_s;
+    if (k > 0) {
+      if (ramp_s > 0) {
+        tl.time_s.push_back(t0 + ramp_s);
+        tl.pressure_Pa.push_back(level);
+      } else {
+        // a jump: represent by an infinitesimally short ramp
+        tl.time_s.push_back(t0 + 1e-9 * hold_s);
+        tl.pressure_Pa.push_back(level);
+      }
+    }
+    tl.time_s.push_back(t0 + hold_s);
+    tl.pressure_Pa.push_back(level);
+    tl.step_start_s.push_back(t0);
+    tl.step_end_s.push_back(t0 + hold_s);
+    tl.step_level_Pa.push_back(level);
+    tl.output_s.push_back(t0 + mark_s);
+    if (output_every_s > 0)
+      for (double t = t0 + output_every_s; t < t0 + hold_s - 1e-9; t += output_every_s) tl.output_s.push_back(t);
+    tl.output_s.push_back(t0 + hold_s);
+    prev = level;
+  }
+  (void)prev;
+  // Insert the start of each ramp (level k-1 held until t0): breakpoints must be increasing.
+  TrialLoad clean;
+  for (std::size_t i = 0; i < tl.time_s.size(); ++i) {
+    if (!clean.time_s.empty() && tl.time_s[i] <= clean.time_s.back() + 1e-12) {
+      clean.pressure_Pa.back() = tl.pressure_Pa[i];
+      continue;
+    }
+    clean.time_s.push_back(tl.time_s[i]);
+    clean.pressure_Pa.push_back(tl.pressure_Pa[i]);
+  }
+  clean.output_s = tl.output_s;
+  std::sort(clean.output_s.begin(), clean.output_s.end());
+  clean.output_s.erase(std::unique(clean.output_s.begin(), clean.output_s.end(),
+                                   [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+                       clean.output_s.end());
+  clean.step_start_s = tl.step_start_s;
+  clean.step_end_s = tl.step_end_s;
+  clean.step_level_Pa = tl.step_level_Pa;
+  LoadHistory h;
+  h.trials.assign(trials, clean);
+  h.rest_between_trials_s = rest_s;
+  std::ostringstream s;
+  s << "staircase 0-" << p_max * 1e-3 << " kPa in " << dp * 1e-3 << " kPa steps, " << hold_s << " s hold, " << trials
+    << " trial(s)";
+  h.description = s.str();
+  return h;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,32 @@
+#pragma once
+// Cavity-pressure histories: one piecewise-linear p(t) per trial, plus the times at which the
+// results are reported. Built by scenes/ from the staircase protocol or a measured CSV.
+#include <string>
+#include <vector>
+
+namespace pneufem {
+
+struct TrialLoad {
+  std::vector<double> time_s;       ///< breakpoints, strictly increasing, first = 0
+  std::vector<double> pressure_Pa;  ///< pressure at each breakpoint (linear in between)
+  std::vector<double> output_s;     ///< report times (within [0, duration])
+  /// Step (plateau) intervals [start, end) for metrics: the paper's 2.5 s mark is start + 2.5.
+  std::vector<double> step_start_s, step_end_s;
+  std::vector<double> step_level_Pa;
+  double duration() const { return time_s.empty() ? 0.0 : time_s.back(); }
+  double pressure(double t) const;
+};
+
+struct LoadHistory {
+  std::vector<TrialLoad> trials;
+  double rest_between_trials_s = 0.0;  ///< unloaded time between trials (material recovery)
+  std::string description;
+};
+
+/// The paper's staircase: levels 0, dp, ..., p_max, each held `hold_s` (the pressure reaches a
+/// level within `ramp_s`), `trials` repetitions; reports at start + mark_s and at the end of
+/// each hold (plus every `output_every_s` if > 0).
+LoadHistory staircase(double p_max_Pa, double dp_Pa, double hold_s, double ramp_s, int trials,
+                      double mark_s, double rest_s, double output_every_s = 0.0);
+
+}  // namespace pneufem

@@ -1,0 +1,80 @@
+#pragma once
+// Static (quasi-static) equilibrium by Newton's method with a consistent tangent, including the
+// follower-pressure load stiffness, a residual line search, and adaptive load continuation.
+// It shares the element and material code of the explicit integrator (Assembler), so
+// "the same equilibrium as a static solver" is a statement about the same discrete equations.
+//
+// Equilibrium: R(u) = f_int(u) - f_ext(u; p) = 0 on the free dofs, with p the cavity pressure.
+// Convergence: ||R_free||_2 <= rel_tol * max(||f_ext||_2, ||f_int||_2) (+ abs_tol_N).
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/assembly.h"
+#include "engine/linear_solver.h"
+
+namespace pneufem {
+
+struct StaticOptions {
+  double rel_tol = 1e-8;          ///< relative residual tolerance
+  double abs_tol_N = 1e-12;       ///< absolute residual floor (N)
+  int max_iterations = 25;        ///< Newton iterations per increment
+  double max_increment_Pa = 5e3;  ///< largest pressure sub-increment of a continuation
+  double min_increment_Pa = 1.0;  ///< give up (limit point) below this sub-increment
+};
+
+struct NewtonReport {
+  bool converged = false;
+  int iterations = 0;
+  int line_search_cuts = 0;
+  int regularised = 0;       ///< factorisations that needed a diagonal shift (not PD)
+  double residual_N = 0.0;   ///< final ||R_free||
+  double reference_N = 0.0;  ///< force scale used by the relative tolerance
+  std::string failure;       ///< why it failed, when it did
+};
+
+/// Cumulative counters of a solver (reported in the run summary).
+struct StaticStats {
+  long increments = 0;
+  long cutbacks = 0;
+  long iterations = 0;
+  long factorizations = 0;
+  long residual_evaluations = 0;
+  double assembly_s = 0.0;
+  double factor_s = 0.0;
+};
+
+class StaticSolver {
+ public:
+  StaticSolver(const Assembler& assembler, StaticOptions options = {});
+
+  /// Newton at fixed load (pressure p_Pa, physical step ts for rate laws) from the guess u.
+  /// Reads the committed material state, writes the trial state of the final iterate.
+  NewtonReport solve(double p_Pa, const TimeStep& ts, std::span<const double> state_committed,
+                     std::span<double> state_trial, Eigen::VectorXd& u);
+
+  /// Moves the equilibrium from (p0, t0) to (p1, t1) in adaptive sub-increments, committing the
+  /// material state after each accepted one (pressure and time advance together). Throws
+  /// PhysicsError when the increment falls below min_increment_Pa (e.g. at a limit point).
+  void advance(double p0_Pa, double p1_Pa, double t0_s, double t1_s, std::vector<double>& state,
+               Eigen::VectorXd& u);
+
+  /// Residual R(u) on the free dofs (fixed entries zeroed).
+  Eigen::VectorXd residual(double p_Pa, const TimeStep& ts, std::span<const double> state_committed,
+                           std::span<double> state_trial, const Eigen::VectorXd& u);
+
+  const StaticStats& stats() const { return stats_; }
+  const StaticOptions& options() const { return opt_; }
+
+ private:
+  const Assembler& asm_;
+  StaticOptions opt_;
+  LinearSolver linear_;
+  SparseMatrix K_;
+  StaticStats stats_;
+  Eigen::VectorXd last_du_per_Pa_;  ///< secant predictor from the last accepted increment
+};
+
+}  // namespace pneufem

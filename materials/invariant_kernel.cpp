@@ -1,0 +1,67 @@
+#include "materials/invariant_kernel.h"
+
+#include <cmath>
+
+namespace pneufem {
+
+Invariants isochoric_invariants(const Mat3& F) {
+  const double J = F.determinant();
+  const Mat3 C = F.transpose() * F;
+  const double I1 = C.trace();
+  const double I2 = 0.5 * (I1 * I1 - (C * C).trace());
+  const double Jm23 = std::cbrt(1.0 / (J * J));
+  return {J, Jm23 * I1, Jm23 * Jm23 * I2};
+}
+
+void invariant_response(const Mat3& F, const InvariantDerivatives& d, bool tangent, PointResponse& out) {
+  const double J = F.determinant();
+  const Mat3 H = F.inverse().transpose();
+  const Mat3 C = F.transpose() * F;
+  const Mat3 B = F * F.transpose();
+  const Mat3 FC = F * C;
+  const double I1 = C.trace();
+  const double I2 = 0.5 * (I1 * I1 - (C * C).trace());
+  const double a = std::cbrt(1.0 / (J * J));  // J^{-2/3}
+  const double b = a * a;                     // J^{-4/3}
+
+  const Mat3 G2 = 2.0 * (I1 * F - FC);                   // dI2/dF
+  const Mat3 g1 = a * (2.0 * F - (2.0 / 3.0) * I1 * H);  // dI1b/dF
+  const Mat3 g2 = b * (G2 - (4.0 / 3.0) * I2 * H);       // dI2b/dF
+
+  out.psi_iso = d.W;
+  out.psi_vol = d.U;
+  out.P_iso = d.W1 * g1 + d.W2 * g2;
+  out.P_vol = d.dU * J * H;
+  if (!tangent) return;
+
+  const Vec9 v1 = flatten(g1), v2 = flatten(g2), vH = flatten(H);
+  Mat9& Ai = out.A_iso;
+  Ai = d.W11 * v1 * v1.transpose() + d.W12 * (v1 * v2.transpose() + v2 * v1.transpose()) +
+       d.W22 * v2 * v2.transpose();
+  Mat9& Av = out.A_vol;
+  // d(J H)/dF = J (H (x) H - H_iL H_kJ);  d2U: U'' J^2 H (x) H.
+  Av = (d.d2U * J * J + d.dU * J) * vH * vH.transpose();
+  for (int i = 0; i < 3; ++i)
+    for (int Jx = 0; Jx < 3; ++Jx)
+      for (int k = 0; k < 3; ++k)
+        for (int L = 0; L < 3; ++L) {
+          const int r = flat(i, Jx), c = flat(k, L);
+          const double HH = H(i, L) * H(k, Jx);
+          const double dik = (i == k) ? 1.0 : 0.0, dJL = (Jx == L) ? 1.0 : 0.0;
+          Av(r, c) -= d.dU * J * HH;
+          // d2 I1b / dF2
+          const double d2I1b = -(2.0 / 3.0) * a * H(k, L) * (2.0 * F(i, Jx) - (2.0 / 3.0) * I1 * H(i, Jx)) +
+                               a * (2.0 * dik * dJL - (4.0 / 3.0) * F(k, L) * H(i, Jx) + (2.0 / 3.0) * I1 * HH);
+          double acc = d.W1 * d2I1b;
+          if (d.W2 != 0.0) {
+            const double dG2 = 2.0 * (2.0 * F(i, Jx) * F(k, L) + I1 * dik * dJL - dik * C(L, Jx) -
+                                      F(i, L) * F(k, Jx) - dJL * B(i, k));
+            const double d2I2b = -(4.0 / 3.0) * b * H(k, L) * (G2(i, Jx) - (4.0 / 3.0) * I2 * H(i, Jx)) +
+                                 b * (dG2 - (4.0 / 3.0) * G2(k, L) * H(i, Jx) + (4.0 / 3.0) * I2 * HH);
+            acc += d.W2 * d2I2b;
+          }
+          Ai(r, c) += acc;
+        }
+}
+
+}  // namespace pneufem

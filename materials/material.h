@@ -1,0 +1,89 @@
+#pragma once
+// The constitutive interface the engine evaluates at every quadrature point.
+//
+// A Material is immutable once built (parameters validated in the constructor) and is
+// evaluated as a pure function of the deformation gradient F and an explicit per-point
+// history state: the committed state is read, the trial state is written, and the
+// integrator alone decides when a trial becomes committed (FEBio's pattern). Purely
+// elastic laws have state_size() == 0.
+//
+// Responses are split into an isochoric ("iso") and a volumetric ("vol") part because the
+// inelastic effects of damage/ (Mullins, fatigue, viscoelasticity) act on the isochoric part
+// only, as Abaqus and FEBio define them; laws that are not split (St Venant-Kirchhoff) put
+// everything in "iso" and report is_split() == false.
+//
+// Units: SI (Pa for stresses and energy densities J/m^3, s for time).
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "materials/tensor.h"
+
+namespace pneufem {
+
+/// Response of a material at one point. P = P_iso + P_vol (first Piola-Kirchhoff, Pa),
+/// psi = psi_iso + psi_vol (Helmholtz energy per reference volume, J/m^3), A = dP/dF (Pa).
+struct PointResponse {
+  double psi_iso = 0.0;
+  double psi_vol = 0.0;
+  Mat3 P_iso = Mat3::Zero();
+  Mat3 P_vol = Mat3::Zero();
+  Mat9 A_iso = Mat9::Zero();  ///< only filled when a tangent is requested
+  Mat9 A_vol = Mat9::Zero();
+
+  double psi() const { return psi_iso + psi_vol; }
+  Mat3 P() const { return P_iso + P_vol; }
+  Mat9 A() const { return A_iso + A_vol; }
+};
+
+/// Physical-time information for rate-dependent laws. A purely elastic evaluation
+/// (e.g. the pseudo-time iterations of a static solve) keeps dt_s = 0 semantics: laws
+/// then return the state reached at the end of the increment dt_s.
+struct TimeStep {
+  double time_s = 0.0;  ///< physical time at the end of the increment
+  double dt_s = 0.0;    ///< physical increment since the committed state (>= 0)
+};
+
+/// Scalar outputs a material can report per point for visualisation (damage etc.).
+struct PointFields {
+  double damage = 0.0;          ///< isochoric softening 1 - (stiffness fraction), in [0, 1)
+  double W_max = 0.0;           ///< peak isochoric energy density seen so far (J/m^3)
+  double viscous_strain = 0.0;  ///< norm of the viscous (overstress) strain measure
+};
+
+class Material {
+ public:
+  virtual ~Material() = default;
+
+  /// Short name, e.g. "yeoh", "mullins(yeoh)".
+  virtual std::string name() const = 0;
+
+  /// Number of doubles of history per quadrature point (0 for elastic laws).
+  virtual int state_size() const { return 0; }
+  /// Writes the virgin state into `state` (size state_size()).
+  virtual void init_state(std::span<double> state) const { (void)state; }
+
+  /// Evaluates n = F.size() points. `state_old` and `state_new` hold n * state_size()
+  /// doubles (either may be empty when state_size() == 0). When `tangent` is false the
+  /// A_* members of `out` are left untouched.
+  virtual void evaluate(std::span<const Mat3> F, const TimeStep& step,
+                        std::span<const double> state_old, std::span<double> state_new,
+                        std::span<PointResponse> out, bool tangent) const = 0;
+
+  /// Visualisation fields from a (committed) state of one point.
+  virtual PointFields fields(std::span<const double> state) const {
+    (void)state;
+    return {};
+  }
+
+  /// Small-strain moduli at F = I (Pa): used for stable-step estimates and scaling.
+  virtual double initial_shear_modulus() const = 0;
+  virtual double initial_bulk_modulus() const = 0;
+  /// True when the response is split as P_iso (isochoric) + P_vol (volumetric).
+  virtual bool is_split() const { return true; }
+};
+
+using MaterialPtr = std::shared_ptr<const Material>;
+
+}  // namespace pneufem
