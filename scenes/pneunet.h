@@ -1,0 +1,45 @@
+#pragma once
+// Parametric slow pneu-net geometry, built as a solid with OpenVDB (level-set CSG of boxes) and
+// meshed into conforming tetrahedra with region tags, named node sets and the cavity surface.
+//
+// Frame (as the CalculiX reference, ../shared/reference/calculix): x = width (centred on 0),
+// y = length (0 at the fixed inlet end), z = up (0 at the bottom of the base). SI units (m).
+#include <string>
+
+#include "engine/mesh.h"
+
+namespace pneufem {
+
+struct PneuNetParams {
+  // Geometry (m). Defaults: the default actuator of the engine issue (= CalculiX reference).
+  double width = 22e-3;            ///< x
+  double base_thickness = 3e-3;    ///< base slab, z in [0, base_thickness]
+  double body_height = 15e-3;      ///< body above the base
+  int chambers = 15;
+  double chamber_length = 6e-3;    ///< y extent of a chamber
+  double interior_wall = 2e-3;     ///< y thickness of the walls between chambers
+  double side_wall = 7e-3;         ///< x thickness of the side walls (chamber width = width - 2 side)
+  double roof = 7e-3;              ///< z thickness above the chambers (chamber height = body - roof)
+  double end_cap = 4e-3;           ///< y thickness of the end walls
+  double channel_width = 2e-3;     ///< air channel, x-centred
+  double channel_height = 2e-3;    ///< from the base top face
+  double fabric_z0 = 1.8e-3;       ///< fabric layer bottom
+  double fabric_thickness = 0.4e-3;
+  // Mesh.
+  double h = 2e-3;                 ///< target element size (m)
+  int fabric_layers = 1;           ///< elements through the fabric thickness
+  bool half = true;                ///< model x >= 0 only, symmetry plane x = 0
+  ElementType element = ElementType::Tet10;
+
+  double length() const { return 2 * end_cap + chambers * chamber_length + (chambers - 1) * interior_wall; }
+  /// Throws InputError naming the offending parameter (scene key "geometry.<name>").
+  void validate() const;
+};
+
+/// Builds the mesh. Node sets: "FIXED" (face y = 0), "TIP" (face y = L), "SYMMETRY" (x = 0,
+/// half model only). Element sets: "SILICONE", "FABRIC". Surface "CAVITY": every face bounding
+/// the chambers and the channel (including the cavity floor on the base). Region tags:
+/// interior_wall, roof, side_wall, end_cap, base, fabric (mesh.h).
+Mesh build_pneunet(const PneuNetParams& p);
+
+}  // namespace pneufem
