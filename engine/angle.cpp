@@ -19,7 +19,9 @@ AngleResult bending_angle(const Model& model, const Eigen::VectorXd& u) {
     const Eigen::Vector3d x = X + u.segment<3>(3 * n);
     P.push_back(X);
     Q.push_back(x);
-    if (spec.mirror_axis >= 0) {  // half model: add the mirror image so the fit sees the whole face
+    // Half model: add the mirror image so the fit sees the whole face (nodes on the symmetry
+    // plane are their own image and are not duplicated, so the fit weights match a full model).
+    if (spec.mirror_axis >= 0 && std::abs(X[spec.mirror_axis]) > 1e-9 * (1.0 + X.norm())) {
       Eigen::Vector3d Xm = X, xm = x;
       Xm[spec.mirror_axis] = -Xm[spec.mirror_axis];
       xm[spec.mirror_axis] = -xm[spec.mirror_axis];

@@ -60,16 +60,23 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
   auto refresh_mass = [&] {
     for (int i = 0; i < n; ++i) minv[i] = fixed[i] ? 0.0 : 1.0 / m_[i / 3];
   };
-  if (dt_ == 0.0 || stats_.steps % std::max(1, opt_.stability_interval) == 0) dt_ = estimate_stable_dt();
+  auto new_dt = [&] {
+    const double est = estimate_stable_dt();
+    return opt_.fixed_dt_s > 0.0 ? opt_.fixed_dt_s : est;
+  };
+  if (dt_ == 0.0 || stats_.steps % std::max(1, opt_.stability_interval) == 0) dt_ = new_dt();
   refresh_mass();
   Eigen::VectorXd f_int, f_ext = external(t_, pressure);
   double IE = 0.0;
   asm_.internal(u_, TimeStep{t_, 0.0}, state_, trial_, &f_int, nullptr, &IE);
   const double a = opt_.damping_alpha_1_s;
   long local_steps = 0;
+  double KE0 = 0.0;  // energy present at the start (initial velocities)
+  for (int i = 0; i < n; ++i) KE0 += 0.5 * m_[i / 3] * v_[i] * v_[i];
+  const double E0 = KE0 + IE;
   while (t_ < t_end - 1e-15) {
     if (local_steps > 0 && local_steps % std::max(1, opt_.stability_interval) == 0) {
-      dt_ = estimate_stable_dt();
+      dt_ = new_dt();
       refresh_mass();
     }
     const double dt = std::min(dt_, t_end - t_);
@@ -84,7 +91,14 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
     u_ += du;
     t_ += dt;
     f_ext = external(t_, pressure);
-    asm_.internal(u_, TimeStep{t_, dt}, state_, trial_, &f_int, nullptr, &IE);
+    try {
+      asm_.internal(u_, TimeStep{t_, dt}, state_, trial_, &f_int, nullptr, &IE);
+    } catch (const PhysicsError& e) {
+      std::ostringstream s;
+      s << "explicit step failed at t = " << t_ << " s with dt = " << dt << " s (the step may be unstable, or "
+        << "the structure collapsed): " << e.what();
+      throw PhysicsError(s.str(), e.element(), t_);
+    }
     state_.swap(trial_);
     energy_.external_work_J += 0.5 * du.dot(f_ext_old + f_ext);
     Eigen::VectorXd mv(n);
@@ -98,10 +112,21 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
     energy_.kinetic_J = KE;
     ++stats_.steps;
     ++local_steps;
-    if (!v_.allFinite()) {
+    // Instability shows as kinetic energy far above all the work put in (energy balance).
+    const double budget = std::max({std::abs(energy_.external_work_J) + E0, std::abs(IE), 1e-30});
+    if (!v_.allFinite() || KE > 10.0 * budget) {
+      int node = 0;
+      double vmax = -1.0;
+      for (int i = 0; i < n / 3; ++i)
+        if (v_.segment<3>(3 * i).allFinite() && v_.segment<3>(3 * i).norm() > vmax) {
+          vmax = v_.segment<3>(3 * i).norm();
+          node = i;
+        }
       std::ostringstream s;
-      s << "explicit integration became unstable at t = " << t_ << " s (non-finite velocity). Hint: reduce "
-           "solver.dt_safety or enable mass scaling (solver.target_dt_s).";
+      s << "explicit integration became unstable at t = " << t_ << " s (kinetic energy " << KE
+        << " J exceeds the work done " << budget << " J; fastest node " << asm_.model().mesh.node_ids[node]
+        << "), dt = " << dt << " s. Hint: use the estimated stable step (remove solver.dt_s), lower "
+        << "solver.dt_safety, or enable selective mass scaling (solver.target_dt_s).";
       throw PhysicsError(s.str(), -1, t_);
     }
     if (observer && (local_steps % std::max(1, observe_every) == 0 || t_ >= t_end - 1e-15)) observer(t_, u_, v_);

@@ -25,6 +25,7 @@ struct ExplicitOptions {
   double target_dt_s = 0.0;        ///< > 0: mass-scale nodes so the stable step is >= this
   double damping_alpha_1_s = 0.0;  ///< mass-proportional damping coefficient a (1/s)
   int stability_interval = 200;    ///< steps between stable-step re-estimates
+  double fixed_dt_s = 0.0;         ///< > 0: use this step instead of the estimate (expert use)
 };
 
 struct EnergyBalance {
@@ -87,7 +88,8 @@ struct RelaxationOptions {
   double rel_tol = 1e-8;           ///< same residual criterion as the static solver
   double abs_tol_N = 1e-12;
   long max_iterations = 2'000'000;
-  double mass_factor = 0.3;        ///< m_i = mass_factor * sum_j |K_ij| (>= 1/4 for dt = 1)
+  double mass_factor = 0.5;        ///< m_i = mass_factor * sum_j |K_ij| (stability needs >= 1/4 at dt = 1;
+                                   ///< 1/2 leaves room for stiffening between mass updates)
   int mass_update_interval = 500;  ///< iterations between fictitious-mass updates
 };
 
