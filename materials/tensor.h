@@ -4,6 +4,7 @@
 // Fourth-order tangents A = dP/dF are stored as 9x9 matrices acting on F flattened
 // column-major (Eigen's default): index(i,J) = i + 3*J, so A(i+3J, k+3L) = dP_iJ / dF_kL.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 namespace pneufem {
