@@ -1,6 +1,9 @@
 #pragma once
-// Parametric slow pneu-net geometry, built as a solid with OpenVDB (level-set CSG of boxes) and
-// meshed into conforming tetrahedra with region tags, named node sets and the cavity surface.
+// Parametric slow pneu-net geometry, built as a solid with OpenVDB (voxel CSG of boxes) and
+// meshed into conforming tetrahedra with region tags, named node sets and the cavity surface:
+// a rectilinear grid through every feature plane, each solid cell split into 5 tetrahedra
+// (scenes/pneunet.cpp explains the choices). Volumes and areas are exact; the build is
+// deterministic, elements are ordered along y and nodes by first use.
 //
 // Frame (as the CalculiX reference, ../shared/reference/calculix): x = width (centred on 0),
 // y = length (0 at the fixed inlet end), z = up (0 at the bottom of the base). SI units (m).
