@@ -1,1 +1,889 @@
-// placeholder
+#include "scenes/inp.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "materials/errors.h"
+
+namespace pneufem {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Text helpers
+// ---------------------------------------------------------------------------------------------
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::string upper(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  return out;
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return out;
+}
+
+/// Splits a data or keyword line at commas into trimmed fields. A trailing comma (Abaqus:
+/// "continued on the next line") does not produce an empty last field; it is reported instead.
+void split_fields(std::string_view line, std::vector<std::string_view>& fields, bool& trailing_comma) {
+  fields.clear();
+  line = trim(line);
+  trailing_comma = !line.empty() && line.back() == ',';
+  if (trailing_comma) line.remove_suffix(1);
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+}
+
+/// Whole-field integer ("+12" allowed); nullopt for anything else.
+std::optional<long> parse_long(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  long v = 0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+/// Whole-field finite real. Accepts what Fortran list input accepts in decks: "1.", ".5", "+2",
+/// "1e-3" and the double-precision exponent "1.0D-3". Rejects inf/nan.
+std::optional<double> parse_double(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty() || s.size() > 64) return std::nullopt;
+  std::array<char, 64> buf{};
+  for (std::size_t i = 0; i < s.size(); ++i) buf[i] = (s[i] == 'd' || s[i] == 'D') ? 'e' : s[i];
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(buf.data(), buf.data() + s.size(), v);
+  if (ec != std::errc() || ptr != buf.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+/// Keyword name: "*Solid  Section, ..." -> "SOLID SECTION".
+std::string keyword_name(std::string_view field) {
+  field = trim(field.substr(1));  // drop '*'
+  std::string out;
+  bool space = false;
+  for (char c : field) {
+    if (is_blank(c)) {
+      space = true;
+      continue;
+    }
+    if (space && !out.empty()) out.push_back(' ');
+    space = false;
+    out.push_back(c);
+  }
+  return upper(out);
+}
+
+struct Keyword {
+  std::string name;                           ///< upper case, single spaces
+  std::map<std::string, std::string> params;  ///< upper-case key -> value as written (unquoted)
+  bool has(const std::string& key) const { return params.count(key) != 0; }
+  std::string get(const std::string& key) const {
+    const auto it = params.find(key);
+    return it == params.end() ? std::string() : it->second;
+  }
+};
+
+Keyword parse_keyword(std::string_view line) {
+  std::vector<std::string_view> fields;
+  bool trailing = false;
+  split_fields(line, fields, trailing);
+  Keyword kw;
+  kw.name = keyword_name(fields[0]);
+  for (std::size_t i = 1; i < fields.size(); ++i) {
+    const std::string_view f = fields[i];
+    if (f.empty()) continue;
+    const std::size_t eq = f.find('=');
+    std::string key = upper(trim(f.substr(0, eq)));
+    std::string_view value = eq == f.npos ? std::string_view() : trim(f.substr(eq + 1));
+    if (value.size() >= 2 && value.front() == '"' && value.back() == '"') value = value.substr(1, value.size() - 2);
+    kw.params[std::move(key)] = std::string(value);
+  }
+  return kw;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Deck reader
+// ---------------------------------------------------------------------------------------------
+
+struct Loc {
+  int file = 0;  ///< index into DeckReader::file_names_
+  int line = 0;  ///< 1-based
+};
+
+enum class Block { None, Skip, Node, Element, NodeSet, ElementSet, Surface, Dload, Boundary };
+
+constexpr int kMaxIncludeDepth = 32;
+constexpr std::size_t kMaxRegions = 65535;  // Mesh::region holds std::uint16_t
+
+/// Single pass over the deck. *INCLUDE is textual (as in CalculiX): the included lines are read in
+/// place of the *INCLUDE line, so a data block may continue into an included file.
+class DeckReader {
+ public:
+  explicit DeckReader(double length_to_m) : length_to_m_(length_to_m) {}
+
+  InpDeck read(const std::string& path) {
+    push_file(path, std::nullopt);
+    std::string_view text;
+    Loc loc;
+    bool any_line = false;
+    while (next_line(text, loc)) {
+      any_line = true;
+      if (text.front() == '*')
+        begin_block(text, loc);
+      else
+        data_line(text, loc);
+    }
+    end_block();
+    if (!any_line)
+      fail(Loc{0, std::max(1, last_line_of_top_)}, "the deck is empty (no keyword or data lines)",
+           "give a deck with *NODE and *ELEMENT, TYPE=C3D4 or C3D10 blocks");
+    finish();
+    return std::move(deck_);
+  }
+
+ private:
+  // ---- errors and warnings ------------------------------------------------------------------
+  std::string where(const Loc& loc) const {
+    return file_names_[static_cast<std::size_t>(loc.file)] + ":" + std::to_string(loc.line);
+  }
+
+  [[noreturn]] void fail(const Loc& loc, const std::string& what, const std::string& todo) const {
+    throw InputError(where(loc) + ": " + what + "; " + todo);
+  }
+
+  /// Adds `message` to the warnings unless a warning with the same key was already given.
+  void warn_once(const std::string& key, const Loc& loc, const std::string& message) {
+    if (warned_.insert(key).second) deck_.warnings.push_back(where(loc) + ": " + message);
+  }
+
+  // ---- line source --------------------------------------------------------------------------
+  struct Frame {
+    int file = 0;
+    std::size_t pos = 0;
+    int line = 0;
+  };
+
+  void push_file(const std::string& path, const std::optional<Loc>& from) {
+    std::ifstream in;
+    std::error_code ec;
+    if (!fs::is_directory(path, ec)) in.open(path, std::ios::binary);
+    if (!in) {
+      if (!from) throw InputError(path + ": cannot open the deck; check the path and the file permissions");
+      fail(*from, "cannot open include file '" + path + "'",
+           "check INPUT= (a relative path is taken from the directory of the including file)");
+    }
+    std::string text;
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    in.seekg(0, std::ios::beg);
+    if (size > 0) {
+      text.resize(static_cast<std::size_t>(size));
+      in.read(text.data(), size);
+      text.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+    }
+    if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte-order mark
+    buffers_.push_back(std::move(text));
+    file_names_.push_back(path);
+    stack_.push_back(Frame{static_cast<int>(file_names_.size()) - 1, 0, 0});
+  }
+
+  /// Next non-blank, non-comment line (trimmed), with *INCLUDE resolved. False at the end.
+  bool next_line(std::string_view& text, Loc& loc) {
+    while (!stack_.empty()) {
+      Frame& fr = stack_.back();
+      const std::string& buf = buffers_[static_cast<std::size_t>(fr.file)];
+      if (fr.pos >= buf.size()) {
+        if (stack_.size() == 1) last_line_of_top_ = fr.line;
+        stack_.pop_back();
+        continue;
+      }
+      const std::size_t nl = buf.find('\n', fr.pos);
+      const std::size_t end = nl == std::string::npos ? buf.size() : nl;
+      text = trim(std::string_view(buf).substr(fr.pos, end - fr.pos));
+      fr.pos = end + 1;
+      ++fr.line;
+      loc = Loc{fr.file, fr.line};
+      if (text.empty() || text.starts_with("**")) continue;
+      if (text.front() == '*' && keyword_name(text.substr(0, text.find(','))) == "INCLUDE") {
+        include(text, loc);
+        continue;
+      }
+      return true;
+    }
+    return false;
+  }
+
+  void include(std::string_view text, const Loc& loc) {
+    const Keyword kw = parse_keyword(text);
+    const std::string input = kw.get("INPUT");
+    if (input.empty()) fail(loc, "*INCLUDE without INPUT=<file>", "add INPUT=<path of the file to include>");
+    if (static_cast<int>(stack_.size()) >= kMaxIncludeDepth)
+      fail(loc, "*INCLUDE nested deeper than " + std::to_string(kMaxIncludeDepth) + " files",
+           "check for a file that includes itself");
+    fs::path p(input);
+    if (p.is_relative()) p = fs::path(file_names_[static_cast<std::size_t>(loc.file)]).parent_path() / p;
+    push_file(p.string(), loc);
+  }
+
+  // ---- blocks -------------------------------------------------------------------------------
+  void begin_block(std::string_view text, const Loc& loc) {
+    end_block();
+    const Keyword kw = parse_keyword(text);
+    block_ = Block::Skip;
+    if (kw.name == "NODE")
+      begin_nodes(kw, loc);
+    else if (kw.name == "ELEMENT")
+      begin_elements(kw, loc);
+    else if (kw.name == "NSET" || kw.name == "ELSET")
+      begin_set(kw, loc);
+    else if (kw.name == "SURFACE")
+      begin_surface(kw, loc);
+    else if (kw.name == "DLOAD")
+      block_ = Block::Dload;
+    else if (kw.name == "BOUNDARY")
+      block_ = Block::Boundary;
+    else
+      warn_once("keyword " + kw.name, loc,
+                "*" + kw.name +
+                    " skipped (only the mesh, sets, surfaces, *DLOAD Pn and *BOUNDARY are read; "
+                    "materials and steps come from the scene)");
+  }
+
+  void end_block() {
+    if (block_ == Block::Element && !pending_.empty()) {
+      fail(pending_loc_,
+           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
+               " nodes but a " + type_name_ + " has " + std::to_string(npe_),
+           "list all its nodes (a line ending with ',' continues on the next data line)");
+    }
+    if (open_members_) unsorted_.insert(open_members_);
+    open_members_ = nullptr;
+    open_set_.clear();
+    block_ = Block::None;
+  }
+
+  void data_line(std::string_view text, const Loc& loc) {
+    split_fields(text, fields_, trailing_comma_);
+    switch (block_) {
+      case Block::None:
+        fail(loc, "data line before any keyword", "start the deck with a keyword line such as *NODE");
+      case Block::Skip:
+        return;
+      case Block::Node:
+        return node_line(loc);
+      case Block::Element:
+        return element_line(loc);
+      case Block::NodeSet:
+      case Block::ElementSet:
+        return set_line(loc);
+      case Block::Surface:
+        return surface_line(loc);
+      case Block::Dload:
+        return dload_line(loc);
+      case Block::Boundary:
+        return boundary_line(loc);
+    }
+  }
+
+  // ---- *NODE --------------------------------------------------------------------------------
+  void begin_nodes(const Keyword& kw, const Loc& loc) {
+    if (kw.has("INPUT")) fail(loc, "*NODE, INPUT= is not supported", "put the node lines in a file read with *INCLUDE");
+    const std::string system = upper(kw.get("SYSTEM"));
+    if (!system.empty() && system != "R")
+      fail(loc, "*NODE, SYSTEM=" + system + " (non-Cartesian coordinates) is not supported",
+           "write Cartesian coordinates (SYSTEM=R)");
+    block_ = Block::Node;
+    open_set(deck_.mesh.node_sets, kw.get("NSET"));
+  }
+
+  void node_line(const Loc& loc) {
+    const std::optional<long> id = parse_long(fields_[0]);
+    if (!id || *id <= 0)
+      fail(loc, "node id '" + std::string(fields_[0]) + "' is not a positive integer",
+           "a *NODE data line is 'id, x, y, z'");
+    if (fields_.size() < 4)
+      fail(loc,
+           "node " + std::to_string(*id) + " has " + std::to_string(fields_.size() - 1) +
+               " coordinate(s) but pneufem needs 3-D nodes",
+           "give 'id, x, y, z' (2-D decks are not supported)");
+    Eigen::Vector3d x;
+    for (int k = 0; k < 3; ++k) {
+      const std::string_view f = fields_[static_cast<std::size_t>(k) + 1];
+      const std::optional<double> v = f.empty() ? std::optional<double>(0.0) : parse_double(f);  // Abaqus: blank = 0
+      if (!v)
+        fail(loc,
+             "node " + std::to_string(*id) + ": coordinate " + "xyz"[k] + " '" + std::string(f) +
+                 "' is not a finite number",
+             "fix the value");
+      x[k] = *v * length_to_m_;
+    }
+    const int index = deck_.mesh.num_nodes();
+    if (!node_index_.try_emplace(*id, index).second)
+      fail(loc, "node " + std::to_string(*id) + " is defined twice", "node ids must be unique: renumber or remove one");
+    deck_.mesh.X.push_back(x);
+    deck_.mesh.node_ids.push_back(*id);
+    if (open_members_) open_members_->push_back(index);
+  }
+
+  // ---- *ELEMENT -----------------------------------------------------------------------------
+  void begin_elements(const Keyword& kw, const Loc& loc) {
+    if (kw.has("INPUT"))
+      fail(loc, "*ELEMENT, INPUT= is not supported", "put the element lines in a file read with *INCLUDE");
+    const std::string type = upper(kw.get("TYPE"));
+    if (type.empty()) fail(loc, "*ELEMENT without TYPE=", "add TYPE=C3D4 or TYPE=C3D10");
+    ElementType et;
+    if (type == "C3D4" || type == "C3D4H") {
+      et = ElementType::Tet4;
+      type_name_ = "C3D4";
+    } else if (type == "C3D10" || type == "C3D10H" || type == "C3D10M") {
+      et = ElementType::Tet10;
+      type_name_ = "C3D10";
+    } else {
+      fail(loc, "element type " + type + " is not supported (pneufem has only C3D4 and C3D10 tetrahedra)",
+           "convert the mesh to C3D4 or C3D10 tetrahedra, or delete this *ELEMENT block if it holds surface "
+           "or line elements");
+    }
+    if (type != type_name_)
+      warn_once("type " + type, loc,
+                type + " is read as " + type_name_ + " (the hybrid/modified formulation is the scene's choice)");
+    if (!first_type_loc_) {
+      deck_.mesh.type = et;
+      first_type_loc_ = loc;
+    } else if (deck_.mesh.type != et) {
+      fail(loc,
+           "TYPE=" + type + " mixes element orders with the " +
+               std::string(deck_.mesh.type == ElementType::Tet4 ? "C3D4" : "C3D10") + " elements of " +
+               where(*first_type_loc_),
+           "use one element order throughout (all C3D4 or all C3D10)");
+    }
+    npe_ = nodes_per_element(et);
+    block_ = Block::Element;
+    const std::string elset = kw.get("ELSET");
+    open_set(deck_.mesh.element_sets, elset);
+    const std::string region = elset.empty() ? std::string("default") : lower(elset);
+    if (deck_.mesh.find_region(region) < 0 && deck_.mesh.region_names.size() > kMaxRegions)
+      fail(loc, "more than " + std::to_string(kMaxRegions + 1) + " distinct ELSET= names on *ELEMENT",
+           "group the elements into fewer element sets (regions)");
+    region_ = deck_.mesh.region_id(region);
+  }
+
+  void element_line(const Loc& loc) {
+    if (pending_.empty()) pending_loc_ = loc;
+    for (std::size_t i = 0; i < fields_.size(); ++i) {
+      const std::string_view f = fields_[i];
+      const std::optional<long> v = parse_long(f);
+      if (!v) {
+        const std::string who =
+            pending_.empty() ? std::string("element id") : "element " + std::to_string(pending_[0]) + ": node";
+        fail(loc, who + " '" + std::string(f) + "' is not an integer",
+             "an *ELEMENT data line is 'id, node1, node2, ...'");
+      }
+      pending_.push_back(*v);
+    }
+    const std::size_t need = static_cast<std::size_t>(npe_) + 1;
+    if (pending_.size() < need) {
+      if (trailing_comma_) return;  // continued on the next data line
+      fail(pending_loc_,
+           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
+               " nodes but a " + type_name_ + " has " + std::to_string(npe_),
+           "list all its nodes (end a line with ',' to continue on the next)");
+    }
+    if (pending_.size() > need)
+      fail(pending_loc_,
+           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
+               " nodes but a " + type_name_ + " has " + std::to_string(npe_),
+           "fix the connectivity (or the TYPE= of the block)");
+    Mesh& mesh = deck_.mesh;
+    const long id = pending_[0];
+    if (id <= 0) fail(pending_loc_, "element id " + std::to_string(id) + " is not positive", "use ids >= 1");
+    const int index = mesh.num_elements();
+    if (!element_index_.try_emplace(id, index).second)
+      fail(pending_loc_, "element " + std::to_string(id) + " is defined twice",
+           "element ids must be unique: renumber or remove one");
+    for (std::size_t k = 1; k < need; ++k) {
+      const auto it = node_index_.find(pending_[k]);
+      if (it == node_index_.end())
+        fail(pending_loc_,
+             "element " + std::to_string(id) + " refers to node " + std::to_string(pending_[k]) +
+                 ", which is not defined",
+             "define the node under *NODE before this *ELEMENT block, or fix the connectivity");
+      mesh.conn.push_back(it->second);
+    }
+    mesh.element_ids.push_back(id);
+    mesh.region.push_back(region_);
+    if (open_members_) open_members_->push_back(index);
+    pending_.clear();
+  }
+
+  // ---- *NSET / *ELSET -----------------------------------------------------------------------
+  void begin_set(const Keyword& kw, const Loc& loc) {
+    const bool nodes = kw.name == "NSET";
+    const std::string key = nodes ? "NSET" : "ELSET";
+    const std::string name = kw.get(key);
+    if (name.empty()) fail(loc, "*" + key + " without " + key + "=<name>", "add the set name");
+    if (nodes && kw.has("ELSET"))
+      fail(loc, "*NSET, ELSET= (nodes of an element set) is not supported", "list the nodes or node sets instead");
+    if (kw.has("INPUT")) fail(loc, "*" + key + ", INPUT= is not supported", "use *INCLUDE for the member lines");
+    block_ = nodes ? Block::NodeSet : Block::ElementSet;
+    generate_ = kw.has("GENERATE");
+    open_set(nodes ? deck_.mesh.node_sets : deck_.mesh.element_sets, name);
+  }
+
+  void set_line(const Loc& loc) {
+    const bool nodes = block_ == Block::NodeSet;
+    const char* kind = nodes ? "node" : "element";
+    auto& ids = nodes ? node_index_ : element_index_;
+    std::vector<int>& members = *open_members_;
+    if (generate_) {
+      std::array<long, 3> g{0, 0, 1};
+      const std::size_t n = fields_.size();
+      if (n < 2 || n > 3) fail(loc, "a GENERATE data line needs 'first, last[, step]'", "write e.g. '1, 100, 1'");
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::optional<long> v = parse_long(fields_[i]);
+        if (!v)
+          fail(loc, "GENERATE value '" + std::string(fields_[i]) + "' is not an integer",
+               "write 'first, last[, step]'");
+        g[i] = *v;
+      }
+      const auto [first, last, step] = g;
+      if (first < 1 || step <= 0 || last < first)
+        fail(loc,
+             "GENERATE range " + std::to_string(first) + ", " + std::to_string(last) + ", " + std::to_string(step) +
+                 " is empty or invalid",
+             "give 1 <= first <= last and a positive step");
+      const long count = (last - first) / step + 1;
+      long found = 0;
+      if (static_cast<std::size_t>(count) <= 4 * ids.size() + 64) {
+        for (long k = 0; k < count; ++k) {
+          const auto it = ids.find(first + k * step);
+          if (it != ids.end()) {
+            members.push_back(it->second);
+            ++found;
+          }
+        }
+      } else {  // huge sparse range: scan the defined ids instead
+        const std::size_t before = members.size();
+        for (const auto& [id, index] : ids)
+          if (id >= first && id <= last && (id - first) % step == 0) members.push_back(index);
+        std::sort(members.begin() + static_cast<std::ptrdiff_t>(before), members.end());  // hash order is arbitrary
+        found = static_cast<long>(members.size() - before);
+      }
+      const long missing = count - found;
+      if (missing > 0)
+        deck_.warnings.push_back(where(loc) + ": GENERATE " + std::to_string(first) + ", " + std::to_string(last) +
+                                 ", " + std::to_string(step) + " of " + open_set_ + ": " + std::to_string(missing) +
+                                 " undefined " + kind + " id(s) skipped");
+      return;
+    }
+    for (const std::string_view f : fields_) {
+      if (f.empty()) continue;
+      if (const std::optional<long> id = parse_long(f)) {
+        const auto it = ids.find(*id);
+        if (it == ids.end())
+          fail(loc, std::string(kind) + " " + std::to_string(*id) + " in set " + open_set_ + " is not defined",
+               std::string("define it before this line or remove it from the set"));
+        members.push_back(it->second);
+      } else {
+        const std::vector<int> other = named_set(nodes, f, loc, nodes ? "*NSET" : "*ELSET");  // copy: may be `members`
+        members.insert(members.end(), other.begin(), other.end());
+      }
+    }
+  }
+
+  /// Members of the node (or element) set named `name`; error naming `context` when unknown.
+  const std::vector<int>& named_set(bool nodes, std::string_view name, const Loc& loc, const std::string& context) {
+    const std::string key = upper(name);
+    auto& sets = nodes ? deck_.mesh.node_sets : deck_.mesh.element_sets;
+    const auto it = sets.find(key);
+    if (it != sets.end()) {
+      if (unsorted_.erase(&it->second) != 0) normalise(it->second);
+      return it->second;
+    }
+    const auto& others = nodes ? deck_.mesh.element_sets : deck_.mesh.node_sets;
+    const std::string kind = nodes ? "node" : "element";
+    if (others.count(key))
+      fail(loc,
+           "'" + std::string(name) + "' in " + context +
+               (nodes ? " is an element set, not a node set" : " is a node set, not an element set"),
+           "use a " + kind + " set here");
+    fail(loc, "unknown " + kind + " set '" + std::string(name) + "' in " + context,
+         "define it with *" + std::string(nodes ? "NSET" : "ELSET") + (nodes ? "" : " (or ELSET= on *ELEMENT)") +
+             " before this line; set names are case-insensitive");
+  }
+
+  /// Calls f(index) for the element id or element set named by `token`.
+  template <class F>
+  void for_elements(std::string_view token, const Loc& loc, const std::string& context, F&& f) {
+    if (const std::optional<long> id = parse_long(token)) {
+      const auto it = element_index_.find(*id);
+      if (it == element_index_.end())
+        fail(loc, "element " + std::to_string(*id) + " in " + context + " is not defined",
+             "define it under *ELEMENT before this line or fix the id");
+      f(it->second);
+      return;
+    }
+    for (int e : named_set(false, token, loc, context)) f(e);
+  }
+
+  template <class F>
+  void for_nodes(std::string_view token, const Loc& loc, const std::string& context, F&& f) {
+    if (const std::optional<long> id = parse_long(token)) {
+      const auto it = node_index_.find(*id);
+      if (it == node_index_.end())
+        fail(loc, "node " + std::to_string(*id) + " in " + context + " is not defined",
+             "define it under *NODE before this line or fix the id");
+      f(it->second);
+      return;
+    }
+    for (int n : named_set(true, token, loc, context)) f(n);
+  }
+
+  /// Makes `name` (upper-cased) the set the current block adds to; a set exists once declared,
+  /// even if empty. Repeated definitions add to the set, as in CalculiX.
+  void open_set(std::map<std::string, std::vector<int>>& sets, const std::string& name) {
+    open_set_ = upper(name);
+    open_members_ = open_set_.empty() ? nullptr : &sets[open_set_];
+  }
+
+  static void normalise(std::vector<int>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  }
+
+  // ---- *SURFACE -----------------------------------------------------------------------------
+  void begin_surface(const Keyword& kw, const Loc& loc) {
+    const std::string name = upper(kw.get("NAME"));
+    if (name.empty()) fail(loc, "*SURFACE without NAME=", "add NAME=<surface name>");
+    const std::string type = upper(kw.get("TYPE"));
+    if (!type.empty() && type != "ELEMENT") {
+      deck_.warnings.push_back(where(loc) + ": *SURFACE " + name + " of TYPE=" + type +
+                               " skipped (only element-face surfaces are read)");
+      return;  // stays Block::Skip
+    }
+    block_ = Block::Surface;
+    surface_ = name;
+    deck_.mesh.surfaces[surface_];
+  }
+
+  void surface_line(const Loc& loc) {
+    if (fields_.size() < 2 || fields_[1].empty())
+      fail(loc, "a *SURFACE data line needs a face label", "write 'element_or_elset, S1' (faces S1..S4)");
+    const std::string label = upper(fields_[1]);
+    int face = -1;
+    if (label.size() == 2 && label[0] == 'S' && label[1] >= '1' && label[1] <= '4') face = label[1] - '1';
+    if (face < 0) fail(loc, "'" + std::string(fields_[1]) + "' is not a tetrahedron face", "use S1, S2, S3 or S4");
+    std::vector<FaceRef>& faces = deck_.mesh.surfaces[surface_];
+    for_elements(fields_[0], loc, "*SURFACE " + surface_, [&](int e) { faces.push_back(FaceRef{e, face}); });
+  }
+
+  // ---- *DLOAD -------------------------------------------------------------------------------
+  void dload_line(const Loc& loc) {
+    if (fields_.size() < 2 || fields_[1].empty())
+      fail(loc, "a *DLOAD data line needs a load label", "write 'element_or_elset, P1, magnitude'");
+    const std::string label = upper(fields_[1]);
+    const bool pressure = label.size() == 2 && label[0] == 'P' && label[1] >= '1' && label[1] <= '9';
+    if (!pressure) {
+      warn_once("dload " + label, loc, "*DLOAD load type " + label + " skipped (only face pressures P1..P4 are read)");
+      return;
+    }
+    const int face = label[1] - '1';
+    if (face > 3)
+      fail(loc, "load " + label + " names face " + label.substr(1) + " but a tetrahedron has faces 1-4", "use P1..P4");
+    if (fields_.size() < 3 || fields_[2].empty())
+      fail(loc, "*DLOAD " + label + " without a magnitude", "write 'element_or_elset, " + label + ", magnitude'");
+    const std::optional<double> p = parse_double(fields_[2]);
+    if (!p) fail(loc, "*DLOAD magnitude '" + std::string(fields_[2]) + "' is not a finite number", "fix the value");
+    for_elements(fields_[0], loc, "*DLOAD", [&](int e) {
+      const long long key = static_cast<long long>(e) * 4 + face;
+      const auto [it, inserted] = load_index_.try_emplace(key, deck_.pressure_faces.size());
+      if (inserted) {
+        deck_.pressure_faces.push_back(InpPressure{FaceRef{e, face}, *p});
+      } else if (deck_.pressure_faces[it->second].magnitude != *p) {
+        std::ostringstream msg;
+        msg.precision(17);
+        msg << "element " << deck_.mesh.element_ids[static_cast<std::size_t>(e)] << " face " << label
+            << " loaded again with " << *p << "; keeping the first magnitude "
+            << deck_.pressure_faces[it->second].magnitude;
+        deck_.warnings.push_back(where(loc) + ": " + msg.str());
+      }
+    });
+  }
+
+  // ---- *BOUNDARY ----------------------------------------------------------------------------
+  void boundary_line(const Loc& loc) {
+    if (fields_.size() < 2 || fields_[1].empty())
+      fail(loc, "a *BOUNDARY data line needs a degree of freedom",
+           "write 'node_or_nset, first_dof[, last_dof[, value]]' or 'node_or_nset, ENCASTRE'");
+    long first = 0, last = 0;
+    if (const std::optional<long> d = parse_long(fields_[1])) {
+      first = last = *d;
+      if (fields_.size() > 2 && !fields_[2].empty()) {
+        const std::optional<long> d2 = parse_long(fields_[2]);
+        if (!d2)
+          fail(loc, "last dof '" + std::string(fields_[2]) + "' is not an integer",
+               "write 'node_or_nset, first_dof, last_dof'");
+        last = *d2;
+      }
+      if (fields_.size() > 3 && !fields_[3].empty()) {
+        const std::optional<double> value = parse_double(fields_[3]);
+        if (!value)
+          fail(loc, "*BOUNDARY value '" + std::string(fields_[3]) + "' is not a finite number", "fix the value");
+        if (*value != 0.0)
+          fail(loc, "*BOUNDARY value " + std::string(fields_[3]) + " is not zero",
+               "only homogeneous conditions (fixed dofs, value 0) are supported: set the value to 0 or remove it");
+      }
+    } else {
+      const std::string name = upper(fields_[1]);
+      if (name == "ENCASTRE" || name == "PINNED") {
+        first = 1;
+        last = 3;
+      } else if (name == "XSYMM" || name == "YSYMM" || name == "ZSYMM") {
+        first = last = name[0] - 'X' + 1;
+      } else {
+        fail(loc, "boundary type '" + std::string(fields_[1]) + "' is not supported",
+             "use dof numbers 1-3 or ENCASTRE, PINNED, XSYMM, YSYMM, ZSYMM");
+      }
+    }
+    if (first < 1 || last < first)
+      fail(loc, "dof range " + std::to_string(first) + "-" + std::to_string(last) + " is invalid",
+           "give 1 <= first_dof <= last_dof (1-3 are the displacements)");
+    if (last > 3)
+      warn_once("boundary dofs", loc,
+                "*BOUNDARY dofs above 3 ignored (solid elements have only the displacement dofs 1-3)");
+    last = std::min(last, 3L);
+    for_nodes(fields_[0], loc, "*BOUNDARY", [&](int n) {
+      for (long d = first; d <= last; ++d) {
+        const long long key = static_cast<long long>(n) * 3 + (d - 1);
+        if (fixed_.insert(key).second) deck_.fixed_dofs.emplace_back(n, static_cast<int>(d - 1));
+      }
+    });
+  }
+
+  // ---- end of deck --------------------------------------------------------------------------
+  void finish() {
+    Mesh& mesh = deck_.mesh;
+    const Loc end{0, std::max(1, last_line_of_top_)};
+    if (mesh.num_nodes() == 0) fail(end, "the deck defines no nodes", "add a *NODE block with 'id, x, y, z' lines");
+    if (mesh.num_elements() == 0)
+      fail(end, "the deck defines no elements", "add an *ELEMENT, TYPE=C3D4 or TYPE=C3D10 block");
+    for (auto& [name, v] : mesh.node_sets) normalise(v);
+    for (auto& [name, v] : mesh.element_sets) normalise(v);
+    for (auto& [name, faces] : mesh.surfaces) {  // a face listed twice would be loaded twice
+      std::unordered_set<long long> seen;
+      std::erase_if(faces, [&](const FaceRef& f) {
+        return !seen.insert(static_cast<long long>(f.element) * 4 + f.local_face).second;
+      });
+    }
+    // Advice the solver would otherwise give far less clearly.
+    std::vector<char> used(static_cast<std::size_t>(mesh.num_nodes()), 0);
+    for (int n : mesh.conn) used[static_cast<std::size_t>(n)] = 1;
+    const auto unused = std::count(used.begin(), used.end(), 0);
+    if (unused > 0)
+      deck_.warnings.push_back(file_names_[0] + ": " + std::to_string(unused) +
+                               " node(s) belong to no element (they carry no stiffness)");
+    int inverted = 0;
+    long first_inverted = 0;
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      if (corner_volume(mesh, e) <= 0.0 && inverted++ == 0)
+        first_inverted = mesh.element_ids[static_cast<std::size_t>(e)];
+    if (inverted > 0)
+      deck_.warnings.push_back(file_names_[0] + ": " + std::to_string(inverted) +
+                               " element(s) have zero or negative volume (first: element " +
+                               std::to_string(first_inverted) + "); check the node order");
+    mesh.ensure_ids();
+  }
+
+  // ---- state --------------------------------------------------------------------------------
+  double length_to_m_;
+  InpDeck deck_;
+
+  std::deque<std::string> buffers_;  // whole files; kept until the end (lines are views into them)
+  std::vector<std::string> file_names_;
+  std::vector<Frame> stack_;
+  int last_line_of_top_ = 0;
+
+  std::vector<std::string_view> fields_;
+  bool trailing_comma_ = false;
+
+  Block block_ = Block::None;
+  std::string open_set_;                      // set filled by the current block (upper case), or empty
+  std::vector<int>* open_members_ = nullptr;  // its members (std::map values do not move)
+  // Sets changed since they were last sorted; sorted when next used (not after every block: a
+  // region written as many *ELEMENT runs would be re-sorted once per run).
+  std::unordered_set<std::vector<int>*> unsorted_;
+  bool generate_ = false;
+  std::string surface_;
+
+  std::optional<Loc> first_type_loc_;
+  std::string type_name_;
+  int npe_ = 0;
+  std::uint16_t region_ = 0;
+  std::vector<long> pending_;  // element id + nodes read so far (continuation lines)
+  Loc pending_loc_;
+
+  std::unordered_map<long, int> node_index_;
+  std::unordered_map<long, int> element_index_;
+  std::unordered_map<long long, std::size_t> load_index_;
+  std::unordered_set<long long> fixed_;
+  std::set<std::string> warned_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Writer
+// ---------------------------------------------------------------------------------------------
+
+// CalculiX reads each real from the first 20 characters of its field (Fortran f20.0, nodes.f),
+// so a coordinate must fit in 20 characters.
+constexpr std::size_t kMaxRealChars = 20;
+constexpr std::size_t kMaxEntriesPerLine = 16;
+constexpr std::size_t kMaxNameChars = 80;  // CalculiX set-name limit
+
+/// Shortest text that reads back to exactly `v` (std::to_chars), if it fits in 20 characters;
+/// otherwise the most significant digits that fit (>= 14, i.e. relative error < 1e-13, and
+/// only for values whose magnitude is far below the model size).
+std::string format_real(double v) {
+  std::array<char, 64> buf{};
+  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  std::size_t n = static_cast<std::size_t>(r.ptr - buf.data());
+  for (int digits = 17; n > kMaxRealChars && digits > 0; --digits) {
+    r = std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::general, digits);
+    n = static_cast<std::size_t>(r.ptr - buf.data());
+  }
+  return std::string(buf.data(), n);
+}
+
+/// Upper-case deck name of a set, surface or region; names the reader would misread are refused.
+std::string deck_name(const std::string& name, const char* what) {
+  const std::string u = upper(name);
+  const bool letter_first = !u.empty() && u[0] >= 'A' && u[0] <= 'Z';
+  const bool bad_char = std::any_of(u.begin(), u.end(), [](char c) {
+    return c == ',' || c == '=' || c == '*' || c == '"' || c == '\n' || is_blank(c);
+  });
+  if (!letter_first || u.size() > kMaxNameChars || bad_char)
+    throw InputError(std::string(what) + " name '" + name + "' cannot be written to an .inp deck; rename it (1-80 " +
+                     "characters starting with a letter, no blanks, commas, '=', '*' or quotes)");
+  return u;
+}
+
+/// Set members, at most 16 per data line.
+void write_id_lines(std::ostream& os, const std::vector<long>& ids) {
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    os << ids[i] << ((i + 1) % kMaxEntriesPerLine == 0 || i + 1 == ids.size() ? "\n" : ", ");
+}
+
+}  // namespace
+
+InpDeck read_inp(const std::string& path, double length_to_m) {
+  if (!(length_to_m > 0.0) || !std::isfinite(length_to_m))
+    throw InputError(path + ": length_to_m = " + std::to_string(length_to_m) +
+                     " is not a positive length; give the deck's length unit in metres (1e-3 for mm)");
+  return DeckReader(length_to_m).read(path);
+}
+
+void write_inp_mesh(std::ostream& os, const Mesh& mesh, double length_to_m) {
+  if (!(length_to_m > 0.0) || !std::isfinite(length_to_m))
+    throw InputError("write_inp_mesh: length_to_m = " + std::to_string(length_to_m) +
+                     " is not a positive length; give the deck's length unit in metres (1e-3 for mm)");
+  const auto nn = static_cast<std::size_t>(mesh.num_nodes());
+  const auto ne = static_cast<std::size_t>(mesh.num_elements());
+  auto node_id = [&](int i) {
+    return mesh.node_ids.size() == nn ? mesh.node_ids[static_cast<std::size_t>(i)] : i + 1L;
+  };
+  auto element_id = [&](int e) {
+    return mesh.element_ids.size() == ne ? mesh.element_ids[static_cast<std::size_t>(e)] : e + 1L;
+  };
+  auto region_name = [&](int e) -> const std::string& {
+    static const std::string kDefault = "default";  // as Mesh::ensure_ids
+    if (mesh.region.size() != ne) return kDefault;
+    const std::size_t r = mesh.region[static_cast<std::size_t>(e)];
+    return r < mesh.region_names.size() ? mesh.region_names[r] : kDefault;
+  };
+  const char* type = mesh.type == ElementType::Tet4 ? "C3D4" : "C3D10";
+
+  os << "** pneufem mesh: " << nn << " nodes, " << ne << " " << type << " elements; lengths in units of "
+     << format_real(length_to_m) << " m\n";
+
+  os << "*NODE\n";
+  for (std::size_t i = 0; i < nn; ++i) {
+    const Eigen::Vector3d& x = mesh.X[i];
+    if (!x.allFinite())
+      throw InputError("write_inp_mesh: node " + std::to_string(node_id(static_cast<int>(i))) +
+                       " has a non-finite coordinate; fix the mesh before writing it");
+    os << node_id(static_cast<int>(i)) << ", " << format_real(x[0] / length_to_m) << ", "
+       << format_real(x[1] / length_to_m) << ", " << format_real(x[2] / length_to_m) << '\n';
+  }
+
+  // Consecutive runs of one region, so the element order (and hence every index) survives a
+  // round trip; CalculiX and Abaqus add repeated ELSET= blocks to the same set.
+  const int npe = mesh.npe();
+  std::map<std::string, std::vector<int>> region_elements;  // upper-case region -> elements
+  for (std::size_t e = 0; e < ne;) {
+    const std::string& region = region_name(static_cast<int>(e));
+    const std::string elset = deck_name(region, "region");
+    os << "*ELEMENT, TYPE=" << type << ", ELSET=" << elset << '\n';
+    std::vector<int>& members = region_elements[elset];
+    for (; e < ne && region_name(static_cast<int>(e)) == region; ++e) {
+      members.push_back(static_cast<int>(e));
+      const int* n = mesh.element(static_cast<int>(e));
+      os << element_id(static_cast<int>(e));
+      // C3D10: 8 nodes, then a trailing comma and the last 2 on a continuation line, as in our
+      // CalculiX reference decks (<= 16 entries and far below 132 characters per line).
+      for (int k = 0; k < npe; ++k) os << (k == 8 ? ",\n" : ", ") << node_id(n[k]);
+      os << '\n';
+    }
+  }
+
+  for (const auto& [name, nodes] : mesh.node_sets) {
+    os << "*NSET, NSET=" << deck_name(name, "node set") << '\n';
+    std::vector<long> ids;
+    ids.reserve(nodes.size());
+    for (int i : nodes) ids.push_back(node_id(i));
+    write_id_lines(os, ids);
+  }
+  for (const auto& [name, elements] : mesh.element_sets) {
+    const std::string elset = deck_name(name, "element set");
+    const auto it = region_elements.find(elset);
+    if (it != region_elements.end() && it->second == elements) continue;  // already the region's ELSET=
+    os << "*ELSET, ELSET=" << elset << '\n';
+    std::vector<long> ids;
+    ids.reserve(elements.size());
+    for (int e : elements) ids.push_back(element_id(e));
+    write_id_lines(os, ids);
+  }
+  for (const auto& [name, faces] : mesh.surfaces) {
+    os << "*SURFACE, NAME=" << deck_name(name, "surface") << ", TYPE=ELEMENT\n";
+    for (const FaceRef& f : faces) os << element_id(f.element) << ", S" << f.local_face + 1 << '\n';
+  }
+}
+
+}  // namespace pneufem
