@@ -173,12 +173,14 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
 
   auto kernel = [&](int e) {
     const int* n = mesh.element(e);
-    Eigen::Matrix<double, 3, NPE> x;
-    for (int a = 0; a < NPE; ++a) x.col(a) = mesh.X[n[a]] + u.template segment<3>(3 * n[a]);
+    // F = I + grad u (not x grad N): at small strain the displacement gradient is computed to full
+    // relative precision, so stresses of a stiff layer (E = 6.5 GPa) carry no round-off floor.
+    Eigen::Matrix<double, 3, NPE> ue;
+    for (int a = 0; a < NPE; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
     std::array<Mat3, NQP> F;
     for (int q = 0; q < NQP; ++q) {
       const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));  // column a = dN_a/dX
-      F[q] = x * g.transpose();
+      F[q] = Mat3::Identity() + ue * g.transpose();
       const double J = F[q].determinant();
       if (!(J > 0.0) || !std::isfinite(J)) {
         atomic_min(bad, e);
@@ -259,11 +261,8 @@ void Assembler::point_responses(const Eigen::VectorXd& u, int e, std::span<const
   const int* n = mesh.element(e);
   for (int q = 0; q < geom_.nqp; ++q) {
     const double* g = geom_.grad(e, q);
-    Mat3 Fq = Mat3::Zero();
-    for (int a = 0; a < npe; ++a) {
-      const Eigen::Vector3d xa = mesh.X[n[a]] + u.segment<3>(3 * n[a]);
-      Fq += xa * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
-    }
+    Mat3 Fq = Mat3::Identity();
+    for (int a = 0; a < npe; ++a) Fq += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
     F[q] = Fq;
   }
   const Material& mat = model_.material_of(e);

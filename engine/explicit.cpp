@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "engine/static_solver.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -140,6 +141,7 @@ RelaxationReport relax(const Assembler& asmb, double p, const TimeStep& ts, std:
   SparseMatrix K = asmb.tangent_pattern();
   Eigen::VectorXd f_int, f_ext(n), v = Eigen::VectorXd::Zero(n), minv(n);
   RelaxationReport rep;
+  rep.reference_N = reference_force_floor(asmb);
   auto residual = [&](bool tangent) {
     f_ext.setZero();
     asmb.internal(u, ts, s_old, s_new, &f_int, tangent ? &K : nullptr, nullptr);

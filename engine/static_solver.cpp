@@ -1,7 +1,9 @@
 #include "engine/static_solver.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "materials/errors.h"
@@ -15,7 +17,21 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 StaticSolver::StaticSolver(const Assembler& assembler, StaticOptions options)
-    : asm_(assembler), opt_(options), K_(assembler.tangent_pattern()) {}
+    : asm_(assembler), opt_(options), K_(assembler.tangent_pattern()) {
+  force_floor_ = reference_force_floor(assembler);
+}
+
+double reference_force_floor(const Assembler& a) {
+  // Force of a 1e-6 strain in the softest material over the body's bounding-box area: a scale
+  // that keeps the relative criterion meaningful when the loads vanish (unloaded states). The
+  // softest material governs how far the structure moves for a given force.
+  const Model& m = a.model();
+  double mu = std::numeric_limits<double>::infinity();
+  for (const Part& p : m.parts) mu = std::min(mu, p.material->initial_shear_modulus());
+  const MeshStats st = compute_stats(m.mesh);
+  const double L = (st.bbox_max - st.bbox_min).norm();
+  return 1e-6 * mu * L * L;
+}
 
 Eigen::VectorXd StaticSolver::residual(double p, const TimeStep& ts, std::span<const double> s_old,
                                        std::span<double> s_new, const Eigen::VectorXd& u) {
@@ -50,13 +66,16 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     stats_.assembly_s += seconds_since(t0);
     R = f_int - f_ext;
     asm_.zero_fixed(R);
-    rep.reference_N = std::max({f_ext.norm(), f_int.norm(), rep.reference_N});
+    rep.reference_N = std::max({f_ext.norm(), f_int.norm(), rep.reference_N, force_floor_});
     rep.residual_N = R.norm();
     rep.iterations = it;
     if (!std::isfinite(rep.residual_N)) {
       rep.failure = "non-finite residual";
       return rep;
     }
+    if (opt_.verbose)
+      std::fprintf(stderr, "    newton p=%.4g kPa it=%d |R|=%.3e ref=%.3e cuts=%d\n", p * 1e-3, it, rep.residual_N,
+                   rep.reference_N, rep.line_search_cuts);
     if (rep.residual_N <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) {
       rep.converged = true;
       return rep;

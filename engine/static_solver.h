@@ -23,6 +23,7 @@ struct StaticOptions {
   int max_iterations = 25;        ///< Newton iterations per increment
   double max_increment_Pa = 5e3;  ///< largest pressure sub-increment of a continuation
   double min_increment_Pa = 1.0;  ///< give up (limit point) below this sub-increment
+  bool verbose = false;           ///< print every iteration to stderr
 };
 
 struct NewtonReport {
@@ -75,6 +76,10 @@ class StaticSolver {
   SparseMatrix K_;
   StaticStats stats_;
   Eigen::VectorXd last_du_per_Pa_;  ///< secant predictor from the last accepted increment
+  double force_floor_ = 0.0;        ///< lower bound of the reference force (N)
 };
+
+/// Force scale below which residuals count as zero relative to the structure's stiffness (N).
+double reference_force_floor(const Assembler& assembler);
 
 }  // namespace pneufem

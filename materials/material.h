@@ -29,8 +29,10 @@ struct PointResponse {
   double psi_vol = 0.0;
   Mat3 P_iso = Mat3::Zero();
   Mat3 P_vol = Mat3::Zero();
-  Mat9 A_iso = Mat9::Zero();  ///< only filled when a tangent is requested
-  Mat9 A_vol = Mat9::Zero();
+  // Tangents are left uninitialised (81 doubles each) unless a tangent is requested: zeroing
+  // them on every force-only evaluation cost more than the stress itself.
+  Mat9 A_iso;  ///< only valid when a tangent was requested
+  Mat9 A_vol;
 
   double psi() const { return psi_iso + psi_vol; }
   Mat3 P() const { return P_iso + P_vol; }
@@ -50,6 +52,9 @@ struct PointFields {
   double damage = 0.0;          ///< isochoric softening 1 - (stiffness fraction), in [0, 1)
   double W_max = 0.0;           ///< peak isochoric energy density seen so far (J/m^3)
   double viscous_strain = 0.0;  ///< norm of the viscous (overstress) strain measure
+  /// True once a failure criterion of the law is met (fatigue: damage >= d_fail). The point keeps a
+  /// small residual stiffness, so the solution stays finite; the driver decides what to do with it.
+  bool failed = false;
 };
 
 class Material {

@@ -1,0 +1,42 @@
+#pragma once
+// One simulation run as the CLI performs it: build the model from a scene, march through the
+// load history (quasi-static or explicit), and write the outputs of a run directory:
+//   angles.csv        trial,time_s,pressure_kPa,angle_deg
+//   states.csv        the same plus global time, cavity volume and tip-plane fit residual
+//   summary.json      version, status, resolved scene, mesh and solver statistics, timings
+//   scene.toml        the fully resolved scene (re-runnable as is)
+//   results.pvd + vtu/state_NNNN.vtu   fields for ParaView
+// Every file is written atomically (temporary file + rename).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engine/quasi_static.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+struct RunOptions {
+  std::string out_dir;
+  int threads = 0;        ///< 0 = all cores
+  bool progress = false;  ///< print a progress line (terminal)
+  std::string command_line;
+};
+
+struct RunResult {
+  std::vector<StateRecord> records;
+  std::string status = "ok";  ///< "ok" or the error message
+  double wall_s = 0.0;
+};
+
+/// Runs the scene and writes the run directory. Physics failures are recorded in summary.json
+/// (status) and rethrown after the outputs so far are safely on disk.
+RunResult run_simulation(const Scene& scene, const RunOptions& options);
+
+/// Writes `text` to `path` atomically; throws std::runtime_error naming the path on failure.
+void write_file_atomic(const std::string& path, const std::string& text);
+
+/// pneufem's version string (project version + git description at build time).
+std::string version_string();
+
+}  // namespace pneufem

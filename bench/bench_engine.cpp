@@ -1,0 +1,122 @@
+// Engine benchmarks (not run in CI): prints figures recorded in BENCHMARKS.md.
+//   * force kernel: element updates per second (internal force only) for Tet4 and Tet10 on the
+//     default pneu-net mesh, 1 and N threads;
+//   * tangent assembly and one Newton iteration (assembly + CHOLMOD factorisation + solve);
+//   * one staircase trial (10 levels, 0-45 kPa) of the default scene, quasi-static Newton.
+// Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "engine/assembly.h"
+#include "engine/linear_solver.h"
+#include "engine/quasi_static.h"
+#include "scenes/build_model.h"
+
+using namespace pneufem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+template <class F>
+double median_seconds(int reps, F&& f) {
+  std::vector<double> t;
+  for (int i = 0; i < reps; ++i) {
+    const auto t0 = Clock::now();
+    f();
+    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+void kernel_rates(const std::string& element, double h_mm, int threads) {
+  const Scene scene = Scene::load("", {"mesh.element=\"" + element + "\"", "mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  const int ne = bm->model.mesh.num_elements();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  for (int i = 0; i < u.size(); ++i) u[i] = 1e-5 * std::sin(0.37 * i);  // a generic small deformation
+  Eigen::VectorXd f;
+  SparseMatrix K;
+  for (int t : {1, threads}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, t);
+    const double tf = median_seconds(7, [&] { A.internal(u, {}, {}, {}, &f, nullptr, nullptr); });
+    const double tk = median_seconds(3, [&] { A.internal(u, {}, {}, {}, &f, &K, nullptr); });
+    std::printf("  %-5s h=%.2f mm  %6d elements  %7d dofs  threads=%d  force: %8.2f ms  %.3g element-updates/s"
+                "  (%.3g qp/s)   force+tangent: %8.2f ms\n",
+                element.c_str(), h_mm, ne, bm->model.num_dofs(), t, tf * 1e3, ne / tf,
+                ne * double(A.geometry().nqp) / tf, tk * 1e3);
+  }
+}
+
+void newton_iteration(double h_mm, int threads) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
+  SparseMatrix K = A.tangent_pattern();
+  LinearSolver ls;
+  const double ta = median_seconds(3, [&] {
+    A.internal(u, {}, {}, {}, &f, &K, nullptr);
+    Eigen::VectorXd fe = Eigen::VectorXd::Zero(u.size());
+    A.add_pressure(u, 2e4, fe, &K);
+  });
+  A.apply_constraints(K, 1.0);
+  ls.factorize(K);  // symbolic analysis + first numeric factorisation
+  const double tf = median_seconds(3, [&] { ls.factorize(K); });
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(u.size());
+  const double ts = median_seconds(5, [&] { b = ls.solve(b); });
+  std::printf("  Newton iteration (Tet10, h=%.2f mm, %d dofs, %d threads): assembly %.3f s, factorisation %.3f s, "
+              "solve %.3f s, nnz(K) = %ld\n",
+              h_mm, bm->model.num_dofs(), threads, ta, tf, ts, static_cast<long>(K.nonZeros()));
+}
+
+void one_trial(double h_mm, int threads) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  QuasiStaticRun run(A, bm->solver.quasi_static);
+  std::vector<StateRecord> recs;
+  const auto t0 = Clock::now();
+  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { recs.push_back(r); });
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  const StaticStats& st = run.static_solver().stats();
+  std::printf("  one staircase trial (Tet10, h=%.2f mm, %d dofs, %d threads): %.2f s wall; %ld increments, %ld cutbacks, "
+              "%ld Newton iterations, assembly %.2f s, factor+solve %.2f s\n",
+              h_mm, bm->model.num_dofs(), threads, wall, st.increments, st.cutbacks, st.iterations, st.assembly_s,
+              st.factor_s);
+  std::printf("    p_kPa  angle_deg\n");
+  for (const auto& r : recs)
+    if (std::abs(r.time_s - std::round(r.time_s / 16.0) * 16.0) < 1e-6)
+      std::printf("    %5.1f  %9.3f\n", r.pressure_Pa * 1e-3, r.angle_deg);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double h = 2.0;
+  int threads = tbb::info::default_concurrency();
+  bool skip_trial = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--skip-trial")) skip_trial = true;
+  }
+  std::printf("pneufem engine benchmark (threads available: %d)\n", tbb::info::default_concurrency());
+  std::printf("force kernel:\n");
+  kernel_rates("tet4", h, threads);
+  kernel_rates("tet10", h, threads);
+  std::printf("implicit:\n");
+  newton_iteration(h, threads);
+  if (!skip_trial) one_trial(h, threads);
+  return 0;
+}

@@ -1,0 +1,103 @@
+#pragma once
+// Plumbing shared by the inelastic decorators of damage/ (Mullins, fatigue, viscoelasticity).
+//
+// A decorator wraps a base Material (STYLE.md practice 2) and owns a few doubles of history per
+// quadrature point. The state block of one point is laid out as
+//     [ decorator's own state (own doubles) | base's state (base->state_size() doubles) ]
+// so decorators nest: viscoelastic(fatigue(mullins(yeoh))) holds
+//     [ visco | fatigue | mullins | (yeoh: none) ]
+// and each layer hands the tail of the block to its base untouched. Points are consecutive blocks.
+//
+// Conventions every decorator follows:
+//  * only the isochoric response (psi_iso, P_iso, A_iso) is modified; the volumetric part of the
+//    base is passed through bit for bit;
+//  * an EMPTY state_old means "the virgin state" (own history at its initial values; the base gets
+//    an empty span too), so a decorated law can be evaluated like an elastic one;
+//  * an empty state_new means "do not write the trial state" (the engine's energy-only passes).
+// Each layer evaluates its base one point at a time (one virtual call per point and layer, since the
+// base's slices are strided by the full block): the price of composability; the math itself is
+// fixed-size and allocation-free, and nothing is mutable, so evaluations are safe under TBB.
+#include <cassert>
+#include <cmath>
+#include <cstddef>
+#include <initializer_list>
+#include <sstream>
+#include <utility>
+#include <span>
+#include <string>
+
+#include "materials/errors.h"
+#include "materials/material.h"
+
+namespace pneufem::detail {
+
+/// The four views of point q's state for a decorator with `own` doubles wrapping a base with `base`.
+struct PointState {
+  std::span<const double> own_old;  ///< empty = virgin
+  std::span<double> own_new;        ///< empty = trial state not wanted
+  std::span<const double> base_old;
+  std::span<double> base_new;
+};
+
+inline PointState point_state(std::span<const double> state_old, std::span<double> state_new, std::size_t q,
+                              std::size_t own, std::size_t base) {
+  const std::size_t ss = own + base, o = q * ss;
+  PointState p;
+  if (!state_old.empty()) {
+    assert(state_old.size() >= o + ss);
+    p.own_old = state_old.subspan(o, own);
+    p.base_old = state_old.subspan(o + own, base);
+  }
+  if (!state_new.empty()) {
+    assert(state_new.size() >= o + ss);
+    p.own_new = state_new.subspan(o, own);
+    p.base_new = state_new.subspan(o + own, base);
+  }
+  return p;
+}
+
+/// Evaluates the base law at one point into `out` (the decorator then modifies the iso part).
+inline void evaluate_base(const Material& base, const Mat3& F, const TimeStep& step, const PointState& ps,
+                          PointResponse& out, bool tangent) {
+  base.evaluate(std::span<const Mat3>(&F, 1), step, ps.base_old, ps.base_new, std::span<PointResponse>(&out, 1),
+                tangent);
+}
+
+/// Throws InputError unless `base` is a non-null split (isochoric/volumetric) law.
+inline void require_split_base(const MaterialPtr& base, const std::string& effect) {
+  if (!base) throw InputError(effect + ": no base material given; wrap a hyperelastic law such as yeoh");
+  if (!base->is_split())
+    throw InputError(effect + ": cannot wrap '" + base->name() +
+                     "': the effect only applies to split (isochoric/volumetric) laws such as yeoh");
+}
+
+/// Throws InputError unless d(base psi_iso)/dF = base P_iso at a fixed committed state, which the
+/// energy-driven effects (mullins, fatigue) rely on for their consistent tangent. Fatigue (whose damage
+/// grows within the increment) and viscoelastic (overstress) laws do not satisfy it, so they must be
+/// applied outside: the canonical order is viscoelastic(fatigue(mullins(base))). Defined in decorator.cpp.
+void require_potential_base(const MaterialPtr& base, const std::string& effect);
+
+inline std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+inline void require(bool ok, const std::string& effect, const std::string& msg) {
+  if (!ok) throw InputError(effect + ": " + msg);
+}
+
+inline void require_finite(const std::string& effect,
+                           std::initializer_list<std::pair<const char*, double>> values) {
+  for (const auto& [key, v] : values)
+    if (!std::isfinite(v)) throw InputError(effect + ": " + key + " must be a finite number, got " + num(v));
+}
+
+/// Combines two stiffness losses acting in series on the isochoric stress: the stiffness
+/// fractions multiply, so damage = 1 - (1 - d_outer)(1 - d_inner).
+inline double combine_damage(double d_outer, double d_inner) { return 1.0 - (1.0 - d_outer) * (1.0 - d_inner); }
+
+/// (x)+ = max(x, 0), the Macaulay bracket.
+inline double macaulay(double x) { return x > 0.0 ? x : 0.0; }
+
+}  // namespace pneufem::detail

@@ -1,0 +1,75 @@
+#include "damage/mullins.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "damage/decorator.h"
+
+namespace pneufem {
+
+MullinsEta ogden_roxburgh(double W_dev, double W_max, const MullinsParams& p) {
+  MullinsEta e;
+  // Primary curve (eta = 1, phi(1) = 0), and the virgin state: nothing to soften before any loading
+  // (a W_dev of -1e-12 Pa from rounding at a pure dilatation is not an unloading).
+  if (W_dev >= W_max || W_max <= 0.0) return e;
+  const double D = p.m_Pa + p.beta * W_max;  // > 0: W_max > 0 and m, beta >= 0, not both 0
+  const double z = (W_max - W_dev) / D, ez2 = std::exp(-z * z);
+  e.eta = 1.0 - std::erf(z) / p.r;
+  e.deta_dW = 2.0 / (p.r * std::sqrt(std::numbers::pi) * D) * ez2;
+  e.phi = (1.0 - e.eta) * W_max - D * (1.0 - ez2) / (p.r * std::sqrt(std::numbers::pi));
+  return e;
+}
+
+Mullins::Mullins(MaterialPtr base, const MullinsParams& p) : base_(std::move(base)), p_(p) {
+  const std::string me = "mullins";
+  detail::require_split_base(base_, me);
+  detail::require_potential_base(base_, me);
+  detail::require_finite(me, {{"r", p.r}, {"m", p.m_Pa}, {"beta", p.beta}});
+  detail::require(p.r > 1.0, me, "r must be > 1 (the largest stress softening is 1/r), got " + detail::num(p.r));
+  detail::require(p.m_Pa >= 0.0, me, "m must be >= 0 Pa (an energy density), got " + detail::num(p.m_Pa));
+  detail::require(p.beta >= 0.0, me, "beta must be >= 0, got " + detail::num(p.beta));
+  detail::require(p.m_Pa > 0.0 || p.beta > 0.0, me,
+                  "m and beta cannot both be 0 (the erf argument would divide by zero); set m > 0 Pa, the "
+                  "energy-density scale over which the softening develops");
+}
+
+void Mullins::init_state(std::span<double> state) const {
+  state[0] = 0.0;  // W_max
+  state[1] = 1.0;  // eta
+  base_->init_state(state.subspan(kOwnState));
+}
+
+void Mullins::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
+                       std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  for (std::size_t q = 0; q < F.size(); ++q) {
+    const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
+    PointResponse& r = out[q];
+    detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
+    const double W_dev = r.psi_iso;
+    const double W_max_old = ps.own_old.empty() ? 0.0 : ps.own_old[0];
+    const double W_max = std::max(W_max_old, W_dev);
+    const MullinsEta e = ogden_roxburgh(W_dev, W_max_old, p_);
+    if (!ps.own_new.empty()) {
+      ps.own_new[0] = W_max;
+      ps.own_new[1] = e.eta;
+    }
+    if (W_dev >= W_max_old || W_max_old <= 0.0) continue;  // primary curve or virgin: the base response as is
+    if (tangent) {
+      const Vec9 p0 = flatten(r.P_iso);
+      r.A_iso = e.eta * r.A_iso + e.deta_dW * p0 * p0.transpose();
+    }
+    r.P_iso *= e.eta;
+    r.psi_iso = e.eta * W_dev + e.phi;
+  }
+}
+
+PointFields Mullins::fields(std::span<const double> state) const {
+  PointFields f = base_->fields(state.subspan(kOwnState));
+  f.W_max = state[0];
+  f.damage = detail::combine_damage(1.0 - state[1], f.damage);
+  return f;
+}
+
+}  // namespace pneufem

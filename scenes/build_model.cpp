@@ -1,0 +1,421 @@
+#include "scenes/build_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "materials/errors.h"
+#include "materials/hyperelastic.h"
+#include "materials/ogden.h"
+#include "scenes/inp.h"
+#include "scenes/pneunet.h"
+
+namespace pneufem {
+
+namespace {
+
+constexpr double kMPa = 1e6, kkPa = 1e3, kmm = 1e-3;
+
+void require_keys(const Scene& scene, const std::string& table, const std::set<std::string>& allowed,
+                  const std::string& what) {
+  for (const std::string& k : scene.table_keys(table))
+    if (!allowed.count(k)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      scene.fail(table + "." + k, "unknown key for " + what + "; allowed: " + list);
+    }
+}
+
+double positive(const Scene& scene, const std::string& key) {
+  const double v = scene.number(key);
+  if (!(v > 0.0)) scene.fail(key, "must be > 0");
+  return v;
+}
+
+PneuNetParams pneunet_params(const Scene& s) {
+  PneuNetParams p;
+  p.width = s.number("geometry.width_mm") * kmm;
+  p.base_thickness = s.number("geometry.base_thickness_mm") * kmm;
+  p.body_height = s.number("geometry.body_height_mm") * kmm;
+  p.chambers = s.integer("geometry.chambers");
+  p.chamber_length = s.number("geometry.chamber_length_mm") * kmm;
+  p.interior_wall = s.number("geometry.interior_wall_mm") * kmm;
+  p.side_wall = s.number("geometry.side_wall_mm") * kmm;
+  p.roof = s.number("geometry.roof_mm") * kmm;
+  p.end_cap = s.number("geometry.end_cap_mm") * kmm;
+  p.channel_width = s.number("geometry.channel_width_mm") * kmm;
+  p.channel_height = s.number("geometry.channel_height_mm") * kmm;
+  p.fabric_z0 = s.number("geometry.fabric_z0_mm") * kmm;
+  p.fabric_thickness = s.number("geometry.fabric_thickness_mm") * kmm;
+  p.h = s.number("mesh.h_mm") * kmm;
+  p.fabric_layers = s.integer("mesh.fabric_layers");
+  p.half = s.boolean("mesh.half");
+  const std::string el = s.string("mesh.element");
+  if (el == "tet10")
+    p.element = ElementType::Tet10;
+  else if (el == "tet4")
+    p.element = ElementType::Tet4;
+  else
+    s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
+  return p;
+}
+
+double length_unit(const Scene& s) {
+  const std::string u = s.string("mesh.length_unit");
+  if (u == "mm") return 1e-3;
+  if (u == "m") return 1.0;
+  s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
+}
+
+const std::vector<int>& node_set(const Scene& s, const Mesh& m, const std::string& key) {
+  std::string name = s.string(key);
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  for (const std::string& n : {name, upper}) {
+    auto it = m.node_sets.find(n);
+    if (it != m.node_sets.end()) {
+      if (it->second.empty()) s.fail(key, "node set '" + name + "' is empty");
+      return it->second;
+    }
+  }
+  std::string avail;
+  for (const auto& [k, v] : m.node_sets) avail += (avail.empty() ? "" : ", ") + k;
+  s.fail(key, "node set '" + name + "' not found in the mesh; available: " + (avail.empty() ? "(none)" : avail));
+}
+
+const std::vector<int>* find_elset(const Mesh& m, const std::string& name) {
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  for (const std::string& n : {name, upper}) {
+    auto it = m.element_sets.find(n);
+    if (it != m.element_sets.end()) return &it->second;
+  }
+  return nullptr;
+}
+
+// Ramer-Douglas-Peucker simplification of (t, p) to within tol (max vertical deviation).
+void rdp(const std::vector<double>& t, const std::vector<double>& p, std::size_t a, std::size_t b, double tol,
+         std::vector<char>& keep) {
+  if (b <= a + 1) return;
+  double worst = -1.0;
+  std::size_t wi = a;
+  for (std::size_t i = a + 1; i < b; ++i) {
+    const double w = (t[i] - t[a]) / (t[b] - t[a]);
+    const double d = std::abs(p[i] - ((1 - w) * p[a] + w * p[b]));
+    if (d > worst) {
+      worst = d;
+      wi = i;
+    }
+  }
+  if (worst > tol) {
+    keep[wi] = 1;
+    rdp(t, p, a, wi, tol, keep);
+    rdp(t, p, wi, b, tol, keep);
+  }
+}
+
+}  // namespace
+
+MaterialPtr make_material(const Scene& s, const std::string& name) {
+  const std::string T = "materials." + name;
+  if (!s.has(T)) s.fail(T, "no such material; define a [" + T + "] table");
+  const std::string model = s.string(T + ".model");
+  static const std::set<std::string> kModels = {"linear_elastic", "yeoh", "neo_hookean", "mooney_rivlin", "ogden"};
+  if (!kModels.count(model))
+    s.fail(T + ".model", "unknown material model \"" + model +
+                             "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
+  positive(s, T + ".density_kg_m3");
+  try {
+    if (model == "linear_elastic") {
+      require_keys(s, T, {"model", "E_MPa", "nu", "density_kg_m3"}, "model linear_elastic");
+      return std::make_shared<SaintVenantKirchhoff>(s.number(T + ".E_MPa") * kMPa, s.number(T + ".nu"));
+    }
+    const double Kr = s.number(T + ".K_over_mu");
+    if (model == "yeoh") {
+      require_keys(s, T, {"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3"}, "model yeoh");
+      const double C10 = s.number(T + ".C10_MPa") * kMPa;
+      const double C20 = s.has(T + ".C20_MPa") ? s.number(T + ".C20_MPa") * kMPa : 0.0;
+      const double C30 = s.has(T + ".C30_MPa") ? s.number(T + ".C30_MPa") * kMPa : 0.0;
+      return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(C10, C20, C30, bulk_from_ratio(2 * C10, Kr)));
+    }
+    if (model == "neo_hookean") {
+      require_keys(s, T, {"model", "C10_MPa", "K_over_mu", "density_kg_m3"}, "model neo_hookean");
+      const double C10 = s.number(T + ".C10_MPa") * kMPa;
+      return std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(C10, bulk_from_ratio(2 * C10, Kr)));
+    }
+    if (model == "mooney_rivlin") {
+      require_keys(s, T, {"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3"}, "model mooney_rivlin");
+      const double C10 = s.number(T + ".C10_MPa") * kMPa, C01 = s.number(T + ".C01_MPa") * kMPa;
+      return std::make_shared<InvariantMaterial<MooneyRivlin>>(
+          MooneyRivlin(C10, C01, bulk_from_ratio(2 * (C10 + C01), Kr)));
+    }
+    if (model == "ogden") {
+      require_keys(s, T, {"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3"}, "model ogden");
+      std::vector<double> mu = s.numbers(T + ".mu_MPa");
+      const std::vector<double> alpha = s.numbers(T + ".alpha");
+      double mu0 = 0.0;
+      for (double& m : mu) {
+        m *= kMPa;
+        mu0 += m;
+      }
+      return std::make_shared<Ogden>(mu, alpha, bulk_from_ratio(mu0, Kr));
+    }
+  } catch (const InputError& e) {
+    s.fail(T, e.what());
+  }
+  s.fail(T + ".model", "unknown material model \"" + model +
+                           "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
+}
+
+Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
+  const std::string source = s.string("mesh.source");
+  if (source == "pneunet") {
+    PneuNetParams p = pneunet_params(s);
+    p.validate();
+    return build_pneunet(p);
+  }
+  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
+  const std::string file = s.string("mesh.file");
+  if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
+  InpDeck deck = read_inp(s.resolve_path(file), length_unit(s));
+  if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
+  Mesh mesh = std::move(deck.mesh);
+  if (s.boolean("mesh.promote_to_tet10")) mesh = promote_to_tet10(mesh);
+  return mesh;
+}
+
+std::unique_ptr<BuiltModel> build_model(const Scene& s) {
+  auto out = std::make_unique<BuiltModel>();
+  Model& model = out->model;
+  const std::string source = s.string("mesh.source");
+  InpDeck deck;
+  if (source == "pneunet") {
+    PneuNetParams p = pneunet_params(s);
+    p.validate();
+    model.mesh = build_pneunet(p);
+  } else if (source == "inp") {
+    const std::string file = s.string("mesh.file");
+    if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
+    deck = read_inp(s.resolve_path(file), length_unit(s));
+    out->warnings = deck.warnings;
+    model.mesh = std::move(deck.mesh);
+    if (s.boolean("mesh.promote_to_tet10")) {
+      if (model.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
+        out->warnings.push_back("mesh.promote_to_tet10: *DLOAD faces are kept (faces map one to one)");
+      model.mesh = promote_to_tet10(model.mesh);
+    }
+  } else {
+    s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
+  }
+  Mesh& mesh = model.mesh;
+  mesh.ensure_ids();
+
+  // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
+  for (const std::string& elset : s.table_keys("mesh.regions")) {
+    const std::vector<int>* els = find_elset(mesh, elset);
+    if (!els) s.fail("mesh.regions." + elset, "element set '" + elset + "' not found in the mesh");
+    const std::uint16_t r = mesh.region_id(s.string("mesh.regions." + elset));
+    for (int e : *els) mesh.region[e] = r;
+  }
+
+  // Parts: element set -> material.
+  const int nparts = s.array_size("parts");
+  if (nparts == 0) s.fail("parts", "define at least one [[parts]] with elset and material");
+  model.element_part.assign(mesh.num_elements(), -1);
+  for (int i = 0; i < nparts; ++i) {
+    const std::string key = "parts[" + std::to_string(i) + "]";
+    const std::string elset = s.string(key + ".elset"), mat = s.string(key + ".material");
+    const std::vector<int>* els = find_elset(mesh, elset);
+    if (!els) {
+      std::string avail;
+      for (const auto& [k, v] : mesh.element_sets) avail += (avail.empty() ? "" : ", ") + k;
+      s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
+    }
+    model.parts.push_back(Part{elset, make_material(s, mat), s.number("materials." + mat + ".density_kg_m3")});
+    for (int e : *els) {
+      if (model.element_part[e] >= 0)
+        s.fail(key + ".elset", "element " + std::to_string(mesh.element_ids[e]) + " is in two parts ('" +
+                                   model.parts[model.element_part[e]].name + "' and '" + elset + "')");
+      model.element_part[e] = i;
+    }
+  }
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    if (model.element_part[e] < 0)
+      s.fail("parts", "element " + std::to_string(mesh.element_ids[e]) +
+                          " belongs to no part; add its element set to a [[parts]] entry");
+
+  // Boundary conditions.
+  model.fixed.assign(3 * mesh.num_nodes(), 0);
+  const bool is_inp = source == "inp";
+  const std::string fixed_key = "mesh.fixed_set";
+  if (!is_inp || !s.string(fixed_key).empty() || deck.fixed_dofs.empty())
+    for (int n : node_set(s, mesh, fixed_key))
+      for (int d = 0; d < 3; ++d) model.fixed[3 * n + d] = 1;
+  if (is_inp && s.boolean("mesh.use_deck_boundary"))
+    for (const auto& [n, d] : deck.fixed_dofs) model.fixed[3 * n + d] = 1;
+  const bool half = is_inp ? !s.string("mesh.symmetry_set").empty() : s.boolean("mesh.half");
+  if (half) {
+    const std::vector<int>& sym = is_inp ? node_set(s, mesh, "mesh.symmetry_set") : mesh.node_sets.at("SYMMETRY");
+    const double L = (compute_stats(mesh).bbox_max - compute_stats(mesh).bbox_min).norm();
+    for (int n : sym) {
+      if (std::abs(mesh.X[n].x()) > 1e-6 * L)
+        s.fail("mesh.symmetry_set", "node " + std::to_string(mesh.node_ids[n]) +
+                                        " is not on the plane x = 0; the symmetry plane must be x = 0");
+      model.fixed[3 * n] = 1;
+    }
+    model.angle.mirror_axis = 0;
+  }
+
+  // Cavity faces.
+  const std::string cav = is_inp ? s.string("mesh.cavity_surface") : "CAVITY";
+  if (is_inp && (cav == "DLOAD" || cav == "dload")) {
+    if (deck.pressure_faces.empty())
+      s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn lines");
+    for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
+  } else {
+    std::string upper = cav;
+    std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+    auto it = mesh.surfaces.find(cav);
+    if (it == mesh.surfaces.end()) it = mesh.surfaces.find(upper);
+    if (it == mesh.surfaces.end())
+      s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
+    model.pressure_faces = it->second;
+  }
+  if (model.pressure_faces.empty()) s.fail("mesh.cavity_surface", "the cavity surface has no faces");
+
+  // Bending angle.
+  model.angle.tip_nodes = node_set(s, mesh, is_inp ? "mesh.tip_set" : "mesh.tip_set");
+  model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
+  model.angle.bend_direction = s.vec3("angle.bend_direction");
+  if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");
+  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
+    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
+  model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
+  validate(model);
+  out->stats = compute_stats(mesh);
+
+  // Load.
+  const std::string protocol = s.string("load.protocol");
+  if (protocol == "staircase") {
+    out->load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
+                          s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"),
+                          s.number("load.rest_s"), s.number("load.output_every_s"));
+  } else if (protocol == "csv") {
+    const std::string csv = s.string("load.csv");
+    if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
+    out->load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+    if (s.number("load.rest_s") > 0) out->load.rest_between_trials_s = s.number("load.rest_s");
+  } else {
+    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
+  }
+
+  // Solver.
+  SolverSettings& sv = out->solver;
+  const std::string mode = s.string("solver.mode");
+  if (mode == "quasi_static")
+    sv.mode = SolverSettings::Mode::QuasiStatic;
+  else if (mode == "explicit")
+    sv.mode = SolverSettings::Mode::Explicit;
+  else
+    s.fail("solver.mode", "must be \"quasi_static\" or \"explicit\", got \"" + mode + "\"");
+  const std::string method = s.string("solver.method");
+  if (method == "newton")
+    sv.quasi_static.method = EquilibriumMethod::Newton;
+  else if (method == "relaxation")
+    sv.quasi_static.method = EquilibriumMethod::Relaxation;
+  else
+    s.fail("solver.method", "must be \"newton\" or \"relaxation\", got \"" + method + "\"");
+  sv.quasi_static.newton.rel_tol = positive(s, "solver.rel_tol");
+  sv.quasi_static.relaxation.rel_tol = sv.quasi_static.newton.rel_tol;
+  sv.quasi_static.newton.max_iterations = s.integer("solver.max_iterations");
+  if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
+  sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
+  sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
+  sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
+  sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
+  sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");
+  if (sv.explicit_dynamics.dt_safety > 1.0) s.fail("solver.dt_safety", "must be <= 1 (fraction of the stable step)");
+  sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");
+  sv.explicit_dynamics.damping_alpha_1_s = s.number("solver.damping_1_s");
+  if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
+  sv.time_scale = positive(s, "solver.time_scale");
+
+  out->output.vtu = s.string("output.vtu");
+  if (out->output.vtu != "steps" && out->output.vtu != "all" && out->output.vtu != "none")
+    s.fail("output.vtu", "must be \"steps\", \"all\" or \"none\"");
+  return out;
+}
+
+LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, double output_every_s) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open pressure file '" + path + "'");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path + ":1: empty file; expected a header trial,time_s,pressure_kPa");
+  std::vector<std::string> cols;
+  {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) {
+      c.erase(std::remove_if(c.begin(), c.end(), ::isspace), c.end());
+      cols.push_back(c);
+    }
+  }
+  auto col = [&](const std::string& n) {
+    auto it = std::find(cols.begin(), cols.end(), n);
+    if (it == cols.end()) throw InputError(path + ":1: missing column '" + n + "'; header must contain trial,time_s,pressure_kPa");
+    return static_cast<std::size_t>(it - cols.begin());
+  };
+  const std::size_t ct = col("trial"), cs = col("time_s"), cp = col("pressure_kPa");
+  std::map<int, std::pair<std::vector<double>, std::vector<double>>> data;
+  long lineno = 1;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.empty()) continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    while (f.size() < cols.size()) f.emplace_back();
+    if (f[cp].find_first_not_of(" \t\r") == std::string::npos) continue;  // angle-only row
+    try {
+      std::size_t used = 0;
+      const int trial = std::stoi(f[ct]);
+      const double t = std::stod(f[cs], &used);
+      const double p = std::stod(f[cp]);
+      auto& [ts, ps] = data[trial];
+      if (!ts.empty() && t <= ts.back())
+        throw InputError(path + ":" + std::to_string(lineno) + ": time_s must increase within a trial");
+      ts.push_back(t);
+      ps.push_back(p);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception&) {
+      throw InputError(path + ":" + std::to_string(lineno) + ": could not read numbers in '" + line + "'");
+    }
+  }
+  if (data.empty()) throw InputError(path + ": no pressure samples found");
+  LoadHistory h;
+  for (auto& [trial, tp] : data) {
+    auto& [ts, ps] = tp;
+    std::vector<char> keep(ts.size(), 0);
+    keep.front() = keep.back() = 1;
+    rdp(ts, ps, 0, ts.size() - 1, tol_kPa, keep);
+    TrialLoad tl;
+    const double t0 = ts.front();
+    for (std::size_t i = 0; i < ts.size(); ++i)
+      if (keep[i]) {
+        tl.time_s.push_back(ts[i] - t0);
+        tl.pressure_Pa.push_back(ps[i] * kkPa);
+      }
+    tl.output_s = tl.time_s;
+    if (output_every_s > 0)
+      for (double t = output_every_s; t < tl.duration(); t += output_every_s) tl.output_s.push_back(t);
+    std::sort(tl.output_s.begin(), tl.output_s.end());
+    h.trials.push_back(std::move(tl));
+  }
+  h.description = "pressure from " + path;
+  return h;
+}
+
+}  // namespace pneufem

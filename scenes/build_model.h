@@ -1,0 +1,52 @@
+#pragma once
+// Scene -> discrete problem: mesh (built-in pneu-net or an Abaqus/CalculiX deck), materials,
+// parts, boundary conditions, cavity faces, bending-angle definition, load history and solver
+// settings. This is the only place that turns scene keys into engine objects.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/explicit.h"
+#include "engine/load_history.h"
+#include "engine/model.h"
+#include "engine/quasi_static.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+struct SolverSettings {
+  enum class Mode { QuasiStatic, Explicit };
+  Mode mode = Mode::QuasiStatic;
+  QuasiStaticOptions quasi_static;
+  ExplicitOptions explicit_dynamics;
+  double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time
+};
+
+struct OutputSettings {
+  std::string vtu = "steps";  ///< "steps", "all" or "none"
+};
+
+/// Everything a run needs. Held by pointer: the engine keeps references into `model`.
+struct BuiltModel {
+  Model model;
+  LoadHistory load;
+  SolverSettings solver;
+  OutputSettings output;
+  MeshStats stats;
+  std::vector<std::string> warnings;
+};
+
+/// Builds the material named `name` (scene table materials.<name>).
+MaterialPtr make_material(const Scene& scene, const std::string& name);
+
+/// Builds only the mesh described by the scene (mesh.* and geometry.*), with its sets.
+Mesh build_mesh(const Scene& scene, std::vector<std::string>* warnings = nullptr);
+
+std::unique_ptr<BuiltModel> build_model(const Scene& scene);
+
+/// Load history from a pressure CSV (columns trial,time_s,pressure_kPa; other columns and rows
+/// without a pressure value are ignored). The 400 Hz signal is simplified to a piecewise-linear
+/// history within `tolerance_kPa` (Ramer-Douglas-Peucker) so each breakpoint is one static state.
+LoadHistory pressure_history_from_csv(const std::string& path, double tolerance_kPa, double output_every_s);
+
+}  // namespace pneufem

@@ -1,0 +1,307 @@
+#include "scenes/scene.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "materials/errors.h"
+#include "scenes/default_scene_text.h"
+
+namespace pneufem {
+
+namespace {
+
+constexpr const char* kDefaultOrigin = "default scene";
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string origin_of(const toml::node& n) {
+  const auto& src = n.source();
+  if (!src.path || *src.path == kDefaultOrigin) return kDefaultOrigin;
+  if (src.path->rfind("--set", 0) == 0) return *src.path;
+  return *src.path + ":" + std::to_string(src.begin.line);
+}
+
+// Keys whose sub-keys are free-form names (checked elsewhere, e.g. by the material factory).
+bool free_form(const std::string& path) {
+  return path == "materials" || path == "mesh.regions" || path.rfind("materials.", 0) == 0;
+}
+
+// Rejects keys of `user` that the default scene does not have.
+void check_known(const toml::table& user, const toml::table& defaults, const std::string& prefix) {
+  for (auto&& [k, v] : user) {
+    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (free_form(prefix)) continue;
+    const toml::node* d = defaults.get(k.str());
+    if (!d) {
+      std::string best;
+      std::size_t best_d = 4;
+      for (auto&& [dk, dv] : defaults) {
+        const std::size_t dist = edit_distance(std::string(k.str()), std::string(dk.str()));
+        if (dist < best_d) {
+          best_d = dist;
+          best = std::string(dk.str());
+        }
+      }
+      std::string msg = origin_of(v) + ": key '" + key + "': unknown key";
+      if (!best.empty()) msg += "; did you mean '" + (prefix.empty() ? best : prefix + "." + best) + "'?";
+      msg += " (`pneufem scene --defaults` lists every key)";
+      throw InputError(msg);
+    }
+    if (v.is_table() && d->is_table() && !free_form(key)) check_known(*v.as_table(), *d->as_table(), key);
+    if (key == "parts" && v.is_array()) {
+      for (auto&& item : *v.as_array()) {
+        if (!item.is_table()) throw InputError(origin_of(item) + ": 'parts' must be an array of tables ([[parts]])");
+        for (auto&& [pk, pv] : *item.as_table())
+          if (pk.str() != "elset" && pk.str() != "material")
+            throw InputError(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
+                             "': unknown key; a part has 'elset' and 'material'");
+      }
+    }
+  }
+}
+
+using Origins = std::map<std::string, std::string>;
+
+// Deep merge of `src` into `dst`. Tables merge recursively, everything else is replaced; a
+// material whose 'model' changes starts from an empty table (its old constants do not apply).
+// The origin (file:line or --set) of every replaced value is recorded, since copies of toml++
+// nodes do not keep their source position.
+void record(Origins& origins, const std::string& key, const toml::node& v) {
+  if (v.is_table()) {
+    for (auto&& [k, c] : *v.as_table()) record(origins, key + "." + std::string(k.str()), c);
+    if (!v.as_table()->empty()) return;
+  }
+  origins[key] = origin_of(v);
+}
+
+void merge(toml::table& dst, const toml::table& src, const std::string& prefix, Origins& origins) {
+  for (auto&& [k, v] : src) {
+    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    toml::node* d = dst.get(k.str());
+    if (v.is_table() && d && d->is_table()) {
+      toml::table& dt = *d->as_table();
+      const toml::table& st = *v.as_table();
+      if (prefix == "materials" && st.contains("model") && dt.contains("model") &&
+          st.get("model")->value<std::string>() != dt.get("model")->value<std::string>()) {
+        dst.insert_or_assign(k.str(), st);
+        record(origins, key, v);
+        continue;
+      }
+      merge(dt, st, key, origins);
+    } else {
+      v.visit([&](auto&& node) { dst.insert_or_assign(k.str(), node); });
+      record(origins, key, v);
+    }
+  }
+}
+
+toml::table parse_text(const std::string& text, const std::string& origin) {
+  try {
+    return toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << origin << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description()
+      << " (TOML syntax error)";
+    throw InputError(s.str());
+  }
+}
+
+}  // namespace
+
+struct Scene::Impl {
+  toml::table table;
+  std::string dir;
+  Origins origins;  ///< where non-default values came from
+};
+
+const std::string& Scene::default_text() {
+  static const std::string text(kDefaultSceneText);
+  return text;
+}
+
+Scene Scene::load(const std::string& path, const std::vector<std::string>& overrides) {
+  auto impl = std::make_shared<Impl>();
+  impl->table = parse_text(default_text(), kDefaultOrigin);
+  Scene s;
+  s.path_ = path;
+  if (!path.empty()) {
+    std::ifstream in(path);
+    if (!in) throw InputError("cannot open scene file '" + path + "': check the path");
+    std::stringstream buf;
+    buf << in.rdbuf();
+    const toml::table user = parse_text(buf.str(), path);
+    check_known(user, impl->table, "");
+    merge(impl->table, user, "", impl->origins);
+    impl->dir = std::filesystem::absolute(path).parent_path().string();
+  } else {
+    impl->dir = std::filesystem::current_path().string();
+  }
+  s.impl_ = impl;
+  return s.with(overrides);
+}
+
+Scene Scene::with(const std::vector<std::string>& overrides) const {
+  if (overrides.empty()) return *this;
+  auto impl = std::make_shared<Impl>(*impl_);
+  for (const std::string& ov : overrides) {
+    const auto eq = ov.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--set " + ov + ": expected key=value, e.g. --set load.trials=10");
+    const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
+    const std::string origin = "--set " + key;
+    toml::table parsed;
+    try {
+      parsed = toml::parse("v = " + value, origin);
+    } catch (const toml::parse_error&) {
+      toml::table t;
+      t.insert("v", value);  // bare word: a string
+      parsed = t;
+    }
+    // Build {a = {b = {c = v}}} and merge it, after checking the key against the defaults.
+    std::vector<std::string> parts;
+    std::stringstream ks(key);
+    for (std::string p; std::getline(ks, p, '.');) parts.push_back(p);
+    toml::table nested;
+    parsed.get("v")->visit([&](auto&& node) { nested.insert_or_assign(parts.back(), node); });
+    for (int i = static_cast<int>(parts.size()) - 2; i >= 0; --i) {
+      toml::table outer;
+      outer.insert(parts[i], nested);
+      nested = outer;
+    }
+    toml::table defaults = parse_text(default_text(), kDefaultOrigin);
+    try {
+      check_known(nested, defaults, "");
+    } catch (const InputError&) {
+      // A key that exists in the current scene (e.g. a user-defined material) is fine too.
+      if (!impl->table.at_path(key)) throw;
+    }
+    Origins ignored;  // the nested copy lost its source; record the override itself
+    merge(impl->table, nested, "", ignored);
+    for (auto it = impl->origins.lower_bound(key + "."); it != impl->origins.end() && it->first.rfind(key + ".", 0) == 0;)
+      it = impl->origins.erase(it);
+    impl->origins[key] = origin;
+  }
+  Scene s;
+  s.impl_ = impl;
+  s.path_ = path_;
+  return s;
+}
+
+bool Scene::has(const std::string& key) const { return static_cast<bool>(impl_->table.at_path(key)); }
+
+std::string Scene::origin(const std::string& key) const {
+  // Exact key, else the closest enclosing key that was set (e.g. a whole table), else any key
+  // below it that was set (e.g. one constant of a material).
+  for (std::string k = key;;) {
+    auto it = impl_->origins.find(k);
+    if (it != impl_->origins.end()) return it->second;
+    const auto dot = k.find_last_of(".[");
+    if (dot == std::string::npos) break;
+    k = k.substr(0, dot);
+  }
+  auto it = impl_->origins.lower_bound(key + ".");
+  if (it != impl_->origins.end() && it->first.rfind(key + ".", 0) == 0) return it->second;
+  return kDefaultOrigin;
+}
+
+void Scene::fail(const std::string& key, const std::string& what) const {
+  throw InputError(origin(key) + ": key '" + key + "': " + what);
+}
+
+double Scene::number(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n) fail(key, "missing");
+  if (auto v = n->value<double>(); v && (n->is_floating_point() || n->is_integer())) return *v;
+  fail(key, "expected a number");
+}
+
+int Scene::integer(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n) fail(key, "missing");
+  if (!n->is_integer()) fail(key, "expected an integer");
+  return static_cast<int>(*n->value<std::int64_t>());
+}
+
+bool Scene::boolean(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n) fail(key, "missing");
+  if (!n->is_boolean()) fail(key, "expected true or false");
+  return *n->value<bool>();
+}
+
+std::string Scene::string(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n) fail(key, "missing");
+  if (!n->is_string()) fail(key, "expected a string (in quotes)");
+  return *n->value<std::string>();
+}
+
+std::vector<double> Scene::numbers(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n) fail(key, "missing");
+  const toml::array* a = n->as_array();
+  if (!a) fail(key, "expected an array of numbers, e.g. [1.0, 2.0]");
+  std::vector<double> out;
+  for (auto&& e : *a) {
+    auto v = e.value<double>();
+    if (!v || !(e.is_floating_point() || e.is_integer())) fail(key, "expected an array of numbers");
+    out.push_back(*v);
+  }
+  return out;
+}
+
+Eigen::Vector3d Scene::vec3(const std::string& key) const {
+  const std::vector<double> v = numbers(key);
+  if (v.size() != 3) fail(key, "expected 3 numbers [x, y, z]");
+  return {v[0], v[1], v[2]};
+}
+
+std::vector<std::string> Scene::table_keys(const std::string& key) const {
+  std::vector<std::string> out;
+  const toml::node* n = key.empty() ? &impl_->table : impl_->table.at_path(key).node();
+  if (!n || !n->is_table()) return out;
+  for (auto&& [k, v] : *n->as_table()) out.emplace_back(k.str());
+  return out;
+}
+
+int Scene::array_size(const std::string& key) const {
+  const toml::node* n = impl_->table.at_path(key).node();
+  if (!n || !n->is_array()) return 0;
+  return static_cast<int>(n->as_array()->size());
+}
+
+std::string Scene::resolve_path(const std::string& p) const {
+  if (p.empty()) return p;
+  std::filesystem::path q(p);
+  if (q.is_absolute()) return p;
+  return (std::filesystem::path(impl_->dir) / q).lexically_normal().string();
+}
+
+std::string Scene::to_toml() const {
+  std::ostringstream s;
+  s << impl_->table;
+  return s.str();
+}
+
+std::string Scene::to_json() const {
+  std::ostringstream s;
+  s << toml::json_formatter{impl_->table};
+  return s.str();
+}
+
+}  // namespace pneufem

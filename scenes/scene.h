@@ -1,0 +1,60 @@
+#pragma once
+// Scene files (TOML): the built-in default scene (scenes/data/default_scene.toml) merged with a
+// user's file and with command-line overrides (--set key=value), validated key by key. The
+// resolved scene is what every output records.
+//
+// Errors name the source: "<file>:<line>: key 'solver.metod': unknown key; did you mean
+// 'solver.method'?" or "--set load.trials=x: ...".
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace pneufem {
+
+class Scene {
+ public:
+  /// Loads `path` ("" = built-in default only) and applies `overrides` ("key=value", value in
+  /// TOML syntax; bare words are taken as strings).
+  static Scene load(const std::string& path, const std::vector<std::string>& overrides = {});
+  /// The built-in default scene text.
+  static const std::string& default_text();
+
+  /// Typed access to a dotted key of the resolved scene. Throws InputError naming the key and
+  /// where it was set when it is missing or has the wrong type.
+  double number(const std::string& key) const;
+  int integer(const std::string& key) const;
+  bool boolean(const std::string& key) const;
+  std::string string(const std::string& key) const;
+  Eigen::Vector3d vec3(const std::string& key) const;
+  std::vector<double> numbers(const std::string& key) const;
+  bool has(const std::string& key) const;
+  /// Names of the sub-tables of `key` (e.g. the materials).
+  std::vector<std::string> table_keys(const std::string& key) const;
+  /// Number of entries of an array of tables (e.g. "parts").
+  int array_size(const std::string& key) const;
+  /// Where a key was set: "scene.toml:12", "--set", or "default scene".
+  std::string origin(const std::string& key) const;
+  /// InputError prefixed with the key's origin.
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+  /// Resolves a path given in the scene relative to the scene file's directory.
+  std::string resolve_path(const std::string& p) const;
+  const std::string& path() const { return path_; }
+
+  /// The fully resolved configuration.
+  std::string to_toml() const;
+  std::string to_json() const;
+
+  /// A copy with more overrides applied (used by sweeps and diagnosis).
+  Scene with(const std::vector<std::string>& overrides) const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;
+  std::string path_;
+};
+
+}  // namespace pneufem

@@ -1,0 +1,182 @@
+// Fatigue damage decorator: irreversibility, the exact solution of the rate law at a constant driver,
+// first-order convergence of the backward-Euler update, threshold, failure flag.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+
+#include "damage/effects.h"
+#include "damage/material_point.h"
+#include "materials/errors.h"
+#include "materials/hyperelastic.h"
+
+namespace pneufem {
+namespace {
+
+constexpr double C10 = 0.019e6, C20 = 9.0e2, C30 = -4.75;  // Ecoflex 00-50, Pa
+constexpr double K = 100.0 * 2.0 * C10;
+
+MaterialPtr ecoflex() { return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(C10, C20, C30, K)); }
+
+/// Isochoric uniaxial stretch.
+Mat3 uniaxial(double lambda) { return Vec3(lambda, 1.0 / std::sqrt(lambda), 1.0 / std::sqrt(lambda)).asDiagonal(); }
+
+double base_energy(const Mat3& F) {
+  PointResponse r;
+  ecoflex()->evaluate(std::span<const Mat3>(&F, 1), TimeStep{}, {}, {}, std::span<PointResponse>(&r, 1), false);
+  return r.psi_iso;
+}
+
+double damage(const MaterialPoint& mp) { return FatigueDamage::damage(mp.committed_state()); }
+
+// W_th = 5 kPa: uniaxial lambda = 1.3 (W0 ~ 3.5 kPa) is below, lambda = 2 (W0 ~ 42 kPa) well above.
+const FatigueParams kParams{5e3, 10.0, 2.0, 0.5};
+
+TEST(Fatigue, DamageNeverDecreasesAndStaysBelowOne) {
+  // tau = 3000 s: the sequence ends near d = 0.9, crossing d_fail = 0.5 on the way.
+  const FatigueParams p{kParams.W_th_Pa, 3000.0, kParams.q, kParams.d_fail};
+  MaterialPoint mp(make_fatigue(ecoflex(), p));
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> stretch(0.7, 2.2), dt(0.0, 2.0);
+  std::bernoulli_distribution unload(0.3);
+  double d_prev = 0.0;
+  int grew = 0, held = 0;
+  for (int n = 0; n < 400; ++n) {
+    const Mat3 F = unload(rng) ? Mat3::Identity() : uniaxial(stretch(rng));
+    const PointResponse r = mp.advance(F, dt(rng));
+    const double d = damage(mp);
+    ASSERT_GE(d, d_prev) << "step " << n;
+    ASSERT_LT(d, 1.0) << "step " << n;
+    ASSERT_TRUE(r.P().allFinite()) << "step " << n;
+    EXPECT_EQ(mp.fields().failed, d >= p.d_fail) << "step " << n;
+    (d > d_prev ? grew : held)++;
+    d_prev = d;
+  }
+  // The sequence must exercise both branches, or the test says nothing.
+  EXPECT_GT(grew, 50);
+  EXPECT_GT(held, 50);
+  EXPECT_TRUE(mp.fields().failed) << "d = " << d_prev;
+}
+
+// Constant W0 above the threshold for a time T: dd/dt = (g/tau)(1 - d) has the exact solution
+// 1 - d(T) = (1 - d0) exp(-g T/tau). N backward-Euler steps give (1 - d0) (1 + z)^{-N}, z = gT/(tau N),
+// whose error is (1 - d_exact) (gT/tau)^2 / (2N) + O(N^-2) (expand -N ln(1 + z)).
+TEST(Fatigue, ConstantDriverMatchesExactSolutionAtFirstOrder) {
+  const Mat3 F = uniaxial(1.6);
+  const double W0 = base_energy(F);
+  const double g = std::pow(W0 / kParams.W_th_Pa - 1.0, kParams.q);
+  ASSERT_GT(g, 0.5);
+  const double T = 2.0 * kParams.tau_s / g;  // g T / tau = 2: d(T) = 1 - exp(-2) = 0.86
+  const double s_exact = std::exp(-g * T / kParams.tau_s);
+  std::vector<double> err;
+  for (int N : {10, 20, 40, 80, 160, 320}) {
+    MaterialPoint mp(make_fatigue(ecoflex(), kParams));
+    for (int n = 0; n < N; ++n) mp.advance(F, T / N);
+    const double s = 1.0 - damage(mp);
+    // The update is exactly backward Euler: equal to the closed form up to rounding of N divisions.
+    const double z = g * T / (kParams.tau_s * N);
+    EXPECT_NEAR(s, std::pow(1.0 + z, -N), 1e-13 * N * s) << "N = " << N;
+    // Backward-Euler error, leading term within 10 % once N is large (the next term is O(1/N^2)).
+    const double leading = s_exact * std::pow(g * T / kParams.tau_s, 2) / (2.0 * N);
+    err.push_back(s - s_exact);
+    if (N >= 80) {
+      EXPECT_NEAR(err.back(), leading, 0.1 * leading) << "N = " << N;
+    }
+  }
+  for (std::size_t i = 1; i < err.size(); ++i) {
+    const double order = std::log2(err[i - 1] / err[i]);
+    if (i + 1 == err.size()) {
+      EXPECT_GT(order, 0.9) << "observed order at the finest pair";
+    }
+    EXPECT_LT(order, 1.1) << "pair " << i;  // first order, not better: the scheme is BE, not exact
+  }
+}
+
+TEST(Fatigue, BelowThresholdDamageIsExactlyConstant) {
+  MaterialPoint mp(make_fatigue(ecoflex(), kParams));
+  for (int n = 0; n < 5; ++n) mp.advance(uniaxial(2.0), 1.0);
+  const double d0 = damage(mp);
+  ASSERT_GT(d0, 0.05);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> stretch(0.8, 1.3), dt(0.0, 100.0);
+  for (int n = 0; n < 200; ++n) {
+    const Mat3 F = uniaxial(stretch(rng));
+    ASSERT_LT(base_energy(F), kParams.W_th_Pa);
+    mp.advance(F, dt(rng));
+    ASSERT_EQ(damage(mp), d0) << "step " << n;  // bitwise: (1 - d) / (1 + 0)
+  }
+}
+
+TEST(Fatigue, ZeroIncrementLeavesDamageUnchanged) {
+  MaterialPoint mp(make_fatigue(ecoflex(), kParams));
+  mp.advance(uniaxial(2.0), 1.0);
+  const double d0 = damage(mp);
+  mp.advance(uniaxial(2.5), 0.0);  // a static (pseudo-time) solve: no physical time elapses
+  EXPECT_EQ(damage(mp), d0);
+}
+
+TEST(Fatigue, FailureFlagAndResidualStiffness) {
+  MaterialPoint mp(make_fatigue(ecoflex(), kParams));
+  int steps = 0;
+  while (!mp.fields().failed && steps < 1000) {
+    mp.advance(uniaxial(2.0), 0.05);  // a = 0.27 per step
+    ++steps;
+  }
+  ASSERT_TRUE(mp.fields().failed);
+  EXPECT_GE(damage(mp), kParams.d_fail);
+  EXPECT_GT(steps, 1);  // it took several increments, not one
+  // Absurd overload for very long increments (a ~ 1e30 per step): d approaches 1 so closely that
+  // 1 - (1 - d) rounds to 1 in double, but the stored integrity 1 - d stays > 0 (it is what is kept),
+  // so the point keeps a positive stiffness fraction and the stresses stay finite.
+  MaterialPoint hard(make_fatigue(ecoflex(), {1.0, 1e-3, 4.0, 0.9}));
+  for (int n = 0; n < 20; ++n) {
+    const PointResponse r = hard.advance(1.05 * uniaxial(3.0), 1e6, true);  // J = 1.16
+    ASSERT_TRUE(r.P().allFinite() && r.A().allFinite()) << "step " << n;
+    ASSERT_GT(hard.committed_state()[0], 0.0) << "step " << n;
+    ASSERT_GT(r.P_vol.norm(), 0.0);  // the volumetric response is never degraded
+  }
+  EXPECT_TRUE(hard.fields().failed);
+}
+
+// Stretch driver: one increment at a constant lambda gives 1 - d = 1/(1 + dt g/tau), g = (lambda/lambda_th - 1)^q.
+TEST(Fatigue, MaxPrincipalStretchDriver) {
+  FatigueParams p{0.0, 10.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.5};
+  const MaterialPtr m = make_fatigue(ecoflex(), p);
+  MaterialPoint below(m), above(m);
+  below.advance(uniaxial(1.45), 5.0);
+  EXPECT_EQ(damage(below), 0.0);
+  // Rotated, so the largest stretch is not along a coordinate axis.
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  above.advance(R * uniaxial(1.8), 5.0);
+  const double g = std::pow(1.8 / 1.5 - 1.0, 2.5);
+  EXPECT_NEAR(1.0 - damage(above), 1.0 / (1.0 + 5.0 * g / 10.0), 1e-14);
+}
+
+TEST(Fatigue, RejectsBadParameters) {
+  const auto expect_error = [](const FatigueParams& p, const std::string& text) {
+    try {
+      make_fatigue(ecoflex(), p);
+      ADD_FAILURE() << "no InputError; expected one containing '" << text << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  expect_error({0.0, 10.0, 2.0, 0.5}, "fatigue: W_th must be > 0 Pa");
+  expect_error({5e3, 0.0, 2.0, 0.5}, "fatigue: tau must be > 0 s");
+  expect_error({5e3, 10.0, 0.5, 0.5}, "fatigue: q must be >= 1");
+  expect_error({5e3, 10.0, 2.0, 1.0}, "fatigue: d_fail must lie in (0, 1)");
+  expect_error({5e3, 10.0, 2.0, 0.0}, "fatigue: d_fail must lie in (0, 1)");
+  expect_error({5e3, INFINITY, 2.0, 0.5}, "fatigue: tau must be a finite number");
+  expect_error({0.0, 10.0, 2.0, 0.5, FatigueDriver::max_principal_stretch, 1.0}, "fatigue: lambda_th must be > 1");
+  try {
+    make_fatigue(make_viscoelastic(ecoflex(), {{0.5}, {1.0}}), kParams);
+    ADD_FAILURE() << "fatigue(viscoelastic(...)) must be rejected";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("viscoelastic(fatigue(mullins(base)))"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pneufem

@@ -1,0 +1,142 @@
+// Scene files: defaults, merging, overrides, and the errors a user sees for bad input.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "materials/errors.h"
+#include "scenes/build_model.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / "pneufem_test_scene";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Scene, DefaultsAreTheEngineIssueActuator) {
+  const Scene s = Scene::load("");
+  EXPECT_DOUBLE_EQ(s.number("geometry.width_mm"), 22.0);
+  EXPECT_EQ(s.integer("geometry.chambers"), 15);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.C10_MPa"), 0.019);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.C30_MPa"), -4.75e-6);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.K_over_mu"), 100.0);
+  EXPECT_DOUBLE_EQ(s.number("materials.fabric.E_MPa"), 6500.0);
+  EXPECT_EQ(s.string("load.protocol"), "staircase");
+  EXPECT_EQ(s.array_size("parts"), 2);
+  EXPECT_EQ(s.origin("geometry.width_mm"), "default scene");
+}
+
+TEST(Scene, FileMergesOverDefaultsAndRecordsOrigins) {
+  const std::string p = write_temp("merge.toml", "[load]\ntrials = 3\n\n[materials.silicone]\nC10_MPa = 0.02\n");
+  const Scene s = Scene::load(p);
+  EXPECT_EQ(s.integer("load.trials"), 3);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.C10_MPa"), 0.02);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.C20_MPa"), 9.0e-4);  // kept from the defaults
+  EXPECT_EQ(s.origin("load.trials"), p + ":2");
+  // The resolved scene re-loads to the same configuration.
+  const std::string resolved = write_temp("resolved.toml", s.to_toml());
+  EXPECT_EQ(Scene::load(resolved).to_toml(), s.to_toml());
+}
+
+TEST(Scene, OverridesParseTomlValuesAndBareWords) {
+  const Scene s = Scene::load("", {"load.trials=10", "solver.method=relaxation", "gravity.g_m_s2=[0, 0, -9.81]"});
+  EXPECT_EQ(s.integer("load.trials"), 10);
+  EXPECT_EQ(s.string("solver.method"), "relaxation");
+  EXPECT_DOUBLE_EQ(s.vec3("gravity.g_m_s2").z(), -9.81);
+  EXPECT_EQ(s.origin("load.trials"), "--set load.trials");
+}
+
+TEST(Scene, ChangingAMaterialModelDropsTheOldConstants) {
+  const Scene s = Scene::load("", {"materials.silicone={model=\"neo_hookean\", C10_MPa=0.02, K_over_mu=100.0, "
+                                   "density_kg_m3=1070.0}"});
+  EXPECT_FALSE(s.has("materials.silicone.C20_MPa"));
+  EXPECT_NO_THROW(make_material(s, "silicone"));
+}
+
+TEST(SceneErrors, UnknownKeyNamesFileLineAndSuggestion) {
+  const std::string p = write_temp("typo.toml", "# comment\n[solver]\nmetod = \"newton\"\n");
+  const std::string msg = error_of([&] { Scene::load(p); });
+  EXPECT_NE(msg.find(p + ":3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("solver.metod"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("did you mean 'solver.method'"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, TomlSyntaxErrorNamesLine) {
+  const std::string p = write_temp("syntax.toml", "[load]\ntrials = = 3\n");
+  const std::string msg = error_of([&] { Scene::load(p); });
+  EXPECT_NE(msg.find(p + ":2"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, WrongTypeNamesKeyAndOrigin) {
+  const std::string p = write_temp("type.toml", "[load]\ntrials = \"ten\"\n");
+  const Scene s = Scene::load(p);
+  const std::string msg = error_of([&] { s.integer("load.trials"); });
+  EXPECT_NE(msg.find(p + ":2"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("load.trials"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("integer"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, UnknownOverrideKeyAndMalformedOverride) {
+  EXPECT_NE(error_of([] { Scene::load("", {"load.trails=3"}); }).find("did you mean 'load.trials'"), std::string::npos);
+  EXPECT_NE(error_of([] { Scene::load("", {"load.trials"}); }).find("key=value"), std::string::npos);
+}
+
+TEST(SceneErrors, BadMaterialConstantNamesTheMaterial) {
+  const Scene s = Scene::load("", {"materials.silicone.C10_MPa=-0.01"});
+  const std::string msg = error_of([&] { make_material(s, "silicone"); });
+  EXPECT_NE(msg.find("materials.silicone"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("C10"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("--set"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, UnknownMaterialKeyAndModel) {
+  const Scene s1 = Scene::load("", {"materials.silicone.C40_MPa=1.0"});
+  EXPECT_NE(error_of([&] { make_material(s1, "silicone"); }).find("allowed"), std::string::npos);
+  const Scene s2 = Scene::load("", {"materials.silicone.model=\"gent\""});
+  EXPECT_NE(error_of([&] { make_material(s2, "silicone"); }).find("unknown material model"), std::string::npos);
+}
+
+TEST(SceneErrors, MissingSetInPartsIsReported) {
+  const Scene s = Scene::load("", {"parts=[{elset=\"SILICONE\", material=\"silicone\"}, {elset=\"CLOTH\", material=\"fabric\"}]",
+                                   "mesh.h_mm=4.0"});
+  const std::string msg = error_of([&] { build_model(s); });
+  EXPECT_NE(msg.find("CLOTH"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("not found"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, ElementWithoutPartIsReported) {
+  const Scene s = Scene::load("", {"parts=[{elset=\"SILICONE\", material=\"silicone\"}]", "mesh.h_mm=4.0"});
+  const std::string msg = error_of([&] { build_model(s); });
+  EXPECT_NE(msg.find("belongs to no part"), std::string::npos) << msg;
+}
+
+TEST(SceneBuild, DefaultModelHasCavityTipFixedAndSymmetry) {
+  const Scene s = Scene::load("", {"mesh.h_mm=4.0"});
+  const auto bm = build_model(s);
+  EXPECT_GT(bm->model.pressure_faces.size(), 0u);
+  EXPECT_GT(bm->model.angle.tip_nodes.size(), 3u);
+  EXPECT_EQ(bm->model.angle.mirror_axis, 0);
+  EXPECT_EQ(bm->load.trials.size(), 1u);
+  EXPECT_EQ(bm->load.trials[0].step_level_Pa.size(), 10u);  // 0, 5, ..., 45 kPa
+  EXPECT_DOUBLE_EQ(bm->load.trials[0].duration(), 160.0);
+}
+
+}  // namespace
+}  // namespace pneufem
