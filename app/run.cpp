@@ -155,6 +155,7 @@ RunResult run_simulation(const Scene& scene, const RunOptions& opt) {
           .add("cutbacks", static_cast<double>(st.cutbacks))
           .add("newton_iterations", static_cast<double>(st.iterations))
           .add("factorizations", static_cast<double>(st.factorizations))
+          .add("krylov_iterations", static_cast<double>(st.krylov_iterations))
           .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
           .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
           .add("assembly_s", st.assembly_s)

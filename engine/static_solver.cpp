@@ -65,8 +65,14 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     asm_.add_gravity(f_ext);
     stats_.assembly_s += seconds_since(t0);
     R = f_int - f_ext;
+    // Force scale of the criterion: the applied load, or the reactions when the loading is by
+    // prescribed displacement, never below the structural floor. It is evaluated at the current
+    // iterate and not accumulated, so a poor trial state cannot loosen the tolerance.
+    double reactions2 = 0.0;
+    for (int i = 0; i < n; ++i)
+      if (asm_.model().fixed[i]) reactions2 += f_int[i] * f_int[i];
+    rep.reference_N = std::max({f_ext.norm(), std::sqrt(reactions2), force_floor_});
     asm_.zero_fixed(R);
-    rep.reference_N = std::max({f_ext.norm(), f_int.norm(), rep.reference_N, force_floor_});
     rep.residual_N = R.norm();
     rep.iterations = it;
     if (!std::isfinite(rep.residual_N)) {
@@ -74,8 +80,8 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
       return rep;
     }
     if (opt_.verbose)
-      std::fprintf(stderr, "    newton p=%.4g kPa it=%d |R|=%.3e ref=%.3e cuts=%d\n", p * 1e-3, it, rep.residual_N,
-                   rep.reference_N, rep.line_search_cuts);
+      std::fprintf(stderr, "    newton p=%.4g kPa it=%d |R|=%.3e ref=%.3e cuts=%d chords=%ld\n", p * 1e-3, it,
+                   rep.residual_N, rep.reference_N, rep.line_search_cuts, stats_.chord_steps);
     if (rep.residual_N <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) {
       rep.converged = true;
       return rep;
@@ -83,33 +89,19 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     if (it == opt_.max_iterations) break;
     ++stats_.iterations;
 
-    // Factorise; if not positive definite, shift the diagonal (Levenberg-style) and retry.
     t0 = std::chrono::steady_clock::now();
     double mean_diag = 0.0;
     for (int i = 0; i < n; ++i) mean_diag += std::abs(K_.coeff(i, i));
     mean_diag /= n;
     asm_.apply_constraints(K_, mean_diag);
-    bool ok = linear_.factorize(K_);
-    ++stats_.factorizations;
-    if (!ok) {
-      SparseMatrix Ks = K_;
-      const Eigen::VectorXd d = Ks.diagonal().cwiseAbs();
-      for (double beta = 1e-6; beta <= 10.0 && !ok; beta *= 10.0) {
-        for (int i = 0; i < n; ++i) Ks.coeffRef(i, i) = K_.coeff(i, i) + beta * d[i];
-        ok = linear_.factorize(Ks);
-        ++stats_.factorizations;
-      }
-      ++rep.regularised;
-      if (!ok) {
-        rep.failure = "tangent could not be factorised even with a diagonal shift";
-        return rep;
-      }
-    }
+    Eigen::VectorXd du;
+    const bool ok = linear_step(R, du, rep);
     stats_.factor_s += seconds_since(t0);
-    const Eigen::VectorXd du = -linear_.solve(R);
+    if (!ok) return rep;
 
     // Line search on s(alpha) = du . R(u + alpha du) (works for the non-potential follower load).
     const double s0 = du.dot(R);
+    if (opt_.verbose) std::fprintf(stderr, "      |du|=%.3e max|du|=%.3e decrement du.R=%.3e\n", du.norm(), du.lpNorm<Eigen::Infinity>(), s0);
     double alpha = 1.0;
     Eigen::VectorXd u_try;
     for (int ls = 0; ls < 8; ++ls) {
@@ -136,12 +128,93 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
       ++rep.line_search_cuts;
     }
     u = u_try;
+
+    // Chord steps with the factor just computed (Shamanskii's method). A stiff inextensible layer
+    // makes every Newton step that bends the structure stretch the layer to second order in the
+    // rotation increment, which shows as a large but "stiff" residual; one back-substitution with
+    // the same factor removes it at a fraction of a new factorisation's cost. Steps continue while
+    // they at least halve the residual.
+    if (linear_.has_factor()) {
+      Eigen::VectorXd Rc;
+      try {
+        Rc = residual(p, ts, s_old, s_new, u);
+      } catch (const PhysicsError&) {
+        continue;
+      }
+      for (int c = 0; c < opt_.chord_steps; ++c) {
+        const double r0 = Rc.norm();
+        if (r0 <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) break;
+        const Eigen::VectorXd dc = -linear_.solve(Rc);
+        Eigen::VectorXd R2;
+        try {
+          R2 = residual(p, ts, s_old, s_new, u + dc);
+        } catch (const PhysicsError&) {
+          break;
+        }
+        if (!(R2.norm() <= 0.5 * r0)) break;
+        u += dc;
+        Rc.swap(R2);
+        ++stats_.chord_steps;
+      }
+    }
   }
   std::ostringstream s;
   s << "no convergence in " << opt_.max_iterations << " iterations (residual " << rep.residual_N << " N, reference "
     << rep.reference_N << " N)";
   rep.failure = s.str();
   return rep;
+}
+
+bool StaticSolver::factorize_current(NewtonReport& rep) {
+  bool ok = linear_.factorize(K_);
+  ++stats_.factorizations;
+  if (ok) return true;
+  // Not positive definite (past a limit point, or a poor trial state): shift the diagonal
+  // (Levenberg-style) until the factorisation succeeds.
+  const int n = asm_.num_dofs();
+  SparseMatrix Ks = K_;
+  const Eigen::VectorXd d = K_.diagonal().cwiseAbs();
+  for (double beta = 1e-6; beta <= 10.0 && !ok; beta *= 10.0) {
+    for (int i = 0; i < n; ++i) Ks.coeffRef(i, i) = K_.coeff(i, i) + beta * d[i];
+    ok = linear_.factorize(Ks);
+    ++stats_.factorizations;
+  }
+  ++rep.regularised;
+  if (!ok) rep.failure = "tangent could not be factorised even with a diagonal shift";
+  return ok;
+}
+
+bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep) {
+  // Inexact Newton-Krylov: conjugate gradients on the current tangent, preconditioned by the
+  // Cholesky factor of an earlier tangent. Between nearby states (load sub-increments, time steps,
+  // later Newton iterations) that factor is an excellent preconditioner, so a few CG iterations
+  // (each one sparse product and two triangular solves) replace a new factorisation, which costs
+  // ~40 triangular solves. CG stops at a relative residual of krylov_rel_tol, enough for
+  // superlinear Newton convergence; on breakdown or slow convergence we re-factorise.
+  if (opt_.krylov_max_iterations > 0 && linear_.has_factor()) {
+    const Eigen::VectorXd b = -R;
+    du = Eigen::VectorXd::Zero(b.size());
+    Eigen::VectorXd r = b, z = linear_.solve(r), pdir = z, Kp;
+    double rz = r.dot(z);
+    const double target = opt_.krylov_rel_tol * b.norm();
+    for (int k = 0; k < opt_.krylov_max_iterations; ++k) {
+      Kp = K_ * pdir;
+      const double pKp = pdir.dot(Kp);
+      if (!(pKp > 0.0)) break;  // not positive definite along p: use a factorisation
+      const double alpha = rz / pKp;
+      du += alpha * pdir;
+      r -= alpha * Kp;
+      ++stats_.krylov_iterations;
+      if (r.norm() <= target) return true;
+      z = linear_.solve(r);
+      const double rz_new = r.dot(z);
+      pdir = z + (rz_new / rz) * pdir;
+      rz = rz_new;
+    }
+  }
+  if (!factorize_current(rep)) return false;
+  du = -linear_.solve(R);
+  return true;
 }
 
 void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vector<double>& state,
@@ -163,22 +236,39 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
   }
   double s_done = 0.0;  // fraction of the increment completed
   double ds = std::min(1.0, opt_.max_increment_Pa / std::abs(span));
-  if (last_du_per_Pa_.size() != u.size()) last_du_per_Pa_ = Eigen::VectorXd::Zero(u.size());
   while (s_done < 1.0 - 1e-12) {
     ds = std::min(ds, 1.0 - s_done);
     const double pa = p0 + s_done * span, pb = p0 + (s_done + ds) * span;
     const double ta = t0 + s_done * (t1 - t0), tb = t0 + (s_done + ds) * (t1 - t0);
-    Eigen::VectorXd u_try = u + last_du_per_Pa_ * (pb - pa);  // secant predictor
-    NewtonReport r = solve(pb, TimeStep{tb, tb - ta}, state, trial, u_try);
-    if (!r.converged) {
-      // A bad predictor can fail where the plain warm start would not: retry once without it.
-      u_try = u;
-      r = solve(pb, TimeStep{tb, tb - ta}, state, trial, u_try);
+    // Start from the polynomial extrapolation of the last equilibria (quadratic through three,
+    // else linear through two) when it balances the new load better than the previous
+    // equilibrium does. Quadratic extrapolation follows the arc of a bending actuator, so the
+    // stiff fabric is not stretched by a tangent-line predictor.
+    Eigen::VectorXd u_try = u;
+    const std::size_t m = path_p_.size();
+    if (m >= 2 && path_p_.back() == pa) {
+      Eigen::VectorXd u_pred;
+      if (m >= 3) {
+        const double x0 = path_p_[m - 3], x1 = path_p_[m - 2], x2 = path_p_[m - 1];
+        const double l0 = (pb - x1) * (pb - x2) / ((x0 - x1) * (x0 - x2));
+        const double l1 = (pb - x0) * (pb - x2) / ((x1 - x0) * (x1 - x2));
+        const double l2 = (pb - x0) * (pb - x1) / ((x2 - x0) * (x2 - x1));
+        u_pred = l0 * path_u_[m - 3] + l1 * path_u_[m - 2] + l2 * path_u_[m - 1];
+      } else {
+        const double x0 = path_p_[0], x1 = path_p_[1];
+        u_pred = path_u_[1] + (path_u_[1] - path_u_[0]) * ((pb - x1) / (x1 - x0));
+      }
+      const TimeStep ts{tb, tb - ta};
+      try {
+        if (residual(pb, ts, state, trial, u_pred).norm() < residual(pb, ts, state, trial, u).norm()) u_try = u_pred;
+      } catch (const PhysicsError&) {
+        // the extrapolated state inverts an element: keep the warm start
+      }
     }
+    NewtonReport r = solve(pb, TimeStep{tb, tb - ta}, state, trial, u_try);
     if (!r.converged) {
       ++stats_.cutbacks;
       ds *= 0.5;
-      last_du_per_Pa_.setZero();
       if (ds * std::abs(span) < opt_.min_increment_Pa) {
         std::ostringstream s;
         s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure
@@ -189,11 +279,24 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
       continue;
     }
     ++stats_.increments;
-    last_du_per_Pa_ = (u_try - u) / (pb - pa);
+    if (path_p_.empty() || path_p_.back() != pa) {
+      path_p_.assign(1, pa);
+      path_u_.assign(1, u);
+    }
+    path_p_.push_back(pb);
+    path_u_.push_back(u_try);
+    if (path_p_.size() > 3) {
+      path_p_.erase(path_p_.begin());
+      path_u_.erase(path_u_.begin());
+    }
     u = u_try;
     state.swap(trial);
     s_done += ds;
-    if (r.iterations <= 4) ds *= 1.5;
+    // Aim at ~4-6 iterations per increment.
+    if (r.iterations <= 4)
+      ds *= 1.5;
+    else if (r.iterations >= 8)
+      ds *= 0.7;
   }
 }
 

@@ -5,7 +5,7 @@
 // "the same equilibrium as a static solver" is a statement about the same discrete equations.
 //
 // Equilibrium: R(u) = f_int(u) - f_ext(u; p) = 0 on the free dofs, with p the cavity pressure.
-// Convergence: ||R_free||_2 <= rel_tol * max(||f_ext||_2, ||f_int||_2) (+ abs_tol_N).
+// Convergence: ||R_free||_2 <= rel_tol * max(||f_ext||_2, ||reactions||_2, floor) (+ abs_tol_N).
 #include <span>
 #include <string>
 #include <vector>
@@ -20,10 +20,15 @@ namespace pneufem {
 struct StaticOptions {
   double rel_tol = 1e-8;          ///< relative residual tolerance
   double abs_tol_N = 1e-12;       ///< absolute residual floor (N)
-  int max_iterations = 25;        ///< Newton iterations per increment
+  int max_iterations = 12;        ///< Newton iterations per increment (then cut back)
   double max_increment_Pa = 5e3;  ///< largest pressure sub-increment of a continuation
   double min_increment_Pa = 1.0;  ///< give up (limit point) below this sub-increment
   bool verbose = false;           ///< print every iteration to stderr
+  /// Newton-Krylov: CG iterations allowed with an old factorisation as preconditioner before
+  /// re-factorising (0 = factorise every Newton iteration).
+  int krylov_max_iterations = 0;
+  double krylov_rel_tol = 1e-3;   ///< CG stopping criterion, relative to |R|
+  int chord_steps = 3;            ///< back-substitutions with the current factor per iteration
 };
 
 struct NewtonReport {
@@ -43,6 +48,8 @@ struct StaticStats {
   long iterations = 0;
   long factorizations = 0;
   long residual_evaluations = 0;
+  long krylov_iterations = 0;
+  long chord_steps = 0;
   double assembly_s = 0.0;
   double factor_s = 0.0;
 };
@@ -70,12 +77,17 @@ class StaticSolver {
   const StaticOptions& options() const { return opt_; }
 
  private:
+  /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
+  bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
+  bool factorize_current(NewtonReport& rep);
+
   const Assembler& asm_;
   StaticOptions opt_;
   LinearSolver linear_;
   SparseMatrix K_;
   StaticStats stats_;
-  Eigen::VectorXd last_du_per_Pa_;  ///< secant predictor from the last accepted increment
+  std::vector<double> path_p_;           ///< pressures of the last (<= 3) equilibria on this path
+  std::vector<Eigen::VectorXd> path_u_;  ///< their displacements (for the predictor)
   double force_floor_ = 0.0;        ///< lower bound of the reference force (N)
 };
 

@@ -336,6 +336,8 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
   sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
+  sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
+  if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
   sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");
   if (sv.explicit_dynamics.dt_safety > 1.0) s.fail("solver.dt_safety", "must be <= 1 (fraction of the stable step)");
   sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");
