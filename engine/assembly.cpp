@@ -209,27 +209,34 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
     if (f_int)
       for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
     if (!tangent) return;
-    double* val = K->valuePtr();
+    // Element stiffness K_ab(i,k) = sum_q w sum_JL g_a[J] A(iJ,kL) g_b[L], accumulated over the
+    // points in a local matrix (upper blocks only, A has major symmetry) and scattered once.
+    Eigen::Matrix<double, 3 * NPE, 3 * NPE> Ke;
+    Ke.setZero();
     for (int q = 0; q < NQP; ++q) {
       const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));
-      const double w = geom_.w(e, q);
-      const Mat9 A = w * resp[q].A();
+      const Mat9 A = geom_.w(e, q) * resp[q].A();
       for (int b = 0; b < NPE; ++b) {
         // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
         Eigen::Matrix<double, 9, 3> T;
         for (int k = 0; k < 3; ++k)
           T.col(k) = A.col(flat(k, 0)) * g(0, b) + A.col(flat(k, 1)) * g(1, b) + A.col(flat(k, 2)) * g(2, b);
-        for (int a = 0; a < NPE; ++a) {
-          // K_ab(i, k) = sum_J g_a[J] T(iJ, k)
-          const int slot = pair_slot_[(static_cast<std::size_t>(e) * NPE + a) * NPE + b];
-          for (int k = 0; k < 3; ++k) {
-            double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
+        for (int a = 0; a <= b; ++a)
+          for (int k = 0; k < 3; ++k)
             for (int i = 0; i < 3; ++i)
-              col[i] += g(0, a) * T(flat(i, 0), k) + g(1, a) * T(flat(i, 1), k) + g(2, a) * T(flat(i, 2), k);
-          }
-        }
+              Ke(3 * a + i, 3 * b + k) +=
+                  g(0, a) * T(flat(i, 0), k) + g(1, a) * T(flat(i, 1), k) + g(2, a) * T(flat(i, 2), k);
       }
     }
+    double* val = K->valuePtr();
+    for (int b = 0; b < NPE; ++b)
+      for (int a = 0; a < NPE; ++a) {
+        const int slot = pair_slot_[(static_cast<std::size_t>(e) * NPE + a) * NPE + b];
+        for (int k = 0; k < 3; ++k) {
+          double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
+          for (int i = 0; i < 3; ++i) col[i] += a <= b ? Ke(3 * a + i, 3 * b + k) : Ke(3 * b + k, 3 * a + i);
+        }
+      }
   };
 
   for (const auto& colour : colours_) {

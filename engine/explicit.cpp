@@ -70,7 +70,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
   Eigen::VectorXd f_int, f_ext = external(t_, pressure);
   double IE = 0.0;
   asm_.internal(u_, TimeStep{t_, 0.0}, state_, trial_, &f_int, nullptr, &IE);
-  const double a = opt_.damping_alpha_1_s;
+  double a = opt_.damping_alpha_1_s;
   long local_steps = 0;
   double KE0 = 0.0;  // energy present at the start (initial velocities)
   for (int i = 0; i < n; ++i) KE0 += 0.5 * m_[i / 3] * v_[i] * v_[i];
@@ -89,6 +89,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
     const Eigen::VectorXd du = dt * v_;
     // Energy: trapezoidal external work, damping work with the mid-step velocity.
     const Eigen::VectorXd f_ext_old = f_ext;
+    const Eigen::VectorXd f_int_old = opt_.adaptive_damping ? f_int : Eigen::VectorXd();
     u_ += du;
     t_ += dt;
     f_ext = external(t_, pressure);
@@ -101,6 +102,15 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
       throw PhysicsError(s.str(), e.element(), t_);
     }
     state_.swap(trial_);
+    if (opt_.adaptive_damping) {
+      double num = 0.0, den = 0.0;
+      for (int i = 0; i < n; ++i)
+        if (!fixed[i]) {
+          num += du[i] * (f_int[i] - f_int_old[i]);
+          den += du[i] * m_[i / 3] * du[i];
+        }
+      if (den > 0.0 && num > 0.0) a = 2.0 * std::sqrt(num / den);
+    }
     energy_.external_work_J += 0.5 * du.dot(f_ext_old + f_ext);
     Eigen::VectorXd mv(n);
     for (int i = 0; i < n; ++i) mv[i] = m_[i / 3] * v_[i];

@@ -24,6 +24,10 @@ struct ExplicitOptions {
   double dt_safety = 0.8;          ///< fraction of the Gershgorin stable step used
   double target_dt_s = 0.0;        ///< > 0: mass-scale nodes so the stable step is >= this
   double damping_alpha_1_s = 0.0;  ///< mass-proportional damping coefficient a (1/s)
+  /// Adaptive damping for quasi-static runs: a = 2 omega with omega^2 the Rayleigh quotient of
+  /// the current motion, du.(f_int(u+du) - f_int(u)) / du.M du (Underwood 1983; Papadrakakis 1981),
+  /// i.e. critical damping of the mode the structure is moving in. Overrides damping_alpha_1_s.
+  bool adaptive_damping = false;
   int stability_interval = 200;    ///< steps between stable-step re-estimates
   double fixed_dt_s = 0.0;         ///< > 0: use this step instead of the estimate (expert use)
 };

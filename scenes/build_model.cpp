@@ -51,7 +51,11 @@ PneuNetParams pneunet_params(const Scene& s) {
   p.fabric_z0 = s.number("geometry.fabric_z0_mm") * kmm;
   p.fabric_thickness = s.number("geometry.fabric_thickness_mm") * kmm;
   p.h = s.number("mesh.h_mm") * kmm;
+  p.h_z = s.number("mesh.h_z_mm") * kmm;
+  if (p.h_z < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
   p.fabric_layers = s.integer("mesh.fabric_layers");
+  p.wall_layers = s.integer("mesh.wall_layers");
+  if (p.wall_layers < 0) s.fail("mesh.wall_layers", "must be >= 0 (0 = from mesh.h_mm)");
   p.half = s.boolean("mesh.half");
   const std::string el = s.string("mesh.element");
   if (el == "tet10")
@@ -343,6 +347,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");
   sv.explicit_dynamics.damping_alpha_1_s = s.number("solver.damping_1_s");
   if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
+  sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
   sv.time_scale = positive(s, "solver.time_scale");
 
   out->output.vtu = s.string("output.vtu");

@@ -113,6 +113,9 @@ std::array<AxisPlanes, 3> feature_planes(const PneuNetParams& p) {
   add(ax[2], hb + p.body_height, true);
   for (auto& a : ax) a.fixed_cells.assign(a.at.size() - 1, 0);
   ax[2].fixed_cells[1] = p.fabric_layers;
+  // y intervals 2, 4, ..., 2(N-1) are the interior walls (0 is the end cap, odd ones chambers).
+  if (p.wall_layers > 0)
+    for (int i = 0; i + 1 < p.chambers; ++i) ax[1].fixed_cells[2 + 2 * i] = p.wall_layers;
   for (int d = 0; d < 3; ++d)
     for (std::size_t m = 0; m + 1 < ax[d].at.size(); ++m)
       if (!(ax[d].at[m + 1] > ax[d].at[m]))
@@ -145,6 +148,9 @@ double min_centre_distance(const AxisPlanes& a, const std::vector<double>& lines
   return d;
 }
 
+/// Target cell size along axis d: h in plane (x, y), h_z vertically when given.
+double axis_h(const PneuNetParams& p, int d) { return d == 2 && p.h_z > 0.0 ? p.h_z : p.h; }
+
 /// Grid lines, voxel size and CSG boxes; throws InputError when the mesh or the OpenVDB solid
 /// would be too large. Assumes check_params(p) passed.
 Plan make_plan(const PneuNetParams& p) {
@@ -152,7 +158,7 @@ Plan make_plan(const PneuNetParams& p) {
   double cells = 1.0;
   std::array<double, 3> per_axis{};
   for (int d = 0; d < 3; ++d) {
-    for (std::size_t m = 0; m + 1 < ax[d].at.size(); ++m) per_axis[d] += interval_cells(ax[d], m, p.h);
+    for (std::size_t m = 0; m + 1 < ax[d].at.size(); ++m) per_axis[d] += interval_cells(ax[d], m, axis_h(p, d));
     cells *= per_axis[d];
   }
   if (cells > kMaxCells)
@@ -165,7 +171,7 @@ Plan make_plan(const PneuNetParams& p) {
     auto& L = plan.lines[d];
     for (std::size_t m = 0; m + 1 < ax[d].at.size(); ++m) {
       const double a = ax[d].at[m], b = ax[d].at[m + 1];
-      const int n = static_cast<int>(interval_cells(ax[d], m, p.h));
+      const int n = static_cast<int>(interval_cells(ax[d], m, axis_h(p, d)));
       for (int s = 0; s < n; ++s) L.push_back(a + (b - a) * s / n);
     }
     L.push_back(ax[d].at.back());

@@ -29,8 +29,10 @@ struct PneuNetParams {
   double fabric_z0 = 1.8e-3;       ///< fabric layer bottom
   double fabric_thickness = 0.4e-3;
   // Mesh.
-  double h = 2e-3;                 ///< target element size (m)
+  double h = 2e-3;                 ///< target element size in plane (x, y) (m)
+  double h_z = 0.0;                ///< target element size along z (m); 0 = same as h
   int fabric_layers = 1;           ///< elements through the fabric thickness
+  int wall_layers = 0;             ///< cells through each interior wall (y); 0 = from h
   bool half = true;                ///< model x >= 0 only, symmetry plane x = 0
   ElementType element = ElementType::Tet10;
 

@@ -1,0 +1,39 @@
+// Quasi-static mode on a small pneu-net (2 chambers, coarse): the staircase driver with warm
+// starts gives the same equilibrium angle whether each state is solved by Newton or by dynamic
+// relaxation (explicit pseudo-dynamics with per-node fictitious masses and kinetic damping).
+// Relaxation is slow here (the 6.5 GPa fabric makes the pseudo-dynamic system stiff: ~10^4-10^5
+// iterations per state), which is why Newton is the default; BENCHMARKS.md has the numbers.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "engine/quasi_static.h"
+#include "engine/static_solver.h"
+#include "scenes/build_model.h"
+
+namespace pneufem {
+namespace {
+
+const std::vector<std::string> kSmall = {"geometry.chambers=2", "mesh.h_mm=6.0", "load.max_kPa=10.0"};
+
+TEST(PneuNetSolvers, QuasiStaticDriverGivesTheSameAngleWithEitherMethod) {
+  // The whole quasi-static driver (staircase, warm starts) with Newton and with relaxation.
+  auto angle_at_top = [](const std::string& method) {
+    std::vector<std::string> sets = kSmall;
+    sets.push_back("solver.method=\"" + method + "\"");
+    sets.push_back("load.max_kPa=5.0");
+    auto bm = build_model(Scene::load("", sets));
+    Assembler A(bm->model);
+    QuasiStaticRun run(A, bm->solver.quasi_static);
+    double last = 0.0;
+    run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { last = r.angle_deg; });
+    return last;
+  };
+  const double a_n = angle_at_top("newton"), a_r = angle_at_top("relaxation");
+  EXPECT_GT(a_n, 0.05);
+  // rel_tol 1e-8 on both: agreement to 1e-3 of the angle is conservative.
+  EXPECT_NEAR(a_r, a_n, 1e-3 * a_n);
+}
+
+}  // namespace
+}  // namespace pneufem
