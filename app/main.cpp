@@ -61,10 +61,20 @@ int main(int argc, char** argv) {
 
   CLI::App* sim = app.add_subcommand("simulate", "Run a scene (default: the built-in pneu-net) and write a run directory");
   sim->add_option("scene", scene_path, "Scene file (TOML); omit for the built-in default pneu-net")->check(CLI::ExistingFile);
-  sim->add_option("--out", out_dir, "Output directory (created if needed)")->required();
+  sim->add_option("--out", out_dir, "Output directory (created if needed)");
   sim->add_option("--set", sets, "Override a scene key, e.g. --set load.trials=10 (repeatable)");
   sim->add_option("--threads", threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));
+  std::string resume_dir;
+  double ckpt_every = 30.0;
+  int abort_after = -1;
+  sim->add_option("--resume", resume_dir,
+                  "Continue a killed run in this directory from its checkpoint (uses its scene.toml; the final "
+                  "results equal an uninterrupted run)");
+  sim->add_option("--checkpoint-every", ckpt_every, "Wall-clock seconds between checkpoints (0 = after every segment)")
+      ->check(CLI::NonNegativeNumber);
+  sim->add_option("--abort-after-checkpoints", abort_after, "Testing aid: exit abruptly after N checkpoints")
+      ->group("");
 
   CLI::App* mesh = app.add_subcommand("mesh", "Write the scene's mesh as .vtu (ParaView) or a runnable CalculiX deck .inp");
   mesh->add_option("scene", scene_path, "Scene file (TOML); omit for the built-in default pneu-net")->check(CLI::ExistingFile);
@@ -79,11 +89,22 @@ int main(int argc, char** argv) {
   try {
     if (sim->parsed()) {
       RunOptions opt;
+      if (!resume_dir.empty()) {
+        if (!scene_path.empty() || !sets.empty())
+          throw InputError("--resume continues a run with its own scene.toml; do not give a scene or --set");
+        if (!out_dir.empty() && out_dir != resume_dir)
+          throw InputError("--resume DIR writes into DIR; omit --out or give the same directory");
+        out_dir = resume_dir;
+        opt.resume = true;
+      }
+      if (out_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
       opt.out_dir = out_dir;
+      opt.checkpoint_every_s = ckpt_every;
+      opt.abort_after_checkpoints = abort_after;
       opt.threads = threads;
       opt.progress = isatty(fileno(stderr));
       opt.command_line = join_args(argc, argv);
-      const Scene scene = Scene::load(scene_path, sets);
+      const Scene scene = opt.resume ? Scene::load("") : Scene::load(scene_path, sets);
       const RunResult r = run_simulation(scene, opt);
       std::printf("%zu states, %.1f s; results in %s (angles.csv, summary.json, results.pvd)\n", r.records.size(), r.wall_s,
                   out_dir.c_str());

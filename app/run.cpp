@@ -2,14 +2,15 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <thread>
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "analysis/paper_metrics.h"
 #include "app/json.h"
 #include "app/version.h"
 #include "engine/angle.h"
@@ -67,13 +68,66 @@ std::string mesh_stats_json(const MeshStats& s) {
   return o.str(2);
 }
 
+std::string angles_csv(const std::vector<StateRecord>& recs) {
+  std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
+  char line[160];
+  for (const StateRecord& r : recs) {
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    s += line;
+  }
+  return s;
+}
+
+std::string states_csv(const std::vector<StateRecord>& recs) {
+  std::string s = "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm\n";
+  char line[256];
+  for (const StateRecord& r : recs) {
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n", r.trial, r.time_s, r.global_time_s,
+                  r.pressure_Pa * 1e-3, r.angle_deg, r.cavity_volume_m3 * 1e9, r.plane_rms_m * 1e3);
+    s += line;
+  }
+  return s;
+}
+
+/// Angles of one trial at each step's mark and end (records at those exact report times).
+StepAngles step_angles(const TrialLoad& tl, int trial, const std::vector<StateRecord>& recs) {
+  StepAngles s;
+  s.trial = trial;
+  auto at = [&](double t) {
+    for (const StateRecord& r : recs)
+      if (r.trial == trial && std::abs(r.time_s - t) < 1e-9) return r.angle_deg;
+    throw InputError("metrics: no report at t = " + std::to_string(t) + " s of trial " + std::to_string(trial));
+  };
+  for (std::size_t k = 0; k < tl.step_start_s.size(); ++k) {
+    s.level_kPa.push_back(tl.step_level_Pa[k] * 1e-3);
+    s.at_mark_deg.push_back(at(tl.step_start_s[k] + tl.mark_s));
+    s.at_end_deg.push_back(at(tl.step_end_s[k]));
+  }
+  return s;
+}
+
+/// Scene keys that switch off every inelastic effect (the "ideal" elastic model of the paper).
+std::vector<std::string> ideal_overrides(const Scene& scene, bool& any_effect) {
+  std::vector<std::string> sets;
+  any_effect = false;
+  for (const std::string& m : scene.table_keys("materials"))
+    for (const char* fx : {"mullins", "fatigue", "viscoelastic"}) {
+      const std::string key = "materials." + m + "." + fx + ".enabled";
+      if (scene.has(key) && scene.boolean(key)) {
+        any_effect = true;
+        sets.push_back(key + "=false");
+      }
+    }
+  return sets;
+}
+
 class ProgressLine {
  public:
   explicit ProgressLine(bool on) : on_(on) {}
-  void update(const StateRecord& r, int trials) {
+  void update(const StateRecord& r, int trials, const char* what) {
     if (!on_) return;
-    std::fprintf(stderr, "\r  trial %d/%d  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", r.trial, trials, r.time_s,
-                 r.pressure_Pa * 1e-3, r.angle_deg);
+    std::fprintf(stderr, "\r  %s trial %d/%d  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", what, r.trial, trials,
+                 r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     std::fflush(stderr);
   }
   void done() {
@@ -84,31 +138,132 @@ class ProgressLine {
   bool on_;
 };
 
+// Application part of a checkpoint: the reports so far and the VTU series.
+struct AppCheckpoint {
+  std::vector<StateRecord> records;
+  std::vector<std::pair<double, std::string>> vtu;
+};
+
+void write_app_section(std::ostream& os, const AppCheckpoint& a) {
+  const std::uint64_t nr = a.records.size(), nv = a.vtu.size();
+  os.write(reinterpret_cast<const char*>(&nr), sizeof nr);
+  for (const StateRecord& r : a.records) os.write(reinterpret_cast<const char*>(&r), sizeof r);
+  os.write(reinterpret_cast<const char*>(&nv), sizeof nv);
+  for (const auto& [t, f] : a.vtu) {
+    const std::uint64_t len = f.size();
+    os.write(reinterpret_cast<const char*>(&t), sizeof t);
+    os.write(reinterpret_cast<const char*>(&len), sizeof len);
+    os.write(f.data(), static_cast<std::streamsize>(len));
+  }
+}
+
+AppCheckpoint read_app_section(std::istream& is) {
+  AppCheckpoint a;
+  std::uint64_t nr = 0, nv = 0;
+  auto check = [&] {
+    if (!is) throw InputError("checkpoint: file is truncated; the run cannot be resumed (start it again)");
+  };
+  is.read(reinterpret_cast<char*>(&nr), sizeof nr);
+  check();
+  a.records.resize(nr);
+  for (auto& r : a.records) is.read(reinterpret_cast<char*>(&r), sizeof r);
+  is.read(reinterpret_cast<char*>(&nv), sizeof nv);
+  check();
+  for (std::uint64_t i = 0; i < nv; ++i) {
+    double t = 0;
+    std::uint64_t len = 0;
+    is.read(reinterpret_cast<char*>(&t), sizeof t);
+    is.read(reinterpret_cast<char*>(&len), sizeof len);
+    check();
+    std::string f(len, '\0');
+    is.read(f.data(), static_cast<std::streamsize>(len));
+    a.vtu.emplace_back(t, f);
+  }
+  check();
+  return a;
+}
+
+/// Quasi-static run of a scene with no outputs (the ideal model of the metrics).
+std::vector<StateRecord> records_of(const Scene& scene) {
+  std::unique_ptr<BuiltModel> bm = build_model(scene);
+  const Assembler asmb(bm->model);
+  QuasiStaticRun run(asmb, bm->solver.quasi_static);
+  std::vector<StateRecord> recs;
+  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { recs.push_back(r); });
+  return recs;
+}
+
+std::vector<StateRecord> read_angles_csv(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::vector<StateRecord> out;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    StateRecord r;
+    double pk = 0;
+    if (std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &r.trial, &r.time_s, &pk, &r.angle_deg) == 4) {
+      r.pressure_Pa = pk * 1e3;
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
-RunResult run_simulation(const Scene& scene, const RunOptions& opt) {
+RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-  fs::create_directories(opt.out_dir);
-  if (!fs::is_directory(opt.out_dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
+  const fs::path dir(opt.out_dir);
+  const Scene scene = opt.resume ? Scene::load((dir / "scene.toml").string()) : scene_arg;
+  if (opt.resume && !fs::exists(dir / "checkpoint.bin"))
+    throw InputError("--resume " + opt.out_dir + ": no checkpoint.bin there (was the run started with this directory?)");
+  fs::create_directories(dir);
+  if (!fs::is_directory(dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
 
   const auto t_build = std::chrono::steady_clock::now();
   std::unique_ptr<BuiltModel> bm = build_model(scene);
   const Assembler asmb(bm->model);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
-  write_file_atomic((fs::path(opt.out_dir) / "scene.toml").string(), scene.to_toml());
+  if (!opt.resume) write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
 
   RunResult result;
-  std::ostringstream angles, states;
-  angles << "trial,time_s,pressure_kPa,angle_deg\n";
-  states << "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm\n";
-  const bool want_vtu = bm->output.vtu != "none";
-  if (want_vtu) fs::create_directories(fs::path(opt.out_dir) / "vtu");
-  PvdSeries pvd((fs::path(opt.out_dir) / "results.pvd").string());
-  int vtu_count = 0;
   ProgressLine progress(opt.progress);
   const int ntrials = static_cast<int>(bm->load.trials.size());
+  json::Object solver_stats;
+  std::exception_ptr failure;
+
+  // The ideal elastic model (effects off, one trial) for the paper's metrics.
+  bool any_effect = false;
+  const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
+  const bool staircase = scene.string("load.protocol") == "staircase";
+  std::vector<StateRecord> ideal;
+  if (opt.compare_ideal && any_effect && staircase && bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
+    if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
+      ideal = read_angles_csv(dir / "ideal_angles.csv");
+    } else {
+      std::vector<std::string> sets = ideal_sets;
+      sets.push_back("load.trials=1");
+      if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
+      ideal = records_of(scene.with(sets));
+      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal));
+    }
+  }
+
+  const bool want_vtu = bm->output.vtu != "none";
+  if (want_vtu) fs::create_directories(dir / "vtu");
+  PvdSeries pvd((dir / "results.pvd").string());
+  AppCheckpoint app;
+  std::unique_ptr<QuasiStaticCheckpoint> resume_from;
+  if (opt.resume) {
+    std::ifstream in(dir / "checkpoint.bin", std::ios::binary);
+    resume_from = std::make_unique<QuasiStaticCheckpoint>(
+        QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
+    app = read_app_section(in);
+    for (const auto& [t, f] : app.vtu) pvd.add(t, f);
+  }
+  std::vector<StateRecord>& records = app.records;
 
   auto is_step_end = [&](const StateRecord& r) {
     const TrialLoad& tl = bm->load.trials[r.trial - 1];
@@ -117,56 +272,64 @@ RunResult run_simulation(const Scene& scene, const RunOptions& opt) {
     return tl.step_end_s.empty();
   };
   auto observe = [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
-    result.records.push_back(r);
-    char line[256];
-    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
-    angles << line;
-    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n", r.trial, r.time_s, r.global_time_s,
-                  r.pressure_Pa * 1e-3, r.angle_deg, r.cavity_volume_m3 * 1e9, r.plane_rms_m * 1e3);
-    states << line;
+    records.push_back(r);
     if (want_vtu && (bm->output.vtu == "all" || is_step_end(r))) {
       char name[64];
-      std::snprintf(name, sizeof name, "vtu/state_%04d.vtu", vtu_count++);
-      write_vtu((fs::path(opt.out_dir) / name).string(), bm->model, compute_fields(asmb, u, state), r.global_time_s,
-                r.trial, r.pressure_Pa * 1e-3, r.angle_deg);
+      std::snprintf(name, sizeof name, "vtu/state_%04zu.vtu", app.vtu.size());
+      write_vtu((dir / name).string(), bm->model, compute_fields(asmb, u, state), r.global_time_s, r.trial,
+                r.pressure_Pa * 1e-3, r.angle_deg);
       pvd.add(r.global_time_s, name);
+      app.vtu.emplace_back(r.global_time_s, name);
     }
-    progress.update(r, ntrials);
+    progress.update(r, ntrials, "");
+  };
+  int checkpoints = 0;
+  auto last_ckpt = std::chrono::steady_clock::now();
+  auto sink = [&](const QuasiStaticCheckpoint& c) {
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt).count();
+    if (since < opt.checkpoint_every_s) return;
+    std::ostringstream os(std::ios::binary);
+    c.write(os);
+    write_app_section(os, app);
+    write_file_atomic((dir / "checkpoint.bin").string(), os.str());
+    write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
+    last_ckpt = std::chrono::steady_clock::now();
+    if (opt.abort_after_checkpoints >= 0 && ++checkpoints >= opt.abort_after_checkpoints) std::_Exit(137);
   };
 
-  json::Object solver_stats;
-  std::exception_ptr failure;
   const auto t_solve = std::chrono::steady_clock::now();
   try {
     if (bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
       QuasiStaticRun run(asmb, bm->solver.quasi_static);
       try {
-        run.run(bm->load, observe);
+        run.run(bm->load, observe, sink, resume_from.get());
       } catch (...) {
-        const StaticStats& st = run.static_solver().stats();
-        solver_stats.add("increments", static_cast<double>(st.increments));
+        solver_stats.add("states", static_cast<double>(run.stats().states));
         throw;
       }
       const StaticStats& st = run.static_solver().stats();
       solver_stats.add_str("mode", "quasi_static")
           .add_str("method", bm->solver.quasi_static.method == EquilibriumMethod::Newton ? "newton" : "relaxation")
           .add("states", static_cast<double>(run.stats().states))
+          .add("rejected_time_steps", static_cast<double>(run.stats().rejected_steps))
           .add("increments", static_cast<double>(st.increments))
           .add("cutbacks", static_cast<double>(st.cutbacks))
           .add("newton_iterations", static_cast<double>(st.iterations))
+          .add("chord_steps", static_cast<double>(st.chord_steps))
           .add("factorizations", static_cast<double>(st.factorizations))
           .add("krylov_iterations", static_cast<double>(st.krylov_iterations))
           .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
           .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
           .add("assembly_s", st.assembly_s)
-          .add("factor_solve_s", st.factor_s);
+          .add("factor_solve_s", st.factor_s)
+          .add("resumed", opt.resume ? 1.0 : 0.0);
     } else {
+      if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
       // Explicit dynamics through the concatenated trials; time_scale > 1 compresses the
       // protocol (quasi-static by time scaling) and the reported times are protocol times.
       ExplicitIntegrator ex(asmb, bm->solver.explicit_dynamics);
       const double ts = bm->solver.time_scale;
-      double t0_protocol = 0.0;
-      double last_angle = 0.0;
+      double t0_protocol = 0.0, last_angle = 0.0;
       for (int k = 0; k < ntrials; ++k) {
         const TrialLoad& tl = bm->load.trials[k];
         const double trial_start = t0_protocol;
@@ -208,9 +371,18 @@ RunResult run_simulation(const Scene& scene, const RunOptions& opt) {
   progress.done();
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  result.records = records;
 
-  write_file_atomic((fs::path(opt.out_dir) / "angles.csv").string(), angles.str());
-  write_file_atomic((fs::path(opt.out_dir) / "states.csv").string(), states.str());
+  write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
+  write_file_atomic((dir / "states.csv").string(), states_csv(records));
+  std::string metrics_note = "null";
+  if (!ideal.empty() && !failure) {
+    const StepAngles ref = step_angles(bm->load.trials[0], 1, ideal);
+    std::vector<TrialMetrics> per_trial;
+    for (int k = 0; k < ntrials; ++k) per_trial.push_back(paper_metrics(step_angles(bm->load.trials[k], k + 1, records), ref));
+    write_file_atomic((dir / "metrics.json").string(), metrics_json(per_trial, ref.level_kPa));
+    metrics_note = json::quote("metrics.json");
+  }
   std::string warnings = "[";
   for (std::size_t i = 0; i < bm->warnings.size(); ++i) warnings += (i ? ", " : "") + json::quote(bm->warnings[i]);
   warnings += "]";
@@ -226,9 +398,10 @@ RunResult run_simulation(const Scene& scene, const RunOptions& opt) {
       .add("solver", solver_stats.str(2))
       .add("timings", timings.str(2))
       .add("warnings", warnings)
-      .add("states_reported", static_cast<double>(result.records.size()))
+      .add("metrics", metrics_note)
+      .add("states_reported", static_cast<double>(records.size()))
       .add("scene", scene.to_json());
-  write_file_atomic((fs::path(opt.out_dir) / "summary.json").string(), summary.str() + "\n");
+  write_file_atomic((dir / "summary.json").string(), summary.str() + "\n");
   if (failure) std::rethrow_exception(failure);
   return result;
 }

@@ -96,6 +96,7 @@ PointFields FatigueDamage::fields(std::span<const double> state) const {
   const double d = 1.0 - state[0];
   f.damage = detail::combine_damage(d, f.damage);
   f.failed = f.failed || d >= p_.d_fail;
+  f.fatigue_damage = damage(state);
   return f;
 }
 

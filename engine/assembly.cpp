@@ -75,6 +75,12 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
     for (int a = 0; a < npe; ++a)
       for (int b = 0; b < npe; ++b) adj[n[a]].push_back(n[b]);
   }
+  // Membrane triangles couple their nodes too (already neighbours when they are element faces).
+  const int npf_m = nodes_per_face(mesh.type);
+  for (const MembraneSet& ms : model.membranes)
+    for (std::size_t t = 0; t + npf_m <= ms.nodes.size(); t += npf_m)
+      for (int a = 0; a < npf_m; ++a)
+        for (int b = 0; b < npf_m; ++b) adj[ms.nodes[t + a]].push_back(ms.nodes[t + b]);
   adj_ptr_.assign(nn + 1, 0);
   for (int i = 0; i < nn; ++i) {
     auto& v = adj[i];
@@ -96,6 +102,20 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
             static_cast<std::uint16_t>(std::lower_bound(first, last, n[a]) - first);
       }
   }
+  // ---- Membranes (engine/membrane.h): reference geometry, lumped mass, pair slots ----------
+  for (const MembraneSet& ms : model.membranes) {
+    mgeom_.push_back(compute_membrane_geometry(mesh, ms));
+    add_membrane_lumped_mass(ms, mgeom_.back(), mass_);
+    auto& slots = mslot_.emplace_back(ms.nodes.size() * npf_m);
+    for (std::size_t t = 0; t < ms.nodes.size(); t += npf_m)
+      for (int a = 0; a < npf_m; ++a)
+        for (int b = 0; b < npf_m; ++b) {
+          const int* first = adj_.data() + adj_ptr_[ms.nodes[t + b]];
+          const int* last = adj_.data() + adj_ptr_[ms.nodes[t + b] + 1];
+          slots[(t + a) * npf_m + b] = static_cast<std::uint16_t>(std::lower_bound(first, last, ms.nodes[t + a]) - first);
+        }
+  }
+  // ---- end membranes ---------------------------------------------------------------------------
   // CSC column pointers: column 3*b + k holds the 3 * |adj(b)| rows of b's neighbours.
   col_ptr_.assign(3 * nn + 1, 0);
   for (int b = 0; b < nn; ++b)
@@ -254,11 +274,69 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
          "mesh near this element, or check its material constants.";
     throw PhysicsError(s.str(), e, ts.time_s);
   }
+  // ---- Membranes (engine/membrane.h): serial, after the coloured loop ----------------------
+  double membrane_energy = 0.0;
+  if (!model_.membranes.empty())
+    add_membranes<NPE == 4 ? 3 : 6>(u, ts, f_int, K, energy ? &membrane_energy : nullptr);
+  // ---- end membranes ---------------------------------------------------------------------------
   if (energy) {
     double sum = 0.0;
     for (double v : elem_energy) sum += v;  // serial: deterministic
-    *energy = sum;
+    *energy = sum + membrane_energy;
   }
+}
+
+template <int NPF>
+void Assembler::add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eigen::VectorXd* f_int, SparseMatrix* K,
+                              double* energy) const {
+  Eigen::Matrix<double, 3, NPF> ue, fe;
+  Eigen::Matrix<double, 3 * NPF, 3 * NPF> Ke;
+  for (std::size_t s = 0; s < model_.membranes.size(); ++s) {
+    const MembraneSet& ms = model_.membranes[s];
+    const MembraneGeometry& g = mgeom_[s];
+    for (int t = 0; t < g.num_triangles(); ++t) {
+      const int* n = ms.nodes.data() + static_cast<std::size_t>(t) * NPF;
+      for (int a = 0; a < NPF; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
+      double W = 0.0;
+      if (!membrane_triangle<NPF>(ms, g, t, ue, W, fe, K ? &Ke : nullptr)) {
+        std::ostringstream msg;
+        msg << "membrane '" << ms.name << "' triangle " << t + 1 << " (first node " << model_.mesh.node_ids[n[0]]
+            << ") collapsed or produced a non-finite stress at t = " << ts.time_s
+            << " s. Hint: the load step is too large; reduce it (static: smaller max_increment) or check the "
+               "membrane's thickness and constants.";
+        throw PhysicsError(msg.str(), -1, ts.time_s);
+      }
+      if (energy) *energy += W;
+      if (f_int)
+        for (int a = 0; a < NPF; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
+      if (!K) continue;
+      double* val = K->valuePtr();
+      const std::uint16_t* slot = mslot_[s].data() + static_cast<std::size_t>(t) * NPF * NPF;
+      for (int b = 0; b < NPF; ++b)
+        for (int a = 0; a < NPF; ++a)
+          for (int k = 0; k < 3; ++k) {
+            double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot[a * NPF + b];
+            for (int i = 0; i < 3; ++i) col[i] += Ke(3 * a + i, 3 * b + k);
+          }
+    }
+  }
+}
+
+double Assembler::max_history_change(std::span<const double> a, std::span<const double> b) const {
+  double worst = 0.0;
+  const int ne = model_.mesh.num_elements();
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = model_.material_of(e);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    if (ss == 0) continue;
+    for (int q = 0; q < geom_.nqp; ++q) {
+      const std::size_t o = state_offset_[e] + q * ss;
+      const PointFields fa = mat.fields(a.subspan(o, ss)), fb = mat.fields(b.subspan(o, ss));
+      // Mullins softening follows the load, not time: only the time-driven histories count.
+      worst = std::max(worst, std::abs(fb.fatigue_damage - fa.fatigue_damage) + std::abs(fb.viscous_strain - fa.viscous_strain));
+    }
+  }
+  return worst;
 }
 
 void Assembler::point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
@@ -364,6 +442,8 @@ void Assembler::add_gravity(Eigen::VectorXd& f_ext) const {
       for (int a = 0; a < npe; ++a) f_ext.segment<3>(3 * n[a]) += rho * geom_.w(e, q) * N[a] * g;
     }
   }
+  for (std::size_t s = 0; s < model_.membranes.size(); ++s)  // membranes (engine/membrane.h)
+    add_membrane_gravity(model_.membranes[s], mgeom_[s], mesh.type, g, f_ext);
 }
 
 void Assembler::apply_constraints(SparseMatrix& K, double diag) const {

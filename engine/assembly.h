@@ -7,6 +7,8 @@
 // scattering straight into the global vectors/matrix. Every global entry therefore receives
 // its contributions in the same order (colour order) whatever the number of threads, so the
 // results are bit-for-bit identical for 1 and N threads, without atomics or per-thread buffers.
+// Membrane layers (Model::membranes) are few triangles and are added serially after the
+// coloured loop, so they keep this property.
 #include <span>
 #include <vector>
 
@@ -68,6 +70,10 @@ class Assembler {
   /// stable-step estimates (Gershgorin) and for the fictitious masses of dynamic relaxation.
   Eigen::VectorXd row_abs_sums(const SparseMatrix& K) const;
 
+  /// Largest change between two material histories of any point's damage plus viscous strain
+  /// (Material::fields); the physical-time step control of rate-dependent runs.
+  double max_history_change(std::span<const double> before, std::span<const double> after) const;
+
   /// Deformation gradients and responses at the element's quadrature points (for output).
   void point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
                        std::span<PointResponse> out) const;
@@ -76,6 +82,10 @@ class Assembler {
   template <int NPE, int NQP>
   void internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
                      std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
+  /// Adds the membranes' internal force, tangent and energy (serial); throws PhysicsError.
+  template <int NPF>
+  void add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eigen::VectorXd* f_int, SparseMatrix* K,
+                     double* energy) const;
 
   const Model& model_;
   ElementGeometry geom_;
@@ -89,6 +99,10 @@ class Assembler {
   std::vector<int> col_ptr_;  ///< CSC column pointers of the pattern
   // Pressure faces in outward node order (global node ids), npf nodes per face.
   std::vector<int> pface_nodes_;
+  // Membrane sets: reference geometry and pair slots (triangle t, local pair (a, b) at
+  // [(t * npf + a) * npf + b], as pair_slot_).
+  std::vector<MembraneGeometry> mgeom_;
+  std::vector<std::vector<std::uint16_t>> mslot_;
 };
 
 }  // namespace pneufem

@@ -78,6 +78,7 @@ LoadHistory staircase(double p_max, double dp, double hold_s, double ramp_s, int
   clean.step_start_s = tl.step_start_s;
   clean.step_end_s = tl.step_end_s;
   clean.step_level_Pa = tl.step_level_Pa;
+  clean.mark_s = mark_s;
   LoadHistory h;
   h.trials.assign(trials, clean);
   h.rest_between_trials_s = rest_s;

@@ -13,6 +13,7 @@ struct TrialLoad {
   /// Step (plateau) intervals [start, end) for metrics: the paper's 2.5 s mark is start + 2.5.
   std::vector<double> step_start_s, step_end_s;
   std::vector<double> step_level_Pa;
+  double mark_s = 2.5;  ///< the paper's mark: metrics sample each step at start + mark_s
   double duration() const { return time_s.empty() ? 0.0 : time_s.back(); }
   double pressure(double t) const;
 };

@@ -34,6 +34,16 @@ void validate(const Model& m) {
   for (const FaceRef& f : m.pressure_faces)
     if (f.element < 0 || f.element >= ne || f.local_face < 0 || f.local_face > 3)
       throw InputError("a pressure face refers to an element or face number outside the mesh");
+  const int npf = nodes_per_face(m.mesh.type);
+  for (const MembraneSet& ms : m.membranes) {
+    if (!(ms.thickness_m > 0.0)) throw InputError("membrane '" + ms.name + "': thickness must be > 0 m");
+    if (!(ms.density_kg_m3 > 0.0)) throw InputError("membrane '" + ms.name + "': density must be > 0 kg/m^3");
+    if (ms.nodes.empty() || ms.nodes.size() % npf != 0)
+      throw InputError("membrane '" + ms.name + "': needs a positive whole number of triangles of " +
+                       std::to_string(npf) + " nodes (Tri" + std::to_string(npf) + " on this mesh)");
+    for (int n : ms.nodes)
+      if (n < 0 || n >= nn) throw InputError("membrane '" + ms.name + "': a triangle node index is outside the mesh");
+  }
   for (int n : m.angle.tip_nodes)
     if (n < 0 || n >= nn) throw InputError("a tip node index is outside the mesh");
 }

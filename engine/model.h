@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "engine/membrane.h"
 #include "engine/mesh.h"
 #include "materials/material.h"
 
@@ -35,6 +36,9 @@ struct Model {
   std::vector<int> element_part;       ///< part index of each element
   std::vector<unsigned char> fixed;    ///< per dof (3 * nodes): 1 = prescribed zero displacement
   std::vector<FaceRef> pressure_faces; ///< faces loaded by the cavity pressure (follower load)
+  /// Optional membrane layers (engine/membrane.h), e.g. the fabric modelled as a membrane;
+  /// their nodes are nodes of the mesh. Empty = solid elements only.
+  std::vector<MembraneSet> membranes;
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d::Zero();
   AngleSpec angle;
 

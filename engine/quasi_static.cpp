@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <istream>
+#include <ostream>
 #include <sstream>
 
 #include "engine/angle.h"
@@ -10,13 +13,121 @@
 
 namespace pneufem {
 
+// ------------------------------------------------------------------ checkpoint (binary)
+namespace {
+constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;  // "PNEFCKP1"
+
+template <class T>
+void put(std::ostream& os, const T& v) {
+  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <class T>
+void get(std::istream& is, T& v) {
+  is.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!is) throw InputError("checkpoint: file is truncated");
+}
+void put_vec(std::ostream& os, const double* d, std::uint64_t n) {
+  put(os, n);
+  os.write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n * sizeof(double)));
+}
+std::vector<double> get_vec(std::istream& is) {
+  std::uint64_t n = 0;
+  get(is, n);
+  if (n > (1ULL << 34)) throw InputError("checkpoint: corrupt vector length");
+  std::vector<double> v(n);
+  is.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(double)));
+  if (!is) throw InputError("checkpoint: file is truncated");
+  return v;
+}
+}  // namespace
+
+void QuasiStaticCheckpoint::write(std::ostream& os) const {
+  put(os, kMagic);
+  put(os, static_cast<std::uint64_t>(next_segment));
+  put(os, dt_suggest_s);
+  put(os, last_angle_deg);
+  put_vec(os, u.data(), static_cast<std::uint64_t>(u.size()));
+  put_vec(os, state.data(), state.size());
+  put_vec(os, path_p.data(), path_p.size());
+  for (const auto& v : path_u) put_vec(os, v.data(), static_cast<std::uint64_t>(v.size()));
+  put(os, stats.states);
+  put(os, stats.rejected_steps);
+  put(os, stats.relaxation_iterations);
+  put(os, stats.wall_s);
+}
+
+QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
+  QuasiStaticCheckpoint c;
+  std::uint64_t magic = 0, seg = 0;
+  get(is, magic);
+  if (magic != kMagic) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  get(is, seg);
+  c.next_segment = static_cast<std::size_t>(seg);
+  get(is, c.dt_suggest_s);
+  get(is, c.last_angle_deg);
+  const std::vector<double> u = get_vec(is);
+  c.u = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
+  c.state = get_vec(is);
+  c.path_p = get_vec(is);
+  for (std::size_t i = 0; i < c.path_p.size(); ++i) {
+    const std::vector<double> v = get_vec(is);
+    c.path_u.emplace_back(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
+  }
+  get(is, c.stats.states);
+  get(is, c.stats.rejected_steps);
+  get(is, c.stats.relaxation_iterations);
+  get(is, c.stats.wall_s);
+  if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size)
+    throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
+                     "resume with the run's own scene.toml");
+  return c;
+}
+
+// ------------------------------------------------------------------ run
 QuasiStaticRun::QuasiStaticRun(const Assembler& assembler, QuasiStaticOptions options)
     : asm_(assembler), opt_(options), newton_(assembler, options.newton) {
   u_ = Eigen::VectorXd::Zero(asm_.num_dofs());
   state_ = asm_.initial_state();
+  rate_dependent_ = !state_.empty();
 }
 
-void QuasiStaticRun::step(double p0, double p1, double t0, double t1) {
+std::vector<QuasiStaticRun::Segment> QuasiStaticRun::segments(const LoadHistory& load) {
+  std::vector<Segment> out;
+  double g = 0.0;
+  for (std::size_t k = 0; k < load.trials.size(); ++k) {
+    const TrialLoad& tl = load.trials[k];
+    const int tr = static_cast<int>(k);
+    if (k > 0) {
+      // Release to zero at the end of the previous trial, rest, then the new trial's start.
+      const double p_end = load.trials[k - 1].pressure_Pa.back();
+      out.push_back({tr, 0, 0, g, g, p_end, 0.0, false});
+      if (load.rest_between_trials_s > 0) {
+        out.push_back({tr, 0, 0, g, g + load.rest_between_trials_s, 0.0, 0.0, false});
+        g += load.rest_between_trials_s;
+      }
+      out.push_back({tr, 0, 0, g, g, 0.0, tl.pressure(0.0), false});
+    }
+    std::vector<double> times = tl.time_s;
+    times.insert(times.end(), tl.output_s.begin(), tl.output_s.end());
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end(), [](double a, double b) { return std::abs(a - b) < 1e-12; }),
+                times.end());
+    auto is_output = [&](double t) {
+      return std::any_of(tl.output_s.begin(), tl.output_s.end(), [&](double o) { return std::abs(o - t) < 1e-12; });
+    };
+    if (is_output(times.front())) {
+      const double t = times.front();
+      out.push_back({tr, t, t, g + t, g + t, tl.pressure(t), tl.pressure(t), true});
+    }
+    for (std::size_t i = 1; i < times.size(); ++i)
+      out.push_back({tr, times[i - 1], times[i], g + times[i - 1], g + times[i], tl.pressure(times[i - 1]),
+                     tl.pressure(times[i]), is_output(times[i])});
+    g += tl.duration();
+  }
+  return out;
+}
+
+void QuasiStaticRun::equilibrium(double p0, double p1, double t0, double t1) {
   if (opt_.method == EquilibriumMethod::Newton) {
     newton_.advance(p0, p1, t0, t1, state_, u_);
   } else {
@@ -27,7 +138,7 @@ void QuasiStaticRun::step(double p0, double p1, double t0, double t1) {
       std::ostringstream s;
       s << "dynamic relaxation did not converge at p = " << p1 * 1e-3 << " kPa, t = " << t1 << " s in "
         << r.iterations << " iterations (residual " << r.residual_N << " N). Hint: raise "
-        << "solver.max_iterations or use solver.method = \"newton\".";
+        << "solver.relaxation_max_iterations or use solver.method = \"newton\".";
       throw PhysicsError(s.str(), -1, t1);
     }
     state_.swap(trial);
@@ -35,66 +146,96 @@ void QuasiStaticRun::step(double p0, double p1, double t0, double t1) {
   ++stats_.states;
 }
 
-void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  double t_global = 0.0;
-  for (std::size_t k = 0; k < load.trials.size(); ++k) {
-    const TrialLoad& tl = load.trials[k];
-    if (k > 0 && load.rest_between_trials_s > 0.0) {
-      // Unloaded rest between trials: advance the history at the pressure the trial ended with
-      // released to zero.
-      const double p_end = load.trials[k - 1].pressure_Pa.back();
-      step(p_end, 0.0, t_global, t_global + load.rest_between_trials_s);
-      t_global += load.rest_between_trials_s;
-    } else if (k > 0) {
-      step(load.trials[k - 1].pressure_Pa.back(), tl.pressure_Pa.front(), t_global, t_global);
-    }
-    std::vector<double> times = tl.time_s;
-    times.insert(times.end(), tl.output_s.begin(), tl.output_s.end());
-    std::sort(times.begin(), times.end());
-    times.erase(std::unique(times.begin(), times.end(), [](double a, double b) { return std::abs(a - b) < 1e-12; }),
-                times.end());
-    // Split long intervals (rate laws need resolved physical time).
-    if (opt_.max_dt_s > 0.0) {
-      std::vector<double> fine;
-      for (std::size_t i = 0; i < times.size(); ++i) {
-        if (i > 0) {
-          const double gap = times[i] - times[i - 1];
-          const int n = static_cast<int>(std::ceil(gap / opt_.max_dt_s - 1e-9));
-          for (int j = 1; j < n; ++j) fine.push_back(times[i - 1] + gap * j / n);
-        }
-        fine.push_back(times[i]);
-      }
-      times.swap(fine);
-    }
-    std::size_t next_out = 0;
-    std::vector<double> outs = tl.output_s;
-    std::sort(outs.begin(), outs.end());
-    double t_prev = times.front();
-    double p_prev = tl.pressure(t_prev);
-    for (double t : times) {
-      const double p = tl.pressure(t);
-      if (t > t_prev || p != p_prev) step(p_prev, p, t_global + t_prev, t_global + t);
-      t_prev = t;
-      p_prev = p;
-      while (next_out < outs.size() && outs[next_out] <= t + 1e-12) {
-        StateRecord rec;
-        rec.trial = static_cast<int>(k) + 1;
-        rec.time_s = outs[next_out];
-        rec.global_time_s = t_global + outs[next_out];
-        rec.pressure_Pa = p;
-        const AngleResult a = bending_angle(asm_.model(), u_);
-        rec.angle_deg = unwrap_deg(a.angle_deg, last_angle_);
-        last_angle_ = rec.angle_deg;
-        rec.plane_rms_m = a.plane_rms_m;
-        rec.cavity_volume_m3 = asm_.cavity_volume(u_);
-        if (observer) observer(rec, u_, state_);
-        ++next_out;
-      }
-    }
-    t_global += tl.duration();
+void QuasiStaticRun::solve_segment(const Segment& s) {
+  const double span = s.g1 - s.g0;
+  if (!rate_dependent_ || span <= 0.0) {
+    if (span > 0.0 || s.p0 != s.p1) equilibrium(s.p0, s.p1, s.g0, s.g1);
+    return;
   }
-  stats_.wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
+  if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
+  double t = s.g0;
+  while (t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1))) {
+    double h = std::min(dt_suggest_, s.g1 - t);
+    if (s.g1 - (t + h) < 0.25 * h) h = s.g1 - t;  // do not leave a sliver
+    const Eigen::VectorXd u_saved = u_;
+    const std::vector<double> state_saved = state_;
+    const StaticSolver::Path path_saved = newton_.path();
+    try {
+      equilibrium(p_at(t), p_at(t + h), t, t + h);
+    } catch (const PhysicsError&) {
+      // A shorter physical step keeps the history change (and the equilibrium shift) smaller.
+      if (h <= opt_.min_dt_s * (1.0 + 1e-9)) throw;
+      u_ = u_saved;
+      state_ = state_saved;
+      newton_.set_path(path_saved);
+      dt_suggest_ = std::max(opt_.min_dt_s, 0.25 * h);
+      ++stats_.rejected_steps;
+      continue;
+    }
+    const double change = asm_.max_history_change(state_saved, state_);
+    if (change > 2.0 * opt_.time_tol && h > opt_.min_dt_s * (1.0 + 1e-9)) {
+      u_ = u_saved;
+      state_ = state_saved;
+      newton_.set_path(path_saved);
+      dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, 0.9 * opt_.time_tol / change));
+      ++stats_.rejected_steps;
+      continue;
+    }
+    const double grow = change > 0.0 ? std::clamp(0.9 * opt_.time_tol / change, 0.5, 2.0) : 2.0;
+    dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+    t += h;
+  }
+}
+
+void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, const CheckpointSink& sink,
+                         const QuasiStaticCheckpoint* resume) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::vector<Segment> segs = segments(load);
+  std::size_t first = 0;
+  double wall_before = 0.0;
+  if (resume) {
+    first = resume->next_segment;
+    dt_suggest_ = resume->dt_suggest_s;
+    last_angle_ = resume->last_angle_deg;
+    u_ = resume->u;
+    state_ = resume->state;
+    newton_.set_path({resume->path_p, resume->path_u});
+    stats_ = resume->stats;
+    wall_before = stats_.wall_s;
+  }
+  for (std::size_t i = first; i < segs.size(); ++i) {
+    const Segment& s = segs[i];
+    solve_segment(s);
+    if (s.report) {
+      StateRecord rec;
+      rec.trial = s.trial + 1;
+      rec.time_s = s.t1;
+      rec.global_time_s = s.g1;
+      rec.pressure_Pa = s.p1;
+      const AngleResult a = bending_angle(asm_.model(), u_);
+      rec.angle_deg = unwrap_deg(a.angle_deg, last_angle_);
+      last_angle_ = rec.angle_deg;
+      rec.plane_rms_m = a.plane_rms_m;
+      rec.cavity_volume_m3 = asm_.cavity_volume(u_);
+      if (observer) observer(rec, u_, state_);
+    }
+    stats_.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    if (sink) {
+      QuasiStaticCheckpoint c;
+      c.next_segment = i + 1;
+      c.dt_suggest_s = dt_suggest_;
+      c.last_angle_deg = last_angle_;
+      c.u = u_;
+      c.state = state_;
+      const StaticSolver::Path path = newton_.path();
+      c.path_p = path.p;
+      c.path_u = path.u;
+      c.stats = stats_;
+      sink(c);
+    }
+  }
+  stats_.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
 }  // namespace pneufem

@@ -3,6 +3,16 @@
 // material history committed at the previous one, in physical time (so rate-dependent laws
 // evolve between states). Equilibria come from Newton (default) or dynamic relaxation; both
 // use the same element and material code and the same residual criterion.
+//
+// Physical time steps adapt when the materials carry history (creep, damage): a step is
+// accepted when the largest change of any point's damage or viscous strain stays below
+// `time_tol` (rejected and retried shorter above 2 time_tol), and the next step is scaled by
+// 0.9 time_tol / change, within [0.5, 2] of the last. Tightening time_tol converges the angle
+// history (tested).
+//
+// The run is a list of segments (the intervals between the load's breakpoints and report
+// times, plus the rest between trials). After each segment the full state can be checkpointed;
+// resuming from a checkpoint continues bit-for-bit as the uninterrupted run would.
 #include <functional>
 #include <string>
 #include <vector>
@@ -22,7 +32,9 @@ struct QuasiStaticOptions {
   EquilibriumMethod method = EquilibriumMethod::Newton;
   StaticOptions newton;
   RelaxationOptions relaxation;
-  double max_dt_s = 0.0;  ///< > 0: split long constant-pressure intervals into steps <= this
+  double time_tol = 0.01;   ///< max change of damage / viscous strain per physical step
+  double min_dt_s = 1e-3;   ///< smallest physical step
+  double max_dt_s = 4.0;    ///< largest physical step (rate-dependent materials only)
 };
 
 /// One reported state.
@@ -37,18 +49,38 @@ struct StateRecord {
 };
 
 struct QuasiStaticStats {
-  long states = 0;
+  long states = 0;           ///< equilibria solved (physical steps)
+  long rejected_steps = 0;   ///< physical steps redone shorter
   long relaxation_iterations = 0;
   double wall_s = 0.0;
+};
+
+/// Everything needed to continue a run exactly where it stopped.
+struct QuasiStaticCheckpoint {
+  std::size_t next_segment = 0;
+  double dt_suggest_s = 0.0;
+  double last_angle_deg = 0.0;
+  Eigen::VectorXd u;
+  std::vector<double> state;
+  std::vector<double> path_p;
+  std::vector<Eigen::VectorXd> path_u;
+  QuasiStaticStats stats;
+
+  void write(std::ostream& os) const;
+  /// Throws InputError when the stream is not a checkpoint of a model with `dofs` and `state_size`.
+  static QuasiStaticCheckpoint read(std::istream& is, std::size_t dofs, std::size_t state_size);
 };
 
 class QuasiStaticRun {
  public:
   using Observer = std::function<void(const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>& state)>;
+  using CheckpointSink = std::function<void(const QuasiStaticCheckpoint&)>;
   QuasiStaticRun(const Assembler& assembler, QuasiStaticOptions options);
 
-  /// Runs every trial of `load`; calls `observer` at every output time.
-  void run(const LoadHistory& load, const Observer& observer);
+  /// Runs every trial of `load`; calls `observer` at every report time and `sink` (if given)
+  /// after every segment. With `resume`, continues from that checkpoint.
+  void run(const LoadHistory& load, const Observer& observer, const CheckpointSink& sink = nullptr,
+           const QuasiStaticCheckpoint* resume = nullptr);
 
   const Eigen::VectorXd& u() const { return u_; }
   const std::vector<double>& state() const { return state_; }
@@ -56,7 +88,16 @@ class QuasiStaticRun {
   const QuasiStaticStats& stats() const { return stats_; }
 
  private:
-  void step(double p0, double p1, double t0, double t1);
+  struct Segment {
+    int trial;               ///< 0-based
+    double t0, t1;           ///< trial-local times
+    double g0, g1;           ///< global times
+    double p0, p1;           ///< pressures at the ends (linear in between)
+    bool report;             ///< a report is due at t1
+  };
+  static std::vector<Segment> segments(const LoadHistory& load);
+  void solve_segment(const Segment& s);
+  void equilibrium(double p0, double p1, double t0, double t1);
 
   const Assembler& asm_;
   QuasiStaticOptions opt_;
@@ -65,6 +106,8 @@ class QuasiStaticRun {
   std::vector<double> state_;
   QuasiStaticStats stats_;
   double last_angle_ = 0.0;
+  double dt_suggest_ = 0.0;
+  bool rate_dependent_ = false;
 };
 
 }  // namespace pneufem

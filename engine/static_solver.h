@@ -26,7 +26,7 @@ struct StaticOptions {
   bool verbose = false;           ///< print every iteration to stderr
   /// Newton-Krylov: CG iterations allowed with an old factorisation as preconditioner before
   /// re-factorising (0 = factorise every Newton iteration).
-  int krylov_max_iterations = 0;
+  int krylov_max_iterations = 10;
   double krylov_rel_tol = 1e-3;   ///< CG stopping criterion, relative to |R|
   int chord_steps = 3;            ///< back-substitutions with the current factor per iteration
 };
@@ -76,6 +76,18 @@ class StaticSolver {
   const StaticStats& stats() const { return stats_; }
   const StaticOptions& options() const { return opt_; }
 
+  /// The last equilibria of the current load path (the predictor's memory); saved in checkpoints
+  /// and restored when a physical step is rejected, so runs are reproducible.
+  struct Path {
+    std::vector<double> p;
+    std::vector<Eigen::VectorXd> u;
+  };
+  Path path() const { return {path_p_, path_u_}; }
+  void set_path(Path path) {
+    path_p_ = std::move(path.p);
+    path_u_ = std::move(path.u);
+  }
+
  private:
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
   bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
@@ -83,6 +95,7 @@ class StaticSolver {
 
   const Assembler& asm_;
   StaticOptions opt_;
+  bool krylov_allowed_ = false;  ///< CG with the old factor: only for pure time increments
   LinearSolver linear_;
   SparseMatrix K_;
   StaticStats stats_;

@@ -52,6 +52,7 @@ struct PointFields {
   double damage = 0.0;          ///< isochoric softening 1 - (stiffness fraction), in [0, 1)
   double W_max = 0.0;           ///< peak isochoric energy density seen so far (J/m^3)
   double viscous_strain = 0.0;  ///< norm of the viscous (overstress) strain measure
+  double fatigue_damage = 0.0;  ///< the rate-dependent (time-driven) part of `damage`
   /// True once a failure criterion of the law is met (fatigue: damage >= d_fail). The point keeps a
   /// small residual stiffness, so the solution stays finite; the driver decides what to do with it.
   bool failed = false;

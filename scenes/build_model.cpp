@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "damage/effects.h"
 #include "materials/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
@@ -34,6 +35,40 @@ double positive(const Scene& scene, const std::string& key) {
   if (!(v > 0.0)) scene.fail(key, "must be > 0");
   return v;
 }
+
+// ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
+
+/// mesh.fabric_model: "solid" (elements of set FABRIC) or "membrane".
+bool fabric_is_membrane(const Scene& s) {
+  const std::string v = s.string("mesh.fabric_model");
+  if (v != "solid" && v != "membrane") s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + v + "\"");
+  return v == "membrane";
+}
+
+/// The membrane fabric: the mesher's FABRIC_MEMBRANE faces, thickness geometry.fabric_thickness_mm,
+/// plane-stress St Venant-Kirchhoff with E and nu of materials.fabric (which must be linear_elastic).
+MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
+  const std::string T = "materials.fabric";
+  if (!s.has(T))
+    s.fail(T, "mesh.fabric_model = \"membrane\" takes the fabric's E_MPa, nu and density_kg_m3 from [" + T +
+                  "]; define it with model = \"linear_elastic\"");
+  const std::string law = s.string(T + ".model");
+  if (law != "linear_elastic")
+    s.fail(T + ".model", "must be \"linear_elastic\" when mesh.fabric_model = \"membrane\" (the membrane is "
+                         "plane-stress St Venant-Kirchhoff), got \"" + law + "\"; or use mesh.fabric_model = \"solid\"");
+  const MaterialPtr mat = make_material(s, "fabric");  // validates the table like any material
+  const auto* svk = dynamic_cast<const SaintVenantKirchhoff*>(mat.get());
+  if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
+  MembraneSet m;
+  m.name = "FABRIC_MEMBRANE";
+  m.nodes = membrane_nodes_of_faces(mesh, mesh.surfaces.at("FABRIC_MEMBRANE"));
+  m.thickness_m = positive(s, "geometry.fabric_thickness_mm") * kmm;
+  m.law = PlaneStressSVK(svk->youngs_modulus(), svk->poisson_ratio());
+  m.density_kg_m3 = positive(s, T + ".density_kg_m3");
+  return m;
+}
+
+// ---- end fabric membrane -------------------------------------------------------------------------
 
 PneuNetParams pneunet_params(const Scene& s) {
   PneuNetParams p;
@@ -64,6 +99,7 @@ PneuNetParams pneunet_params(const Scene& s) {
     p.element = ElementType::Tet4;
   else
     s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
+  p.fabric_model = fabric_is_membrane(s) ? FabricModel::Membrane : FabricModel::Solid;
   return p;
 }
 
@@ -123,7 +159,66 @@ void rdp(const std::vector<double>& t, const std::vector<double>& p, std::size_t
 
 }  // namespace
 
+namespace {
+
+const std::set<std::string> kEffects = {"mullins", "fatigue", "viscoelastic"};
+
+// Inelastic effects of a material table: [materials.NAME.mullins], .fatigue, .viscoelastic, each
+// with `enabled` and its constants. Applied in the canonical order viscoelastic(fatigue(mullins)).
+EffectParams effect_params(const Scene& s, const std::string& T) {
+  EffectParams e;
+  auto on = [&](const std::string& k) { return s.has(T + "." + k) && s.boolean(T + "." + k + ".enabled"); };
+  if (on("mullins")) {
+    const std::string K = T + ".mullins";
+    require_keys(s, K, {"enabled", "r", "m_MPa", "beta"}, "mullins");
+    e.mullins = MullinsParams{s.number(K + ".r"), s.number(K + ".m_MPa") * kMPa, s.number(K + ".beta")};
+  }
+  if (on("fatigue")) {
+    const std::string K = T + ".fatigue";
+    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "d_fail"}, "fatigue");
+    FatigueParams f;
+    const std::string driver = s.string(K + ".driver");
+    if (driver == "energy")
+      f.driver = FatigueDriver::energy;
+    else if (driver == "max_principal_stretch")
+      f.driver = FatigueDriver::max_principal_stretch;
+    else
+      s.fail(K + ".driver", "must be \"energy\" or \"max_principal_stretch\"");
+    f.W_th_Pa = s.number(K + ".W_th_MPa") * kMPa;
+    f.lambda_th = s.number(K + ".lambda_th");
+    f.tau_s = s.number(K + ".tau_s");
+    f.q = s.number(K + ".q");
+    f.d_fail = s.number(K + ".d_fail");
+    e.fatigue = f;
+  }
+  if (on("viscoelastic")) {
+    const std::string K = T + ".viscoelastic";
+    require_keys(s, K, {"enabled", "gamma", "tau_s"}, "viscoelastic");
+    e.viscoelastic = ViscoParams{s.numbers(K + ".gamma"), s.numbers(K + ".tau_s")};
+  }
+  return e;
+}
+
+}  // namespace
+
+namespace {
+MaterialPtr make_base_material(const Scene& s, const std::string& name);
+}
+
 MaterialPtr make_material(const Scene& s, const std::string& name) {
+  const std::string T = "materials." + name;
+  MaterialPtr base = make_base_material(s, name);
+  const EffectParams e = effect_params(s, T);
+  if (!e.mullins && !e.fatigue && !e.viscoelastic) return base;
+  try {
+    return decorate(base, e);
+  } catch (const InputError& err) {
+    s.fail(T, err.what());
+  }
+}
+
+namespace {
+MaterialPtr make_base_material(const Scene& s, const std::string& name) {
   const std::string T = "materials." + name;
   if (!s.has(T)) s.fail(T, "no such material; define a [" + T + "] table");
   const std::string model = s.string(T + ".model");
@@ -139,25 +234,25 @@ MaterialPtr make_material(const Scene& s, const std::string& name) {
     }
     const double Kr = s.number(T + ".K_over_mu");
     if (model == "yeoh") {
-      require_keys(s, T, {"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3"}, "model yeoh");
+      require_keys(s, T, {"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model yeoh");
       const double C10 = s.number(T + ".C10_MPa") * kMPa;
       const double C20 = s.has(T + ".C20_MPa") ? s.number(T + ".C20_MPa") * kMPa : 0.0;
       const double C30 = s.has(T + ".C30_MPa") ? s.number(T + ".C30_MPa") * kMPa : 0.0;
       return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(C10, C20, C30, bulk_from_ratio(2 * C10, Kr)));
     }
     if (model == "neo_hookean") {
-      require_keys(s, T, {"model", "C10_MPa", "K_over_mu", "density_kg_m3"}, "model neo_hookean");
+      require_keys(s, T, {"model", "C10_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model neo_hookean");
       const double C10 = s.number(T + ".C10_MPa") * kMPa;
       return std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(C10, bulk_from_ratio(2 * C10, Kr)));
     }
     if (model == "mooney_rivlin") {
-      require_keys(s, T, {"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3"}, "model mooney_rivlin");
+      require_keys(s, T, {"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model mooney_rivlin");
       const double C10 = s.number(T + ".C10_MPa") * kMPa, C01 = s.number(T + ".C01_MPa") * kMPa;
       return std::make_shared<InvariantMaterial<MooneyRivlin>>(
           MooneyRivlin(C10, C01, bulk_from_ratio(2 * (C10 + C01), Kr)));
     }
     if (model == "ogden") {
-      require_keys(s, T, {"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3"}, "model ogden");
+      require_keys(s, T, {"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model ogden");
       std::vector<double> mu = s.numbers(T + ".mu_MPa");
       const std::vector<double> alpha = s.numbers(T + ".alpha");
       double mu0 = 0.0;
@@ -173,6 +268,8 @@ MaterialPtr make_material(const Scene& s, const std::string& name) {
   s.fail(T + ".model", "unknown material model \"" + model +
                            "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
 }
+
+}  // namespace
 
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   const std::string source = s.string("mesh.source");
@@ -216,6 +313,10 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   }
   Mesh& mesh = model.mesh;
   mesh.ensure_ids();
+  const bool membrane_fabric = fabric_is_membrane(s);
+  if (membrane_fabric && source != "pneunet")
+    s.fail("mesh.fabric_model", "\"membrane\" needs mesh.source = \"pneunet\" (the built-in mesher places the "
+                                "membrane on the fabric mid-plane); use \"solid\" for a deck");
 
   // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
   for (const std::string& elset : s.table_keys("mesh.regions")) {
@@ -238,12 +339,13 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
       for (const auto& [k, v] : mesh.element_sets) avail += (avail.empty() ? "" : ", ") + k;
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
     }
+    if (membrane_fabric && els->empty()) continue;  // FABRIC is empty: the fabric is the membrane
     model.parts.push_back(Part{elset, make_material(s, mat), s.number("materials." + mat + ".density_kg_m3")});
     for (int e : *els) {
       if (model.element_part[e] >= 0)
         s.fail(key + ".elset", "element " + std::to_string(mesh.element_ids[e]) + " is in two parts ('" +
                                    model.parts[model.element_part[e]].name + "' and '" + elset + "')");
-      model.element_part[e] = i;
+      model.element_part[e] = static_cast<int>(model.parts.size()) - 1;
     }
   }
   for (int e = 0; e < mesh.num_elements(); ++e)
@@ -298,6 +400,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
     s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
+  if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
   out->stats = compute_stats(mesh);
 
@@ -340,6 +443,10 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
   sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
+  sv.quasi_static.time_tol = positive(s, "solver.time_tol");
+  sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
+  sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
+  if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
   sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
   if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
   sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");

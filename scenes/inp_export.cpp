@@ -68,6 +68,8 @@ void write_material(std::ostringstream& os, const Scene& s, const std::string& n
 std::string calculix_deck(const Scene& s, const BuiltModel& bm) {
   const Model& m = bm.model;
   const Mesh& mesh = m.mesh;
+  if (!m.membranes.empty())
+    s.fail("mesh.fabric_model", "the CalculiX export does not write membranes yet; export with mesh.fabric_model = \"solid\"");
   std::ostringstream os;
   os << "*HEADING\npneufem export: units mm, N, MPa, tonne. Step time == cavity pressure in kPa.\n";
   write_inp_mesh(os, mesh, 1e-3);

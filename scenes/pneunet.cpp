@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
@@ -22,7 +23,8 @@
 //    voxel belongs to a box when its centre lies strictly inside the box.
 // 2. Grid: a rectilinear grid whose lines include every feature plane (box faces and the fabric
 //    faces); each interval between feature planes gets ceil(len / h) equal cells (the fabric
-//    gets fabric_layers). Inside one cell the solid indicator is therefore constant.
+//    gets fabric_layers; a membrane fabric adds its mid-plane, see FabricModel). Inside one cell
+//    the solid indicator is therefore constant.
 // 3. Each cell is classified by the voxel nearest to its centre. The voxel size v is the
 //    smallest distance from any cell centre to a box face, so that voxel's centre (within v/2
 //    of the cell centre per axis) lies on the same side of every box face as the cell centre:
@@ -77,6 +79,9 @@ struct Plan {
 /// Chamber i spans y in [chamber_y0(i), chamber_y0(i) + chamber_length].
 double chamber_y0(const PneuNetParams& p, int i) { return p.end_cap + i * (p.chamber_length + p.interior_wall); }
 
+/// z of the fabric mid-plane, where FabricModel::Membrane puts the membrane.
+double fabric_mid_plane(const PneuNetParams& p) { return p.fabric_z0 + 0.5 * p.fabric_thickness; }
+
 std::array<AxisPlanes, 3> feature_planes(const PneuNetParams& p) {
   std::array<AxisPlanes, 3> ax;
   auto add = [](AxisPlanes& a, double v, bool solid) {
@@ -104,15 +109,20 @@ std::array<AxisPlanes, 3> feature_planes(const PneuNetParams& p) {
   add(ax[1], p.length(), true);
   // z: the fabric faces bound a region, not the solid.
   const double hb = p.base_thickness;
+  const bool membrane = p.fabric_model == FabricModel::Membrane;
   add(ax[2], 0.0, true);
   add(ax[2], p.fabric_z0, false);
+  if (membrane) add(ax[2], fabric_mid_plane(p), false);
   add(ax[2], p.fabric_z0 + p.fabric_thickness, false);
   add(ax[2], hb, true);
   add(ax[2], hb + p.channel_height, true);
   add(ax[2], hb + p.body_height - p.roof, true);
   add(ax[2], hb + p.body_height, true);
   for (auto& a : ax) a.fixed_cells.assign(a.at.size() - 1, 0);
-  ax[2].fixed_cells[1] = p.fabric_layers;
+  if (membrane)
+    ax[2].fixed_cells[1] = ax[2].fixed_cells[2] = (p.fabric_layers + 1) / 2;
+  else
+    ax[2].fixed_cells[1] = p.fabric_layers;
   // y intervals 2, 4, ..., 2(N-1) are the interior walls (0 is the end cap, odd ones chambers).
   if (p.wall_layers > 0)
     for (int i = 0; i + 1 < p.chambers; ++i) ax[1].fixed_cells[2 + 2 * i] = p.wall_layers;
@@ -407,8 +417,9 @@ Mesh build_pneunet(const PneuNetParams& p) {
   const double hb = p.base_thickness, L = p.length(), z_roof = hb + p.body_height - p.roof;
   const double x_side = 0.5 * p.width - p.side_wall, z_fab0 = p.fabric_z0, z_fab1 = p.fabric_z0 + p.fabric_thickness;
   // Cell centres are at least half a cell from every feature plane: strict comparisons are safe.
+  const bool solid_fabric = p.fabric_model == FabricModel::Solid;
   auto region_of = [&](double x, double y, double z) {
-    if (z > z_fab0 && z < z_fab1) return r_fabric;
+    if (solid_fabric && z > z_fab0 && z < z_fab1) return r_fabric;
     if (z < hb) return r_base;
     if (y < p.end_cap || y > L - p.end_cap) return r_cap;
     if (z > z_roof) return r_roof;
@@ -424,7 +435,13 @@ Mesh build_pneunet(const PneuNetParams& p) {
       for (int i = 0; i <= nx; ++i) m.X[node(i, j, k)] = Eigen::Vector3d(gx[i], gy[j], gz[k]);
 
   const auto& splits = cell_splits();
-  std::vector<FaceRef> cavity;
+  std::vector<FaceRef> cavity, membrane;
+  // Membrane fabric: the top faces (hex face z+ = 5) of the cells just below the mid-plane grid
+  // line, so each face on the plane is taken once. -1 = solid fabric.
+  const int k_membrane =
+      solid_fabric ? -1
+                   : static_cast<int>(std::find(gz.begin(), gz.end(), fabric_mid_plane(p)) - gz.begin()) - 1;
+  assert(solid_fabric || (k_membrane >= 0 && k_membrane < nz));  // the mid-plane is a grid line
   // Hex face 2*axis+side -> neighbour offset.
   static constexpr int kStep[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
   for (int j = 0; j < ny; ++j)
@@ -440,6 +457,7 @@ Mesh build_pneunet(const PneuNetParams& p) {
           for (int f = 0; f < 4; ++f) {
             const int d = s.face_dir[t][f];
             if (d < 0) continue;
+            if (k == k_membrane && d == 5) membrane.push_back({e, f});
             const int ii = i + kStep[d][0], jj = j + kStep[d][1], kk = k + kStep[d][2];
             // Every void cell of the grid is cavity: the grid spans the actuator's bounding box
             // (or its x >= 0 half), and the cavity is enclosed by end caps, side walls, roof and base.
@@ -449,8 +467,10 @@ Mesh build_pneunet(const PneuNetParams& p) {
         }
       }
   m.surfaces["CAVITY"] = std::move(cavity);
+  if (!solid_fabric) m.surfaces["FABRIC_MEMBRANE"] = std::move(membrane);
 
-  // Element sets and node sets (grid indices, exact).
+  // Element sets and node sets (grid indices, exact). FABRIC exists (empty for a membrane fabric).
+  m.element_sets["FABRIC"];
   for (int e = 0; e < m.num_elements(); ++e) m.element_sets[m.region[e] == r_fabric ? "FABRIC" : "SILICONE"].push_back(e);
   auto& fixed = m.node_sets["FIXED"];
   auto& tip = m.node_sets["TIP"];

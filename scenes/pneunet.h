@@ -7,11 +7,21 @@
 //
 // Frame (as the CalculiX reference, ../shared/reference/calculix): x = width (centred on 0),
 // y = length (0 at the fixed inlet end), z = up (0 at the bottom of the base). SI units (m).
+#include <cstdint>
 #include <string>
 
 #include "engine/mesh.h"
 
 namespace pneufem {
+
+/// How the fabric strain-limiting layer is represented.
+///  Solid:    its cells are elements of region "fabric" (element set FABRIC), a layer with the
+///            bending stiffness of a 0.4 mm plate.
+///  Membrane: its cells are base silicone (element set SILICONE), a grid plane is added at the
+///            layer's mid-plane, and the element faces on that plane form the surface
+///            FABRIC_MEMBRANE, each once, for a membrane (engine/membrane.h): no bending stiffness.
+///            Each half of the layer gets ceil(fabric_layers / 2) cells; FABRIC is present but empty.
+enum class FabricModel : std::uint8_t { Solid, Membrane };
 
 struct PneuNetParams {
   // Geometry (m). Defaults: the default actuator of the engine issue (= CalculiX reference).
@@ -32,6 +42,7 @@ struct PneuNetParams {
   double h = 2e-3;                 ///< target element size in plane (x, y) (m)
   double h_z = 0.0;                ///< target element size along z (m); 0 = same as h
   int fabric_layers = 1;           ///< elements through the fabric thickness
+  FabricModel fabric_model = FabricModel::Solid;  ///< scene key mesh.fabric_model
   int wall_layers = 0;             ///< cells through each interior wall (y); 0 = from h
   bool half = true;                ///< model x >= 0 only, symmetry plane x = 0
   ElementType element = ElementType::Tet10;
@@ -43,7 +54,8 @@ struct PneuNetParams {
 
 /// Builds the mesh. Node sets: "FIXED" (face y = 0), "TIP" (face y = L), "SYMMETRY" (x = 0,
 /// half model only). Element sets: "SILICONE", "FABRIC". Surface "CAVITY": every face bounding
-/// the chambers and the channel (including the cavity floor on the base). Region tags:
+/// the chambers and the channel (including the cavity floor on the base); with
+/// FabricModel::Membrane also "FABRIC_MEMBRANE" (faces on the fabric mid-plane). Region tags:
 /// interior_wall, roof, side_wall, end_cap, base, fabric (mesh.h).
 Mesh build_pneunet(const PneuNetParams& p);
 
