@@ -68,11 +68,15 @@ std::string mesh_stats_json(const MeshStats& s) {
   return o.str(2);
 }
 
-std::string angles_csv(const std::vector<StateRecord>& recs) {
+/// angles.csv text; `exact` writes round-trip precision (for files read back on --resume).
+std::string angles_csv(const std::vector<StateRecord>& recs, bool exact = false) {
   std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
   char line[160];
   for (const StateRecord& r : recs) {
-    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    if (exact)
+      std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    else
+      std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     s += line;
   }
   return s;
@@ -247,7 +251,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       sets.push_back("load.trials=1");
       if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
       ideal = records_of(scene.with(sets));
-      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal));
+      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal, true));
     }
   }
 

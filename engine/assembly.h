@@ -38,14 +38,15 @@ class Assembler {
   }
   std::vector<double> initial_state() const;
 
-  /// Lumped nodal mass (kg), one value per node.
+  /// Lumped nodal mass (kg), one value per node (solid elements and membranes).
   const Eigen::VectorXd& lumped_mass() const { return mass_; }
 
   /// Evaluates the internal force vector f_int(u) (N), the tangent dF/du (N/m, pattern of
   /// tangent_pattern(); fixed dofs are NOT applied) and the stored energy (J) for the requested
   /// outputs (nullptr = skip). Material history: reads `state_old`, writes the trial state into
   /// `state_new` (may be empty when state_size() == 0). Throws PhysicsError naming the first
-  /// element (lowest index) with det F <= 0 or a non-finite stress.
+  /// element (lowest index) with det F <= 0 or a non-finite stress, or a collapsed membrane
+  /// triangle. Includes the model's membranes (engine/membrane.h).
   void internal(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
                 std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
 
@@ -53,7 +54,7 @@ class Assembler {
   /// model's pressure faces to f_ext, and, when K is given, subtracts the (symmetrised) load
   /// stiffness d f_ext / du from K.
   void add_pressure(const Eigen::VectorXd& u, double p_Pa, Eigen::VectorXd& f_ext, SparseMatrix* K) const;
-  /// Adds the consistent gravity load int rho N_a g dV.
+  /// Adds the consistent gravity load int rho N_a g dV (and rho t int N_a g dA of the membranes).
   void add_gravity(Eigen::VectorXd& f_ext) const;
   /// Volume enclosed by the pressure faces in the deformed configuration (m^3); exact for a
   /// closed cavity (or one closed by symmetry planes through the origin).

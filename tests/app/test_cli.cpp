@@ -92,6 +92,28 @@ TEST(Cli, HelpListsTheSubcommands) {
   EXPECT_NE(rs.out.find("--threads"), std::string::npos);
 }
 
+TEST(Cli, KilledRunResumesToTheUninterruptedResult) {
+  // Two trials with creep and fatigue (history-dependent, adaptive time steps). The interrupted
+  // run dies abruptly after its 6th checkpoint (as if killed: no clean-up, exit 137); resuming
+  // must give byte-identical angles and metrics.
+  const std::string fx = kTiny + " --set load.trials=2 --set materials.silicone.viscoelastic.enabled=true"
+                         " --set materials.silicone.fatigue.enabled=true --set materials.silicone.fatigue.W_th_MPa=0.001"
+                         " --set materials.silicone.fatigue.tau_s=200.0 --set output.vtu=\\\"steps\\\"";
+  const fs::path full = fresh_dir("full"), cut = fresh_dir("cut");
+  const Result a = run("simulate --out " + full.string() + " " + fx);
+  ASSERT_EQ(a.code, 0) << a.out;
+  const Result b = run("simulate --out " + cut.string() + " " + fx + " --checkpoint-every 0 --abort-after-checkpoints 6");
+  ASSERT_EQ(b.code, 137) << b.out;
+  ASSERT_TRUE(fs::exists(cut / "checkpoint.bin"));
+  EXPECT_FALSE(fs::exists(cut / "summary.json"));  // the killed run never finished
+  const Result c = run("simulate --resume " + cut.string());
+  ASSERT_EQ(c.code, 0) << c.out;
+  EXPECT_EQ(slurp(cut / "angles.csv"), slurp(full / "angles.csv"));
+  EXPECT_EQ(slurp(cut / "metrics.json"), slurp(full / "metrics.json"));
+  EXPECT_EQ(slurp(cut / "results.pvd"), slurp(full / "results.pvd"));
+  EXPECT_NE(slurp(full / "metrics.json").find("\"trial\": 2"), std::string::npos);
+}
+
 TEST(Cli, MeshExportsARunnableCalculixDeck) {
   const fs::path f = fs::temp_directory_path() / "pneufem_cli_mesh.inp";
   const Result r = run("mesh --out " + f.string() + " " + kTiny);

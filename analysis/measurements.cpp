@@ -1,0 +1,314 @@
+#include "analysis/measurements.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <climits>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <system_error>
+
+#include "analysis/csv_scan.h"
+#include "materials/errors.h"
+
+namespace pneufem {
+
+namespace {
+
+constexpr std::array<const char*, 4> kColumns = {"trial", "time_s", "pressure_kPa", "angle_deg"};
+enum Col { kTrial = 0, kTime = 1, kPressure = 2, kAngle = 3 };
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// A hint for a missing required column: a header cell that shares its stem ("pressure" for
+/// pressure_kPa) was probably meant, with another unit or none.
+std::string missing_column_hint(const std::string& required, const std::vector<std::string>& names) {
+  const std::string stem = lower(required.substr(0, required.find('_')));
+  for (const std::string& n : names)
+    if (n.rfind(stem, 0) == 0)
+      return "the header has '" + n + "': rename it to " + required +
+             " (the unit is part of the name; convert the values if they are in another unit)";
+  return "add the column; the header must name trial,time_s,pressure_kPa,angle_deg (any order, "
+         "other columns are ignored, cells of pressure_kPa or angle_deg may be empty)";
+}
+
+/// Per-stream bookkeeping while reading: order checks and repeated time stamps.
+struct StreamState {
+  int last_line = 0;
+  int repeats = 0;
+  int first_repeat_line = 0;
+};
+
+struct TrialState {
+  TrialRecording rec;
+  StreamState pressure, angle;
+};
+
+class CanonicalReader {
+ public:
+  CanonicalReader(std::string_view text, const std::string& source) : text_(text), source_(source) {}
+
+  Recording read() {
+    csv::LineCursor lines(text_);
+    csv::Line line;
+    if (!lines.next(line) || csv::trim(line.text).empty()) {
+      csv::Line rest;
+      bool only_blank = true;
+      while (only_blank && lines.next(rest)) only_blank = csv::trim(rest.text).empty();
+      if (only_blank)
+        csv::fail(source_, 1, 1, "the file is empty",
+                  "give a header line trial,time_s,pressure_kPa,angle_deg followed by one row per sample");
+      csv::fail(source_, 1, 1, "the first line is blank",
+                "put the header trial,time_s,pressure_kPa,angle_deg on line 1");
+    }
+    read_header(line);
+
+    int skipped_rows = 0, first_skipped = 0, rows = 0;
+    while (lines.next(line)) {
+      if (csv::trim(line.text).empty()) continue;
+      ++rows;
+      if (!read_row(line) && skipped_rows++ == 0) first_skipped = line.number;
+    }
+    if (rows == 0)
+      csv::fail(source_, line.number + 1, 1, "no data rows after the header",
+                "add one row per sample: trial,time_s,pressure_kPa,angle_deg");
+
+    Recording rec;
+    rec.source = source_;
+    if (skipped_rows > 0)
+      rec.warnings.push_back(source_ + ": " + std::to_string(skipped_rows) +
+                             " row(s) with neither pressure_kPa nor angle_deg were skipped (first at line " +
+                             std::to_string(first_skipped) + ")");
+    for (auto& [number, index] : trial_index_) {
+      TrialState& st = trials_[index];
+      note_repeats(rec, st.rec.trial, "pressure", st.pressure);
+      note_repeats(rec, st.rec.trial, "angle", st.angle);
+      if (st.rec.pressure_kPa.t_s.empty())
+        rec.warnings.push_back(source_ + ": trial " + std::to_string(number) + " has no pressure_kPa samples");
+      if (st.rec.angle_deg.t_s.empty())
+        rec.warnings.push_back(source_ + ": trial " + std::to_string(number) + " has no angle_deg samples");
+      rec.trials.push_back(std::move(st.rec));
+    }
+    return rec;
+  }
+
+ private:
+  void read_header(const csv::Line& line) {
+    csv::split(line.text, fields_);
+    std::vector<std::string> names;
+    for (std::string_view f : fields_) names.push_back(csv::header_name(f));
+    header_names_.clear();
+    for (std::string_view f : fields_) header_names_.emplace_back(csv::trim(f));
+    column_.fill(-1);
+    for (std::size_t i = 0; i < names.size(); ++i)
+      for (std::size_t c = 0; c < kColumns.size(); ++c) {
+        if (names[i] != lower(kColumns[c])) continue;
+        if (column_[c] >= 0)
+          csv::fail(source_, line.number, static_cast<int>(i) + 1,
+                    "column '" + std::string(kColumns[c]) + "' appears twice (also field " +
+                        std::to_string(column_[c] + 1) + ")",
+                    "keep one of them, or rename the other");
+        column_[c] = static_cast<int>(i);
+      }
+    for (std::size_t c = 0; c < kColumns.size(); ++c) {
+      if (column_[c] >= 0) continue;
+      if (names.size() == 1 && line.text.find(';') != std::string_view::npos)
+        csv::fail(source_, line.number, 1, "the header has no commas but has ';'",
+                  "save the file with ',' as the field separator and '.' as the decimal point");
+      std::string have;
+      for (const std::string& n : header_names_) have += (have.empty() ? "" : ",") + n;
+      csv::fail(source_, line.number, 1,
+                "missing column '" + std::string(kColumns[c]) + "' (the header is '" + have + "')",
+                missing_column_hint(kColumns[c], names));
+    }
+    width_ = fields_.size();
+  }
+
+  /// The header's spelling of a column, for messages.
+  std::string column_name(std::size_t field) const {
+    return field < header_names_.size() && !header_names_[field].empty() ? header_names_[field]
+                                                                         : "field " + std::to_string(field + 1);
+  }
+
+  [[noreturn]] void fail_field(const csv::Line& line, std::size_t field, const std::string& what,
+                               const std::string& todo) const {
+    csv::fail(source_, line.number, static_cast<int>(field) + 1, column_name(field) + " " + what, todo);
+  }
+
+  /// Number in a required or optional column; returns false for an empty optional cell.
+  bool number(const csv::Line& line, int col, bool required, double& v) const {
+    const std::size_t f = static_cast<std::size_t>(column_[col]);
+    switch (csv::parse_double(fields_[f], v)) {
+      case csv::Number::ok: return true;
+      case csv::Number::empty:
+        if (!required) return false;
+        fail_field(line, f, "is empty", "every row needs its " + std::string(kColumns[col]));
+      case csv::Number::not_finite:
+        fail_field(line, f, "= " + csv::quoted(fields_[f]) + " is not a finite number",
+                   "write a measured value, or leave the cell empty when this row has no sample of that stream");
+      case csv::Number::not_a_number: break;
+    }
+    fail_field(line, f, "= " + csv::quoted(fields_[f]) + " is not a number",
+               "write a plain decimal number with '.' as the decimal point, e.g. 12.5 or 1.25e-3");
+  }
+
+  /// Returns false when the row carries neither pressure nor angle.
+  bool read_row(const csv::Line& line) {
+    csv::split(line.text, fields_);
+    if (fields_.size() < width_)
+      fail_field(line, fields_.size(),
+                 "is missing: the row has " + std::to_string(fields_.size()) + " fields, the header " +
+                     std::to_string(width_),
+                 "give every row as many comma-separated fields as the header (leave cells empty, not out)");
+    if (fields_.size() > width_)
+      csv::fail(source_, line.number, static_cast<int>(width_) + 1,
+                "the row has " + std::to_string(fields_.size()) + " fields, the header only " +
+                    std::to_string(width_),
+                "remove the extra fields or name them in the header (unnamed extra columns are not ignored)");
+
+    const std::size_t ft = static_cast<std::size_t>(column_[kTrial]);
+    long trial = 0;
+    switch (csv::parse_int(fields_[ft], trial)) {
+      case csv::Number::ok: break;
+      case csv::Number::empty: fail_field(line, ft, "is empty", "every row needs its trial number");
+      default:
+        fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is not an integer", "number the trials 1, 2, 3, ...");
+    }
+    if (trial < INT_MIN || trial > INT_MAX)
+      fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is out of range", "number the trials 1, 2, 3, ...");
+
+    double t = 0.0, p = 0.0, a = 0.0;
+    number(line, kTime, true, t);
+    const bool has_p = number(line, kPressure, false, p);
+    const bool has_a = number(line, kAngle, false, a);
+    if (!has_p && !has_a) return false;
+
+    TrialState& st = trial_state(static_cast<int>(trial));
+    if (has_p) append(line, st.rec.trial, "pressure", st.rec.pressure_kPa, st.pressure, t, p);
+    if (has_a) append(line, st.rec.trial, "angle", st.rec.angle_deg, st.angle, t, a);
+    return true;
+  }
+
+  TrialState& trial_state(int trial) {
+    if (last_trial_index_ >= 0 && trials_[static_cast<std::size_t>(last_trial_index_)].rec.trial == trial)
+      return trials_[static_cast<std::size_t>(last_trial_index_)];
+    auto [it, inserted] = trial_index_.try_emplace(trial, trials_.size());
+    if (inserted) {
+      trials_.emplace_back();
+      trials_.back().rec.trial = trial;
+    }
+    last_trial_index_ = static_cast<int>(it->second);
+    return trials_[it->second];
+  }
+
+  void append(const csv::Line& line, int trial, const char* stream, Series& s, StreamState& st, double t, double v) {
+    if (!s.t_s.empty() && t <= s.t_s.back()) {
+      if (t == s.t_s.back()) {
+        s.value.back() = v;  // a repeated time stamp: the last sample wins (documented, warned)
+        if (st.repeats++ == 0) st.first_repeat_line = line.number;
+        st.last_line = line.number;
+        return;
+      }
+      fail_field(line, static_cast<std::size_t>(column_[kTime]),
+                 "= " + csv::quoted(csv::trim(fields_[static_cast<std::size_t>(column_[kTime])])) +
+                     " goes back in time: the previous " + stream + " sample of trial " + std::to_string(trial) +
+                     " is at time_s = " + csv::number_text(s.t_s.back()) + " (line " + std::to_string(st.last_line) +
+                     ")",
+                 "sort each trial's rows by time; if a new trial starts here (time restarting), give it its own "
+                 "trial number");
+    }
+    s.t_s.push_back(t);
+    s.value.push_back(v);
+    st.last_line = line.number;
+  }
+
+  void note_repeats(Recording& rec, int trial, const char* stream, const StreamState& st) const {
+    if (st.repeats == 0) return;
+    rec.warnings.push_back(source_ + ": trial " + std::to_string(trial) + ": " + std::to_string(st.repeats) +
+                           " repeated " + stream + " time stamp(s) (first at line " +
+                           std::to_string(st.first_repeat_line) + "); kept the last sample of each");
+  }
+
+  std::string_view text_;
+  const std::string& source_;
+  std::vector<std::string_view> fields_;
+  std::vector<std::string> header_names_;
+  std::array<int, 4> column_{};
+  std::size_t width_ = 0;
+  std::vector<TrialState> trials_;
+  std::map<int, std::size_t> trial_index_;  // ordered: the output is sorted by trial number
+  int last_trial_index_ = -1;
+};
+
+}  // namespace
+
+Recording parse_measurements_csv(std::string_view text, const std::string& source) {
+  return CanonicalReader(text, source).read();
+}
+
+Recording read_measurements_csv(const std::string& path) {
+  const std::string text = csv::read_file(path);
+  return parse_measurements_csv(text, path);
+}
+
+std::string format_measurements_csv(const Recording& rec) {
+  std::vector<const TrialRecording*> order;
+  std::size_t rows = 0;
+  for (const TrialRecording& tr : rec.trials) {
+    order.push_back(&tr);
+    rows += tr.pressure_kPa.t_s.size() + tr.angle_deg.t_s.size();
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const TrialRecording* a, const TrialRecording* b) { return a->trial < b->trial; });
+
+  std::string out = "trial,time_s,pressure_kPa,angle_deg\n";
+  out.reserve(out.size() + rows * 40);
+  for (const TrialRecording* tr : order) {
+    const std::string trial = std::to_string(tr->trial) + ",";
+    const Series& p = tr->pressure_kPa;
+    const Series& a = tr->angle_deg;
+    std::size_t i = 0, j = 0;
+    while (i < p.t_s.size() || j < a.t_s.size()) {
+      const bool take_p = i < p.t_s.size() && (j >= a.t_s.size() || p.t_s[i] <= a.t_s[j]);
+      const bool take_a = j < a.t_s.size() && (i >= p.t_s.size() || a.t_s[j] <= p.t_s[i]);
+      out += trial;
+      out += csv::number_text(take_p ? p.t_s[i] : a.t_s[j]);
+      out += ',';
+      if (take_p) out += csv::number_text(p.value[i++]);
+      out += ',';
+      if (take_a) out += csv::number_text(a.value[j++]);
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+void write_measurements_csv(const std::string& path, const Recording& rec) {
+  namespace fs = std::filesystem;
+  const std::string text = format_measurements_csv(rec);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error("cannot write '" + tmp + "': check that the directory exists and is writable");
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw std::runtime_error("failed writing '" + path + "' (disk full?)");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot move '" + tmp + "' to '" + path + "': " + ec.message());
+  }
+}
+
+}  // namespace pneufem

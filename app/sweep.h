@@ -1,0 +1,89 @@
+#pragma once
+// Parameter sweeps (`pneufem sweep`): run one scene at many values of any numeric scene keys
+// (damage constants first of all) and tabulate the paper's metrics per point.
+//
+//   points     the cartesian product of each --param's N values (linear or log spacing), or
+//              --lhs N Latin-hypercube samples over the ranges (log ranges sampled in log space)
+//   workers    shared nothing: each point is a separate `pneufem simulate` process (fork/exec of
+//              the pneufem binary) writing DIR/points/NNNN/; J processes at a time with T threads
+//              each. A point's result does not depend on J or T.
+//   resume     a point is skipped when its directory holds summary.json with "status": "ok" and a
+//              scene.toml equal to the point's resolved scene (same scene file, --set and
+//              parameter values); anything else (failed, interrupted, changed) is run again from a
+//              clean directory. Re-running the same command after a kill continues the sweep.
+//   outputs    DIR/sweep.csv (one row per point, rewritten atomically after every point),
+//              DIR/sweep_<key>.svg (final-trial NRMSE against each parameter), DIR/sweep.json.
+// A failed point is recorded with its error and does not stop the sweep.
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace pneufem {
+
+/// One --param KEY=LO:HI[:N][:log|lin].
+struct ParamSpec {
+  std::string text;  ///< as given, for messages
+  std::string key;   ///< dotted scene key, e.g. materials.silicone.fatigue.tau_s
+  double lo = 0.0, hi = 0.0;
+  int n = 0;             ///< grid values (0 = not given, allowed with --lhs only)
+  bool log = false;      ///< log spacing / log-uniform sampling (needs lo > 0)
+  bool integer = false;  ///< the scene key is an integer: values are rounded
+};
+
+/// Parses a --param spec; throws InputError quoting the spec and the expected form.
+ParamSpec parse_param_spec(const std::string& text);
+
+/// The values of one grid axis: n values from lo to hi inclusive, evenly spaced (in log10 when
+/// log); n = 1 gives lo. Integer keys are rounded and repeated values dropped.
+std::vector<double> grid_values(const ParamSpec& p);
+/// Cartesian product of the grid axes, one row per point, the last parameter varying fastest.
+std::vector<std::vector<double>> grid_points(const std::vector<ParamSpec>& params);
+/// n Latin-hypercube samples: each parameter's range split into n equal strata (in log space for
+/// log ranges), each stratum sampled exactly once at a uniformly random position, strata paired
+/// by independent random permutations (McKay, Beckman & Conover 1979). Deterministic for a seed
+/// on every platform (mt19937_64's output is fixed by the C++ standard; the conversions are ours).
+std::vector<std::vector<double>> lhs_points(const std::vector<ParamSpec>& params, int n, std::uint64_t seed);
+
+/// A value as scene (TOML) text: integers as integers, floats in the shortest form that reads back
+/// to the same double, always with a '.' or an exponent (100.0, 316.22776601683796, 1e-05).
+std::string format_value(double v, bool integer);
+
+struct SweepOptions {
+  std::string scene_path;           ///< "" = the built-in default scene
+  std::vector<std::string> params;  ///< --param specs
+  std::vector<std::string> sets;    ///< --set key=value, applied before the parameters
+  int lhs = 0;                      ///< > 0: that many Latin-hypercube samples instead of the grid
+  std::uint64_t seed = 1;           ///< LHS seed
+  std::string out_dir;
+  int jobs = 0;             ///< worker processes (0 = number of cores)
+  int threads_per_job = 1;  ///< --threads of each worker
+  std::string exe;          ///< the pneufem binary the workers run
+  bool dry_run = false;     ///< print the points, run nothing, write nothing
+  std::string command_line;
+  std::FILE* log = stdout;  ///< one line per point; nullptr = quiet
+};
+
+struct SweepPoint {
+  int index = 0;                    ///< 1-based, = the NNNN of points/NNNN
+  std::vector<double> values;       ///< one per parameter
+  std::vector<std::string> texts;   ///< the values as given to the scene
+  std::string status = "pending";   ///< "ok", "failed" or "pending"
+  bool skipped = false;             ///< done by an earlier invocation
+  double wall_s = 0.0;
+  std::vector<double> nrmse;        ///< per trial, from metrics.json (empty without metrics)
+  double final_angle_deg = 0.0;     ///< NaN when no angle was reported
+  std::string error;
+};
+
+struct SweepResult {
+  std::vector<SweepPoint> points;
+  int ok = 0, failed = 0, skipped = 0;
+  double wall_s = 0.0;
+};
+
+/// Runs (or, with dry_run, plans) the sweep. Bad options throw InputError naming the option
+/// (--param, --lhs, --jobs, ...); failed points are recorded, not thrown.
+SweepResult run_sweep(const SweepOptions& options);
+
+}  // namespace pneufem

@@ -1,0 +1,197 @@
+// Canonical measurement CSV (analysis/measurements.h): a hand-made file with every tolerated
+// quirk, a bit-exact round trip of the paper's ten-trial recording, a 10^6-row read (rate
+// printed, not asserted), and one case per class of malformed input asserting file:line:column.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "analysis/measurements.h"
+#include "materials/errors.h"
+#include "tests/analysis/synthetic.h"
+
+namespace pneufem {
+namespace {
+
+using testing::StaircaseSpec;
+
+bool contains(const std::vector<std::string>& v, const std::string& needle) {
+  for (const std::string& s : v)
+    if (s.find(needle) != std::string::npos) return true;
+  return false;
+}
+
+TEST(MeasurementsCsv, ReadsTheSmallDataFileWithItsQuirks) {
+  const std::string path = std::string(PNEUFEM_TEST_DATA_DIR) + "/measurements/canonical_small.csv";
+  const Recording rec = read_measurements_csv(path);
+  EXPECT_EQ(rec.source, path);
+  ASSERT_EQ(rec.trials.size(), 2u);
+  const TrialRecording& t1 = rec.trials[0];
+  const TrialRecording& t2 = rec.trials[1];
+  EXPECT_EQ(t1.trial, 1);  // sorted by trial number although trial 2 comes first in the file
+  EXPECT_EQ(t2.trial, 2);
+  EXPECT_EQ(t1.pressure_kPa.t_s, (std::vector<double>{0.0, 0.0025, 0.005, 0.0375}));
+  EXPECT_EQ(t1.pressure_kPa.value, (std::vector<double>{0.02, 0.01, 0.025, 0.15}));  // repeated stamp: last wins
+  EXPECT_EQ(t1.angle_deg.t_s, (std::vector<double>{0.0, 0.0333333}));
+  EXPECT_EQ(t1.angle_deg.value, (std::vector<double>{0.1, 0.12}));
+  EXPECT_EQ(t2.pressure_kPa.value, (std::vector<double>{0.03, 0.04}));
+  EXPECT_EQ(t2.angle_deg.value, (std::vector<double>{0.5}));
+  ASSERT_EQ(rec.warnings.size(), 1u);
+  EXPECT_TRUE(contains(rec.warnings, path + ": trial 1: 1 repeated pressure time stamp(s) (first at line 7); kept "
+                                            "the last sample of each"))
+      << rec.warnings[0];
+}
+
+TEST(MeasurementsCsv, StreamsMayBeInterleavedAnyWayAndRowsMayCarryOneStream) {
+  const std::string text =
+      "trial,time_s,pressure_kPa,angle_deg\n"
+      "1,0,1,\n1,0.1,2,\n1,0.2,3,\n"  // all pressure rows first ...
+      "1,0,,10\n1,0.15,,11\n"         // ... then the angle rows of the same trial
+      "+2,0.0,5,20\n2.0,0.1,,\n";     // "+2" and "2.0" are trial 2; a row with neither stream is skipped
+  const Recording rec = parse_measurements_csv(text, "mem.csv");
+  ASSERT_EQ(rec.trials.size(), 2u);
+  EXPECT_EQ(rec.trials[0].pressure_kPa.t_s, (std::vector<double>{0.0, 0.1, 0.2}));
+  EXPECT_EQ(rec.trials[0].angle_deg.t_s, (std::vector<double>{0.0, 0.15}));
+  EXPECT_EQ(rec.trials[1].trial, 2);
+  EXPECT_EQ(rec.trials[1].pressure_kPa.value, (std::vector<double>{5.0}));
+  EXPECT_TRUE(contains(rec.warnings, "mem.csv: 1 row(s) with neither pressure_kPa nor angle_deg were skipped (first "
+                                     "at line 8)"));
+}
+
+/// The paper's recording: ten trials of 0..45 kPa, 160 s each, 400 Hz pressure and 30 fps angle.
+Recording paper_recording() {
+  StaircaseSpec spec;
+  spec.outlier_frames = {100, 2000};
+  Recording rec;
+  for (int trial = 1; trial <= 10; ++trial)
+    rec.trials.push_back(testing::make_staircase_trial(spec, trial, 50u + static_cast<unsigned>(trial)));
+  return rec;
+}
+
+void expect_same(const Recording& a, const Recording& b) {
+  ASSERT_EQ(a.trials.size(), b.trials.size());
+  for (std::size_t i = 0; i < a.trials.size(); ++i) {
+    EXPECT_EQ(a.trials[i].trial, b.trials[i].trial);
+    // Bit-for-bit: the writer uses the shortest text that reads back to the same double.
+    EXPECT_EQ(a.trials[i].pressure_kPa.t_s, b.trials[i].pressure_kPa.t_s) << "trial " << a.trials[i].trial;
+    EXPECT_EQ(a.trials[i].pressure_kPa.value, b.trials[i].pressure_kPa.value) << "trial " << a.trials[i].trial;
+    EXPECT_EQ(a.trials[i].angle_deg.t_s, b.trials[i].angle_deg.t_s) << "trial " << a.trials[i].trial;
+    EXPECT_EQ(a.trials[i].angle_deg.value, b.trials[i].angle_deg.value) << "trial " << a.trials[i].trial;
+  }
+}
+
+TEST(MeasurementsCsv, RoundTripOfThePaperRecordingIsExact) {
+  const Recording rec = paper_recording();
+  const std::string path = testing::temp_path("roundtrip.csv");
+  write_measurements_csv(path, rec);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  const Recording back = read_measurements_csv(path);
+  EXPECT_TRUE(back.warnings.empty()) << back.warnings.front();
+  expect_same(rec, back);
+  std::filesystem::remove(path);
+}
+
+// ~10^6 rows: 10 trials x 250 s at 400 Hz plus the 30 fps angle stream (rows shared where the
+// time stamps coincide, every 0.1 s). The rate is printed for the record; no timing assertion
+// (machines differ), but the content is checked.
+TEST(MeasurementsCsv, MillionRowFileReadRate) {
+  StaircaseSpec spec;
+  spec.hold_s = 25.0;  // 10 levels x 25 s = 250 s = 100 000 pressure samples per trial
+  Recording rec;
+  for (int trial = 1; trial <= 10; ++trial)
+    rec.trials.push_back(testing::make_staircase_trial(spec, trial, 900u + static_cast<unsigned>(trial)));
+  const std::string path = testing::temp_path("million.csv");
+  write_measurements_csv(path, rec);
+  const std::size_t rows = 10 * (100000 + 7500 - 2500);
+  const auto bytes = std::filesystem::file_size(path);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const Recording back = read_measurements_csv(path);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("[ read     ] %zu rows, %.1f MB in %.3f s: %.2f million rows/s, %.0f MB/s\n", rows, bytes / 1e6, s,
+              rows / s / 1e6, bytes / 1e6 / s);
+  std::filesystem::remove(path);
+
+  ASSERT_EQ(back.trials.size(), 10u);
+  std::size_t p = 0, a = 0;
+  for (const TrialRecording& tr : back.trials) {
+    p += tr.pressure_kPa.t_s.size();
+    a += tr.angle_deg.t_s.size();
+  }
+  EXPECT_EQ(p, 1000000u);
+  EXPECT_EQ(a, 75000u);
+  expect_same(rec, back);
+}
+
+// ---- malformed input: every message is "<file>:<line>:<column>: <what>; <what to do>" -----------
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_measurements_csv(text, "data.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MeasurementsCsvErrors, MessagesNameFileLineAndColumn) {
+  const std::string h = "trial,time_s,pressure_kPa,angle_deg\n";
+  struct Case {
+    std::string text, expected;
+  };
+  const std::vector<Case> cases = {
+      {"", "data.csv:1:1: the file is empty; "},
+      {"\xEF\xBB\xBF\r\n\n", "data.csv:1:1: the file is empty; "},
+      {"\n" + h + "1,0,1,2\n", "data.csv:1:1: the first line is blank; "},
+      {"trial,time_s,pressure_kPa\n1,0,1\n",
+       "data.csv:1:1: missing column 'angle_deg' (the header is 'trial,time_s,pressure_kPa'); add the column"},
+      {"trial,time_s,pressure,angle_deg\n1,0,1,2\n",
+       "data.csv:1:1: missing column 'pressure_kPa' (the header is 'trial,time_s,pressure,angle_deg'); the header has "
+       "'pressure': rename it to pressure_kPa"},
+      {"trial;time_s;pressure_kPa;angle_deg\n1;0;1;2\n", "data.csv:1:1: the header has no commas but has ';'; "},
+      {"trial,time_s,pressure_kPa,angle_deg,Time_s\n", "data.csv:1:5: column 'time_s' appears twice (also field 2); "},
+      {h, "data.csv:2:1: no data rows after the header; "},
+      {h + "1,0,abc,\n", "data.csv:2:3: pressure_kPa = 'abc' is not a number; "},
+      {h + "1,0,1,2\n1,0.1,3;4,\n", "data.csv:3:3: pressure_kPa = '3;4' is not a number; "},
+      {h + "1,0,nan,\n", "data.csv:2:3: pressure_kPa = 'nan' is not a finite number; "},
+      {h + "1,0,,-inf\n", "data.csv:2:4: angle_deg = '-inf' is not a finite number; "},
+      {h + "1,0,1e999,\n", "data.csv:2:3: pressure_kPa = '1e999' is not a finite number; "},
+      {h + "1,NaN,1,\n", "data.csv:2:2: time_s = 'NaN' is not a finite number; "},
+      {h + "1.5,0,1,\n", "data.csv:2:1: trial = '1.5' is not an integer; "},
+      {h + "one,0,1,\n", "data.csv:2:1: trial = 'one' is not an integer; "},
+      {h + "99999999999,0,1,\n", "data.csv:2:1: trial = '99999999999' is out of range; "},
+      {h + ",0,1,\n", "data.csv:2:1: trial is empty; "},
+      {h + "1,,1,\n", "data.csv:2:2: time_s is empty; "},
+      {h + "1,0,1\n", "data.csv:2:4: angle_deg is missing: the row has 3 fields, the header 4; "},
+      {h + "1,0,1,2,3\n", "data.csv:2:5: the row has 5 fields, the header only 4; "},
+      {h + "1,0,1,\n1,0.5,1,\n1,0.25,1,\n",
+       "data.csv:4:2: time_s = '0.25' goes back in time: the previous pressure sample of trial 1 is at time_s = 0.5 "
+       "(line 3); "},
+      {h + "1,0,,1\n1,0.5,,1\n1,0,2,\n1,0.25,,1\n",  // the pressure stream may restart; the angle may not
+       "data.csv:5:2: time_s = '0.25' goes back in time: the previous angle sample of trial 1 is at time_s = 0.5 "
+       "(line 3); "},
+      {"Time_s,Trial,note,Angle_deg,Pressure_kPa\n0,1,x,,1 kPa\n",
+       "data.csv:2:5: Pressure_kPa = '1 kPa' is not a number; "},
+  };
+  for (const Case& c : cases) {
+    const std::string msg = error_of(c.text);
+    EXPECT_EQ(msg.rfind(c.expected, 0), 0u) << "expected: " << c.expected << "\n     got: " << msg;
+    EXPECT_NE(msg.find("; "), std::string::npos) << "no advice in: " << msg;
+  }
+}
+
+TEST(MeasurementsCsvErrors, MissingFileNamesThePath) {
+  const std::string path = testing::temp_path("does_not_exist.csv");
+  try {
+    read_measurements_csv(path);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path + ": cannot open the file", 0), 0u) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pneufem
