@@ -10,8 +10,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/compare_cli.h"
+#include "app/diagnose_cli.h"
 #include "app/run.h"
 #include "app/sweep.h"
+#include "app/synth.h"
 #include "materials/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/inp.h"
@@ -120,6 +123,45 @@ int main(int argc, char** argv) {
   sw->add_option("--set", sweep.sets, "Override a scene key at every point, e.g. --set load.trials=10 (repeatable)");
   sw->add_flag("--dry-run", sweep.dry_run, "List the points and exit without running them");
 
+  CLI::App* sy = app.add_subcommand(
+      "synth", "Synthetic measurements from a scene with hidden effects, sampled like the rig (pressure 400 Hz, "
+               "angle 30 fps, controller overshoot, noise, outlier frames): OUT.csv, OUT.truth.csv, OUT.truth.json");
+  SynthOptions synth;
+  std::string hidden_spec;
+  sy->add_option("scene", synth.scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
+      ->check(CLI::ExistingFile);
+  sy->add_option("--hidden", hidden_spec,
+                 "EFFECT[,EFFECT...] hidden at their truth values (candidates: stiffness, viscoelastic, mullins, "
+                 "fatigue, pressure_lag, gravity and registered material effects), or none (the control dataset)")
+      ->required();
+  sy->add_option("--out", synth.out_csv, "Measurement CSV to write (canonical format); truth files go beside it")
+      ->required();
+  sy->add_option("--set", synth.sets, "Override a scene key, also a hidden effect's value (repeatable)");
+  sy->add_option("--seed", synth.seed, "Random seed of the noise (same seed, same file)")->capture_default_str();
+  sy->add_option("--threads", synth.threads, "Worker threads (default: all cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
+  sy->add_option("--pressure-rate", synth.pressure_rate_Hz, "Pressure sampling rate (Hz)")->capture_default_str();
+  sy->add_option("--angle-rate", synth.angle_rate_Hz, "Angle (video) frame rate (Hz)")->capture_default_str();
+  sy->add_option("--controller-hz", synth.controller_hz, "Natural frequency of the inlet controller (Hz)")
+      ->capture_default_str();
+  sy->add_option("--controller-damping", synth.controller_damping,
+                 "Damping ratio of the inlet controller, in (0, 1) (0.65: ~7 % overshoot, 0.3 s rise at 1 Hz)")
+      ->capture_default_str();
+  sy->add_option("--pressure-noise", synth.pressure_noise_kPa, "Pressure sensor white noise, 1 sigma (kPa)")
+      ->capture_default_str();
+  sy->add_option("--angle-noise", synth.angle_noise_deg, "Angle tracking white noise, 1 sigma (deg)")
+      ->capture_default_str();
+  sy->add_option("--outliers", synth.outlier_fraction, "Fraction of frames with a tracking failure (0 = none)")
+      ->capture_default_str();
+  sy->add_option("--report-every", synth.report_every_s, "Densest spacing of solved model states in holds (s)")
+      ->capture_default_str();
+  sy->add_option("--inlet-tolerance", synth.inlet_tolerance_kPa,
+                 "Piecewise-linear fit of the true inlet pressure that drives the model (kPa)")
+      ->capture_default_str();
+
+  std::unique_ptr<CompareCommand> cmp = add_compare_command(app);
+  std::unique_ptr<DiagnoseCommand> dia = add_diagnose_command(app);
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (sim->parsed()) {
@@ -145,6 +187,8 @@ int main(int argc, char** argv) {
                   out_dir.c_str());
       return 0;
     }
+    if (cmp->cmd->parsed()) return run_compare_command(*cmp, join_args(argc, argv));
+    if (dia->cmd->parsed()) return run_diagnose_command(*dia, join_args(argc, argv));
     if (sw->parsed()) {
       sweep.exe = fs::read_symlink("/proc/self/exe").string();
       sweep.command_line = join_args(argc, argv);
@@ -154,6 +198,14 @@ int main(int argc, char** argv) {
                   r.failed, r.wall_s, (fs::path(sweep.out_dir) / "sweep.csv").c_str());
       if (r.failed > 0) std::fprintf(stderr, "error: %d of %zu points failed (their errors are in sweep.csv)\n", r.failed, r.points.size());
       return r.failed > 0 ? 1 : 0;
+    }
+    if (sy->parsed()) {
+      synth.hidden = parse_hidden(hidden_spec);
+      synth.command_line = join_args(argc, argv);
+      const SynthResult r = run_synth(synth);
+      std::printf("synth: %zu trial(s), %ld model states, %d outlier frames, %.1f s; wrote %s (+ .truth.csv, .truth.json)\n",
+                  r.data.trials.size(), r.states, r.outliers, r.wall_s, synth.out_csv.c_str());
+      return 0;
     }
     if (mesh->parsed()) return cmd_mesh(scene_path, sets, mesh_out);
     if (sc->parsed()) {

@@ -13,6 +13,7 @@
 #include "analysis/paper_metrics.h"
 #include "app/json.h"
 #include "app/version.h"
+#include "damage/registry.h"
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/explicit.h"
@@ -115,8 +116,8 @@ std::vector<std::string> ideal_overrides(const Scene& scene, bool& any_effect) {
   std::vector<std::string> sets;
   any_effect = false;
   for (const std::string& m : scene.table_keys("materials"))
-    for (const char* fx : {"mullins", "fatigue", "viscoelastic"}) {
-      const std::string key = "materials." + m + "." + fx + ".enabled";
+    for (const MaterialEffect* fx : material_effects()) {  // built-in and registered (damage/registry.h)
+      const std::string key = "materials." + m + "." + fx->name + ".enabled";
       if (scene.has(key) && scene.boolean(key)) {
         any_effect = true;
         sets.push_back(key + "=false");

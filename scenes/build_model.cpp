@@ -3,16 +3,21 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <optional>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "damage/effects.h"
+#include "damage/registry.h"
 #include "materials/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
+#include "materials/scaled.h"
 #include "scenes/inp.h"
 #include "scenes/pneunet.h"
+#include "scenes/pressure_lag.h"
 
 namespace pneufem {
 
@@ -57,13 +62,16 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
     s.fail(T + ".model", "must be \"linear_elastic\" when mesh.fabric_model = \"membrane\" (the membrane is "
                          "plane-stress St Venant-Kirchhoff), got \"" + law + "\"; or use mesh.fabric_model = \"solid\"");
   const MaterialPtr mat = make_material(s, "fabric");  // validates the table like any material
-  const auto* svk = dynamic_cast<const SaintVenantKirchhoff*>(mat.get());
+  const auto* scaled = dynamic_cast<const ScaledMaterial*>(mat.get());
+  const auto* svk = dynamic_cast<const SaintVenantKirchhoff*>(scaled ? scaled->base().get() : mat.get());
   if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
   MembraneSet m;
   m.name = "FABRIC_MEMBRANE";
   m.nodes = membrane_nodes_of_faces(mesh, mesh.surfaces.at("FABRIC_MEMBRANE"));
   m.thickness_m = positive(s, "geometry.fabric_thickness_mm") * kmm;
-  m.law = PlaneStressSVK(svk->youngs_modulus(), svk->poisson_ratio());
+  // Plane-stress SVK is linear in E: materials.fabric.stiffness_scale scales E exactly (the region
+  // scales of [regions] apply to solid elements only).
+  m.law = PlaneStressSVK((scaled ? scaled->scale() : 1.0) * svk->youngs_modulus(), svk->poisson_ratio());
   m.density_kg_m3 = positive(s, T + ".density_kg_m3");
   return m;
 }
@@ -136,6 +144,27 @@ const std::vector<int>* find_elset(const Mesh& m, const std::string& name) {
   return nullptr;
 }
 
+/// regions.TAG.stiffness_scale of every [regions.TAG] table (tags absent = 1). The tags are the
+/// mesh's region names (engine/mesh.h: interior_wall, roof, side_wall, end_cap, base, fabric for the
+/// built-in pneu-net; a deck's come from mesh.regions).
+std::map<std::string, double> region_scales(const Scene& s, const Mesh& mesh) {
+  std::map<std::string, double> out;
+  for (const std::string& tag : s.table_keys("regions")) {
+    const std::string T = "regions." + tag;
+    if (std::find(mesh.region_names.begin(), mesh.region_names.end(), tag) == mesh.region_names.end()) {
+      std::string valid;
+      for (const std::string& r : mesh.region_names) valid += (valid.empty() ? "" : ", ") + r;
+      s.fail(T, "no region '" + tag + "' in this mesh; valid region tags: " + (valid.empty() ? "(none)" : valid));
+    }
+    require_keys(s, T, {"stiffness_scale"}, "a region");
+    if (!s.has(T + ".stiffness_scale")) continue;
+    const double v = s.number(T + ".stiffness_scale");
+    if (!(std::isfinite(v) && v > 0.0)) s.fail(T + ".stiffness_scale", "must be > 0 (1 = unchanged; 0.8 = 20 % softer)");
+    out[tag] = v;
+  }
+  return out;
+}
+
 // Ramer-Douglas-Peucker simplification of (t, p) to within tol (max vertical deviation).
 void rdp(const std::vector<double>& t, const std::vector<double>& p, std::size_t a, std::size_t b, double tol,
          std::vector<char>& keep) {
@@ -203,19 +232,86 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
 
 namespace {
 MaterialPtr make_base_material(const Scene& s, const std::string& name);
+
+/// materials.NAME.stiffness_scale (absent in a user-defined table = 1).
+double material_scale(const Scene& s, const std::string& name) {
+  const std::string key = "materials." + name + ".stiffness_scale";
+  if (!s.has(key)) return 1.0;
+  const double v = s.number(key);
+  if (!(std::isfinite(v) && v > 0.0)) s.fail(key, "must be > 0 (1 = the material as given; 0.8 = 20 % softer)");
+  return v;
 }
 
-MaterialPtr make_material(const Scene& s, const std::string& name) {
-  const std::string T = "materials." + name;
-  MaterialPtr base = make_base_material(s, name);
-  const EffectParams e = effect_params(s, T);
-  if (!e.mullins && !e.fatigue && !e.viscoelastic) return base;
-  try {
-    return decorate(base, e);
-  } catch (const InputError& err) {
-    s.fail(T, err.what());
-  }
+/// Keys every material table may have besides its law's constants: the scale and the effects.
+std::set<std::string> with_common_keys(std::set<std::string> keys) {
+  keys.insert("stiffness_scale");
+  for (const MaterialEffect* fx : material_effects()) keys.insert(fx->name);
+  return keys;
 }
+
+/// One inelastic layer to apply: ascending `order`, ties in registry order (damage/registry.h).
+struct Layer {
+  int order;
+  std::size_t rank;
+  std::string key;  ///< scene table, for error messages
+  std::function<MaterialPtr(MaterialPtr)> apply;
+};
+
+/// The enabled registered (non-built-in) effect `fx` of table T, or nothing. Parameters left out
+/// take the registry defaults; unknown keys are rejected naming the valid ones.
+std::optional<Layer> registered_layer(const Scene& s, const std::string& T, const MaterialEffect& fx, std::size_t rank) {
+  const std::string K = T + "." + fx.name;
+  if (!s.has(K) || !s.boolean(K + ".enabled")) return std::nullopt;
+  std::set<std::string> allowed{"enabled"};
+  std::map<std::string, double> values;
+  for (const EffectParameter& p : fx.params) {
+    allowed.insert(p.name);
+    values[p.name] = s.has(K + "." + p.name) ? s.number(K + "." + p.name) : p.default_value;
+  }
+  require_keys(s, K, allowed, "effect " + fx.name);
+  const MaterialEffect* f = &fx;  // registry entries are never moved
+  return Layer{fx.order, rank, K, [f, values](MaterialPtr b) { return f->decorate(std::move(b), values); }};
+}
+}  // namespace
+
+/// The material of table materials.NAME with its stiffness scale times `region_scale`, wrapped by its
+/// enabled effects: effect(...(scaled(base))). The scale sits inside the effects, so energy thresholds
+/// (Mullins m, fatigue W_th) are in the scaled energy (materials/scaled.h explains why).
+MaterialPtr make_material(const Scene& s, const std::string& name, double region_scale) {
+  const std::string T = "materials." + name;
+  MaterialPtr m = make_base_material(s, name);
+  try {
+    m = scale_material(std::move(m), material_scale(s, name) * region_scale);
+  } catch (const InputError& err) {
+    s.fail(T + ".stiffness_scale", err.what());
+  }
+  const EffectParams e = effect_params(s, T);
+  std::vector<Layer> layers;
+  std::size_t rank = 0;
+  for (const MaterialEffect* fx : material_effects()) {
+    ++rank;
+    if (fx->name == "mullins" && e.mullins)
+      layers.push_back({fx->order, rank, T, [p = *e.mullins](MaterialPtr b) { return make_mullins(std::move(b), p); }});
+    else if (fx->name == "fatigue" && e.fatigue)
+      layers.push_back({fx->order, rank, T, [p = *e.fatigue](MaterialPtr b) { return make_fatigue(std::move(b), p); }});
+    else if (fx->name == "viscoelastic" && e.viscoelastic)
+      layers.push_back({fx->order, rank, T, [p = *e.viscoelastic](MaterialPtr b) { return make_viscoelastic(std::move(b), p); }});
+    else if (!is_builtin_effect(fx->name))
+      if (auto l = registered_layer(s, T, *fx, rank)) layers.push_back(std::move(*l));
+  }
+  std::stable_sort(layers.begin(), layers.end(),
+                   [](const Layer& a, const Layer& b) { return a.order != b.order ? a.order < b.order : a.rank < b.rank; });
+  for (const Layer& l : layers) {
+    try {
+      m = l.apply(std::move(m));
+    } catch (const InputError& err) {
+      s.fail(l.key, err.what());
+    }
+  }
+  return m;
+}
+
+MaterialPtr make_material(const Scene& s, const std::string& name) { return make_material(s, name, 1.0); }
 
 namespace {
 MaterialPtr make_base_material(const Scene& s, const std::string& name) {
@@ -229,30 +325,30 @@ MaterialPtr make_base_material(const Scene& s, const std::string& name) {
   positive(s, T + ".density_kg_m3");
   try {
     if (model == "linear_elastic") {
-      require_keys(s, T, {"model", "E_MPa", "nu", "density_kg_m3"}, "model linear_elastic");
+      require_keys(s, T, with_common_keys({"model", "E_MPa", "nu", "density_kg_m3"}), "model linear_elastic");
       return std::make_shared<SaintVenantKirchhoff>(s.number(T + ".E_MPa") * kMPa, s.number(T + ".nu"));
     }
     const double Kr = s.number(T + ".K_over_mu");
     if (model == "yeoh") {
-      require_keys(s, T, {"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model yeoh");
+      require_keys(s, T, with_common_keys({"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3"}), "model yeoh");
       const double C10 = s.number(T + ".C10_MPa") * kMPa;
       const double C20 = s.has(T + ".C20_MPa") ? s.number(T + ".C20_MPa") * kMPa : 0.0;
       const double C30 = s.has(T + ".C30_MPa") ? s.number(T + ".C30_MPa") * kMPa : 0.0;
       return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(C10, C20, C30, bulk_from_ratio(2 * C10, Kr)));
     }
     if (model == "neo_hookean") {
-      require_keys(s, T, {"model", "C10_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model neo_hookean");
+      require_keys(s, T, with_common_keys({"model", "C10_MPa", "K_over_mu", "density_kg_m3"}), "model neo_hookean");
       const double C10 = s.number(T + ".C10_MPa") * kMPa;
       return std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(C10, bulk_from_ratio(2 * C10, Kr)));
     }
     if (model == "mooney_rivlin") {
-      require_keys(s, T, {"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model mooney_rivlin");
+      require_keys(s, T, with_common_keys({"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3"}), "model mooney_rivlin");
       const double C10 = s.number(T + ".C10_MPa") * kMPa, C01 = s.number(T + ".C01_MPa") * kMPa;
       return std::make_shared<InvariantMaterial<MooneyRivlin>>(
           MooneyRivlin(C10, C01, bulk_from_ratio(2 * (C10 + C01), Kr)));
     }
     if (model == "ogden") {
-      require_keys(s, T, {"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3", "mullins", "fatigue", "viscoelastic"}, "model ogden");
+      require_keys(s, T, with_common_keys({"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3"}), "model ogden");
       std::vector<double> mu = s.numbers(T + ".mu_MPa");
       const std::vector<double> alpha = s.numbers(T + ".alpha");
       double mu0 = 0.0;
@@ -330,6 +426,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   const int nparts = s.array_size("parts");
   if (nparts == 0) s.fail("parts", "define at least one [[parts]] with elset and material");
   model.element_part.assign(mesh.num_elements(), -1);
+  const std::map<std::string, double> region_scale = region_scales(s, mesh);
   for (int i = 0; i < nparts; ++i) {
     const std::string key = "parts[" + std::to_string(i) + "]";
     const std::string elset = s.string(key + ".elset"), mat = s.string(key + ".material");
@@ -340,12 +437,30 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
     }
     if (membrane_fabric && els->empty()) continue;  // FABRIC is empty: the fabric is the membrane
-    model.parts.push_back(Part{elset, make_material(s, mat), s.number("materials." + mat + ".density_kg_m3")});
+    const double density = s.number("materials." + mat + ".density_kg_m3");
+    model.parts.push_back(Part{elset, make_material(s, mat), density});
+    const int part = static_cast<int>(model.parts.size()) - 1;
+    // Elements of a region with a stiffness scale != 1 get their own part "ELSET@region" (same
+    // material, scaled); each part's material sets its own state layout, so assembly is unchanged.
+    std::map<std::uint16_t, int> region_part;
     for (int e : *els) {
       if (model.element_part[e] >= 0)
         s.fail(key + ".elset", "element " + std::to_string(mesh.element_ids[e]) + " is in two parts ('" +
                                    model.parts[model.element_part[e]].name + "' and '" + elset + "')");
-      model.element_part[e] = static_cast<int>(model.parts.size()) - 1;
+      int p = part;
+      if (static_cast<std::size_t>(e) < mesh.region.size()) {
+        const std::string& tag = mesh.region_names[mesh.region[e]];
+        const auto sc = region_scale.find(tag);
+        if (sc != region_scale.end() && sc->second != 1.0) {
+          auto [it, fresh] = region_part.try_emplace(mesh.region[e], -1);
+          if (fresh) {
+            model.parts.push_back(Part{elset + "@" + tag, make_material(s, mat, sc->second), density});
+            it->second = static_cast<int>(model.parts.size()) - 1;
+          }
+          p = it->second;
+        }
+      }
+      model.element_part[e] = p;
     }
   }
   for (int e = 0; e < mesh.num_elements(); ++e)
@@ -418,6 +533,15 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   } else {
     s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
   }
+  // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
+  // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
+  // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
+  const double lag_s = s.number("load.pressure_lag_s");
+  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
+    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
+  if (lag_s > 0.0)
+    out->load = apply_pressure_lag(out->load, lag_s,
+                                   protocol == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
 
   // Solver.
   SolverSettings& sv = out->solver;

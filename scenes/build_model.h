@@ -36,8 +36,11 @@ struct BuiltModel {
   std::vector<std::string> warnings;
 };
 
-/// Builds the material named `name` (scene table materials.<name>).
+/// Builds the material named `name` (scene table materials.<name>): its law, stiffness_scale and
+/// enabled effects (built-in and registered, damage/registry.h).
 MaterialPtr make_material(const Scene& scene, const std::string& name);
+/// The same with the stiffness additionally multiplied by `region_scale` (regions.<tag>.stiffness_scale).
+MaterialPtr make_material(const Scene& scene, const std::string& name, double region_scale);
 
 /// Builds only the mesh described by the scene (mesh.* and geometry.*), with its sets.
 Mesh build_mesh(const Scene& scene, std::vector<std::string>* warnings = nullptr);

@@ -38,7 +38,7 @@ std::string origin_of(const toml::node& n) {
 
 // Keys whose sub-keys are free-form names (checked elsewhere, e.g. by the material factory).
 bool free_form(const std::string& path) {
-  return path == "materials" || path == "mesh.regions" || path.rfind("materials.", 0) == 0;
+  return path == "materials" || path == "mesh.regions" || path == "regions" || path.rfind("materials.", 0) == 0;
 }
 
 // Rejects keys of `user` that the default scene does not have.

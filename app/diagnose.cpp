@@ -1,0 +1,706 @@
+#include "app/diagnose.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include <nlopt.hpp>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include "analysis/compare.h"
+#include "analysis/steps.h"
+#include "app/compare.h"
+#include "app/drive.h"
+#include "app/effect_catalog.h"
+#include "app/json.h"
+#include "app/run.h"
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/path_model.h"
+#include "engine/static_solver.h"
+#include "materials/errors.h"
+#include "scenes/build_model.h"
+#include "scenes/pressure_lag.h"
+
+namespace fs = std::filesystem;
+
+namespace pneufem {
+
+namespace {
+
+/// The elastic reference of a scene: every inelastic effect table switched off, no gravity, no
+/// pressure lag (the path model adds gravity and lag itself; stiffness scales are elastic and stay).
+Scene elastic_reference(const Scene& scene) {
+  std::vector<std::string> sets;
+  for (const std::string& m : scene.table_keys("materials"))
+    for (const std::string& sub : scene.table_keys("materials." + m))
+      if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
+  sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
+  if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
+  return scene.with(sets);
+}
+
+bool has_history(const Model& m) {
+  for (const Part& p : m.parts)
+    if (p.material->state_size() > 0) return true;
+  return false;
+}
+
+/// Reduced-model replay of a recording for any variant of the base scene (same mesh).
+class RomEvaluator {
+ public:
+  RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points)
+      : rec_(rec), frames_(frames) {
+    ref_ = build_model(elastic_reference(base));
+    double p_max = 0.0;
+    for (const TrialRecording& t : rec.trials)
+      for (double p : t.pressure_kPa.value) p_max = std::max(p_max, p);
+    p_max_Pa_ = std::max(1e3, p_max * 1e3);
+    PathModelOptions po;
+    po.p_top_Pa = 1.8 * p_max_Pa_;  // softened models reach angles the elastic one reaches only above p_max
+    po.dp_Pa = p_max_Pa_ / 40.0;
+    po.max_points = rom_points;
+    po.max_dt_s = 0.5;
+    po.newton = ref_->solver.quasi_static.newton;
+    path_ = std::make_unique<PathModel>(ref_->model, po);
+    DriveOptions d;
+    d.max_report_gap_s = 0.5;  // creep and damage inside holds: 0.5 s states, linear in between
+    inlet_ = measured_load(rec, d, base.number("load.rest_s"), true, offset_);
+    rest_s_ = base.number("load.rest_s");
+  }
+
+  const PathModel& path() const { return *path_; }
+
+  /// Model angle (deg) at every frame of `frames_` for the variant scene.
+  std::vector<double> at_frames(const Scene& variant) const {
+    const std::vector<std::vector<double>> per_trial = simulate(variant, true);
+    std::vector<double> out(frames_.size());
+    std::vector<std::size_t> next(rec_.trials.size(), 0);
+    for (std::size_t i = 0; i < frames_.size(); ++i) out[i] = per_trial[frames_[i].trial_index][next[frames_[i].trial_index]++];
+    return out;
+  }
+
+  /// Model angle series at every measured angle time of every trial.
+  std::vector<Series> series(const Scene& variant) const {
+    const std::vector<std::vector<double>> a = simulate(variant, false);
+    std::vector<Series> out(rec_.trials.size());
+    for (std::size_t k = 0; k < rec_.trials.size(); ++k) {
+      out[k].t_s = rec_.trials[k].angle_deg.t_s;
+      out[k].value = a[k];
+    }
+    return out;
+  }
+
+ private:
+  /// Per trial, the model angle at the kept frames (kept_only) or at every angle sample.
+  std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only) const {
+    const std::unique_ptr<BuiltModel> bm = build_model(variant);
+    const double lag = variant.has("load.pressure_lag_s") ? variant.number("load.pressure_lag_s") : 0.0;
+    const LoadHistory load = lag > 0.0 ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
+    const std::size_t nt = rec_.trials.size();
+    // Engine times of the requested samples, per trial.
+    std::vector<std::vector<double>> times(nt);
+    if (kept_only) {
+      for (const ComparedFrame& f : frames_) times[f.trial_index].push_back(f.t_s - offset_[f.trial_index]);
+    } else {
+      for (std::size_t k = 0; k < nt; ++k)
+        for (double t : rec_.trials[k].angle_deg.t_s) times[k].push_back(t - offset_[k]);
+    }
+    std::vector<std::vector<double>> out(nt);
+    if (!has_history(bm->model)) {
+      // Elastic (stiffness, gravity, lag): the angle is a function of the chamber pressure alone,
+      // so the FULL FEM is affordable — one static sweep 0 -> max pressure, then a lookup per
+      // sample. (The reduced model is too stiff for shape-changing elastic loads such as gravity;
+      // see tests/app/test_path_model.cpp.) Sweeps are cached by scene without the lag, so a lag
+      // calibration re-uses one sweep.
+      double hi = 0.0;
+      for (const TrialLoad& tr : load.trials)
+        for (double p : tr.pressure_Pa) hi = std::max(hi, p);
+      const int n = 40;  // angle-pressure curve samples; linear in between (smooth curve)
+      const std::vector<double> th = elastic_curve(variant, *bm, hi, n);
+      const double lo = 0.0;
+      for (std::size_t k = 0; k < nt; ++k) {
+        const TrialLoad& tr = load.trials[k];
+        for (double t : times[k]) {
+          const double p = tr.pressure(std::clamp(t, 0.0, tr.duration()));
+          const double x = hi > lo ? (p - lo) / (hi - lo) * n : 0.0;
+          const int i = std::clamp(static_cast<int>(std::floor(x)), 0, n - 1);
+          const double f = std::clamp(x - i, 0.0, 1.0);
+          out[k].push_back(th[i] + f * (th[i + 1] - th[i]));
+        }
+      }
+      return out;
+    }
+    // History: one continuous replay of all trials (internal variables carry over).
+    PathLoad pl;
+    std::vector<double> start(nt);
+    double g = 0.0;
+    for (std::size_t k = 0; k < nt; ++k) {
+      const TrialLoad& tr = load.trials[k];
+      start[k] = g;
+      for (std::size_t i = 0; i < tr.time_s.size(); ++i) {
+        const double t = g + tr.time_s[i];
+        if (!pl.t_s.empty() && t <= pl.t_s.back()) continue;
+        pl.t_s.push_back(t);
+        pl.p_Pa.push_back(tr.pressure_Pa[i]);
+      }
+      g += tr.duration();
+      // Between trials the actuator is vented to 0 and rests for load.rest_s (as the FEM drive
+      // does); with no rest, the vent takes 1 ms so the next trial starts from 0 kPa.
+      const double rest = std::max(rest_s_, 1e-3);
+      pl.t_s.push_back(g + std::min(1e-3, 0.5 * rest));
+      pl.p_Pa.push_back(0.0);
+      if (rest > 1e-3) {
+        pl.t_s.push_back(g + rest);
+        pl.p_Pa.push_back(0.0);
+      }
+      g += rest;
+    }
+    const std::vector<double> th = path_->run(bm->model, pl);
+    for (std::size_t k = 0; k < nt; ++k) {
+      const TrialLoad& tr = load.trials[k];
+      for (double t : times[k]) {
+        const double gt = start[k] + std::clamp(t, 0.0, tr.duration());
+        const auto it = std::upper_bound(pl.t_s.begin(), pl.t_s.end(), gt);
+        const std::size_t i = std::clamp<std::size_t>(static_cast<std::size_t>(it - pl.t_s.begin()), 1, pl.t_s.size() - 1);
+        const double f = std::clamp((gt - pl.t_s[i - 1]) / (pl.t_s[i] - pl.t_s[i - 1]), 0.0, 1.0);
+        out[k].push_back(th[i - 1] + f * (th[i] - th[i - 1]));
+      }
+    }
+    return out;
+  }
+
+  /// Angles (deg) of the static FEM equilibria at p = hi i / n, i = 0..n (cached).
+  std::vector<double> elastic_curve(const Scene& variant, const BuiltModel& bm, double hi, int n) const {
+    const std::string key = variant.with({"load.pressure_lag_s=0.0"}).to_toml();
+    {
+      std::lock_guard<std::mutex> lock(cache_mu_);
+      const auto it = curves_.find(key);
+      if (it != curves_.end()) return it->second;
+    }
+    const Assembler A(bm.model);
+    StaticSolver solver(A, bm.solver.quasi_static.newton);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(bm.model.num_dofs());
+    std::vector<double> state;
+    solver.advance(0.0, 0.0, 0.0, 0.0, state, u);  // gravity alone
+    std::vector<double> th = {bending_angle(bm.model, u).angle_deg};
+    for (int i = 1; i <= n; ++i) {
+      solver.advance(hi * (i - 1) / n, hi * i / n, 0.0, 0.0, state, u);
+      th.push_back(unwrap_deg(bending_angle(bm.model, u).angle_deg, th.back()));
+    }
+    std::lock_guard<std::mutex> lock(cache_mu_);
+    curves_[key] = th;
+    return th;
+  }
+
+  mutable std::mutex cache_mu_;
+  mutable std::map<std::string, std::vector<double>> curves_;
+  const Recording& rec_;
+  const std::vector<ComparedFrame>& frames_;
+  std::unique_ptr<BuiltModel> ref_;
+  std::unique_ptr<PathModel> path_;
+  LoadHistory inlet_;
+  std::vector<double> offset_;
+  double rest_s_ = 0.0, p_max_Pa_ = 0.0;
+};
+
+double rss_of(const std::vector<double>& model, const std::vector<ComparedFrame>& frames) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < frames.size(); ++i) s += (model[i] - frames[i].measured_deg) * (model[i] - frames[i].measured_deg);
+  return s;
+}
+
+/// Value of a catalog parameter at the scaled coordinate x in [0, 1].
+double unscale(const CandidateParameter& p, double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return p.log ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + x * (p.hi - p.lo);
+}
+double scale(const CandidateParameter& p, double v) {
+  v = std::clamp(v, p.lo, p.hi);
+  return p.log ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
+}
+
+struct Calibration {
+  std::vector<double> values;
+  double rss = std::numeric_limits<double>::infinity();
+  int evaluations = 0;
+  std::string error;
+};
+
+/// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
+/// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
+/// (several) from the best grid point. Failed evaluations (no equilibrium) count as +infinity.
+Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                      int budget, const std::vector<double>* start = nullptr) {
+  const std::size_t k = c.params.size();
+  Calibration best;
+  auto eval = [&](const std::vector<double>& x) {
+    std::vector<double> v(k);
+    for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
+    double r = std::numeric_limits<double>::infinity();
+    ++best.evaluations;
+    try {
+      r = rss(v);
+    } catch (const std::exception& e) {
+      if (best.error.empty()) best.error = e.what();
+    }
+    if (r < best.rss) {
+      best.rss = r;
+      best.values = v;
+    }
+    return std::isfinite(r) ? r : 1e300;
+  };
+  if (k == 0) {
+    eval({});
+    return best;
+  }
+  // Coarse grid (and the catalog's initial point).
+  std::vector<double> x0(k);
+  for (std::size_t i = 0; i < k; ++i) x0[i] = scale(c.params[i], start ? (*start)[i] : c.params[i].initial);
+  eval(x0);
+  // From a given start (refinement): a local search only, in a cell of +-1/per around it.
+  const int per = start ? 6 : (k == 1 ? 5 : 3);
+  std::vector<int> idx(k, 0);
+  std::vector<double> xbest = x0;
+  double fbest = best.rss;
+  while (!start) {
+    std::vector<double> x(k);
+    for (std::size_t i = 0; i < k; ++i) x[i] = (idx[i] + 0.5) / per;
+    const double f = eval(x);
+    if (f < fbest) fbest = f, xbest = x;
+    std::size_t i = 0;
+    while (i < k && ++idx[i] == per) idx[i++] = 0;
+    if (i == k) break;
+  }
+  const int left = std::max(4, budget - best.evaluations);
+  if (k == 1) {
+    // Golden section on the grid cell around the best point (+- one cell).
+    double a = std::max(0.0, xbest[0] - 1.0 / per), b = std::min(1.0, xbest[0] + 1.0 / per);
+    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+    double c1 = b - r * (b - a), c2 = a + r * (b - a);
+    double f1 = eval({c1}), f2 = eval({c2});
+    for (int it = 2; it < left && b - a > 1e-4; ++it) {
+      if (f1 < f2) {
+        b = c2, c2 = c1, f2 = f1;
+        c1 = b - r * (b - a);
+        f1 = eval({c1});
+      } else {
+        a = c1, c1 = c2, f1 = f2;
+        c2 = a + r * (b - a);
+        f2 = eval({c2});
+      }
+    }
+    return best;
+  }
+  nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(k));
+  opt.set_lower_bounds(std::vector<double>(k, 0.0));
+  opt.set_upper_bounds(std::vector<double>(k, 1.0));
+  opt.set_maxeval(left);
+  opt.set_xtol_abs(1e-4);
+  opt.set_initial_step(std::vector<double>(k, 0.5 / per));
+  auto fn = [](const std::vector<double>& x, std::vector<double>&, void* data) {
+    return (*static_cast<std::function<double(const std::vector<double>&)>*>(data))(x);
+  };
+  std::function<double(const std::vector<double>&)> f = eval;
+  opt.set_min_objective(fn, &f);
+  std::vector<double> x = xbest;
+  double fx = 0.0;
+  try {
+    opt.optimize(x, fx);
+  } catch (const std::exception&) {
+    // roundoff / forced stop: the best point seen is kept by eval()
+  }
+  return best;
+}
+
+double sq(double v) { return v * v; }
+
+/// Residual signature of a comparison: numbers the reasons are made of.
+struct Signature {
+  std::vector<double> trial_rmse;     ///< per trial
+  double growth = 1.0;                ///< rmse of the last trial / first
+  double creep_top_deg = 0.0;         ///< mean (measured - model) spread at the top third of the levels
+  double creep_low_deg = 0.0;         ///< ... at the other levels
+  double creep_first_deg = 0.0, creep_last_deg = 0.0;  ///< mean spread difference, first / last trial
+  double first_vs_rest = 0.0;         ///< mean residual of trial 1 minus that of the others
+  double early_deg = 0.0, late_deg = 0.0;  ///< mean residual in the first 0.5 s of steps / after the mark
+  double rest_deg = 0.0;              ///< mean residual on steps at (near) zero pressure
+  double proportional = 0.0;          ///< correlation of mark residual with the measured mark angle
+};
+
+Signature signature_of(const Comparison& c) {
+  Signature s;
+  double top = 0.0, low = 0.0;
+  int ntop = 0, nlow = 0;
+  std::vector<double> mean_res;
+  double lvl_max = 0.0;
+  for (const TrialComparison& t : c.trials)
+    for (const StepComparison& st : t.steps) lvl_max = std::max(lvl_max, st.level_kPa);
+  std::vector<double> xs, ys;
+  double rest = 0.0;
+  int nrest = 0;
+  for (std::size_t k = 0; k < c.trials.size(); ++k) {
+    const TrialComparison& t = c.trials[k];
+    s.trial_rmse.push_back(t.rmse_deg);
+    double cr = 0.0, mr = 0.0;
+    int ncr = 0, nmr = 0;
+    for (const StepComparison& st : t.steps) {
+      const double d = st.spread_measured_deg - st.spread_model_deg;
+      if (std::isfinite(d)) {
+        (st.level_kPa >= 2.0 / 3.0 * lvl_max ? top : low) += d;
+        ++(st.level_kPa >= 2.0 / 3.0 * lvl_max ? ntop : nlow);
+        cr += d, ++ncr;
+      }
+      if (std::isfinite(st.mean_residual_deg)) mr += st.mean_residual_deg * st.frames, nmr += static_cast<int>(st.frames);
+      if (std::isfinite(st.measured_mark_deg) && std::isfinite(st.model_mark_deg)) {
+        xs.push_back(st.measured_mark_deg);
+        ys.push_back(st.model_mark_deg - st.measured_mark_deg);
+      }
+      if (std::abs(st.level_kPa) < 0.05 * lvl_max && std::isfinite(st.mean_residual_deg)) rest += st.mean_residual_deg, ++nrest;
+    }
+    if (k == 0) s.creep_first_deg = ncr ? cr / ncr : 0.0;
+    if (k + 1 == c.trials.size()) s.creep_last_deg = ncr ? cr / ncr : 0.0;
+    mean_res.push_back(nmr ? mr / nmr : 0.0);
+  }
+  s.creep_top_deg = ntop ? top / ntop : 0.0;
+  s.creep_low_deg = nlow ? low / nlow : 0.0;
+  if (!s.trial_rmse.empty() && s.trial_rmse.front() > 0) s.growth = s.trial_rmse.back() / s.trial_rmse.front();
+  if (mean_res.size() > 1) {
+    double others = 0.0;
+    for (std::size_t k = 1; k < mean_res.size(); ++k) others += mean_res[k];
+    s.first_vs_rest = mean_res[0] - others / static_cast<double>(mean_res.size() - 1);
+  }
+  double e = 0.0, l = 0.0;
+  long ne = 0, nl = 0;
+  for (std::size_t i = 0; i < c.profile.t_s.size(); ++i) {
+    if (!std::isfinite(c.profile.mean_deg[i])) continue;
+    if (c.profile.t_s[i] < 0.5) e += c.profile.mean_deg[i] * c.profile.count[i], ne += c.profile.count[i];
+    if (c.profile.t_s[i] > 2.5) l += c.profile.mean_deg[i] * c.profile.count[i], nl += c.profile.count[i];
+  }
+  s.early_deg = ne ? e / ne : 0.0;
+  s.late_deg = nl ? l / nl : 0.0;
+  s.rest_deg = nrest ? rest / nrest : 0.0;
+  if (xs.size() > 2) {
+    double mx = 0, my = 0;
+    for (std::size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += ys[i];
+    mx /= xs.size(), my /= ys.size();
+    double sxy = 0, sxx = 0, syy = 0;
+    for (std::size_t i = 0; i < xs.size(); ++i)
+      sxy += (xs[i] - mx) * (ys[i] - my), sxx += sq(xs[i] - mx), syy += sq(ys[i] - my);
+    s.proportional = sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+  }
+  return s;
+}
+
+std::string fmt(const char* f, double a) {
+  char b[96];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+
+/// The sentence about the residual feature that `effect` explains.
+std::string evidence(const std::string& effect, const Signature& s) {
+  const std::string growth = "the error grows from trial 1 to the last trial (rms " + fmt("%.2f", s.trial_rmse.front()) +
+                             " -> " + fmt("%.2f", s.trial_rmse.back()) + " deg)";
+  const std::string creep = "the measured angle keeps rising during the top holds (" + fmt("%+.2f", s.creep_top_deg) +
+                            " deg more than modelled over a hold, vs " + fmt("%+.2f", s.creep_low_deg) + " at the lower steps)";
+  if (effect == "fatigue") return growth + ", and " + creep;
+  if (effect == "viscoelastic")
+    return "inside the holds the measured angle creeps more than the model (" + fmt("%+.2f", s.creep_first_deg) +
+           " deg in trial 1, " + fmt("%+.2f", s.creep_last_deg) + " deg in the last trial)";
+  if (effect == "mullins")
+    return "trial 1 differs from the later trials (mean residual " + fmt("%+.2f", s.first_vs_rest) +
+           " deg relative to them), the signature of softening set by the first peak load";
+  if (effect == "stiffness")
+    return "the error scales with the angle (correlation of the step error with the angle " + fmt("%+.2f", s.proportional) +
+           ") with little time structure";
+  if (effect == "pressure_lag")
+    return "the error concentrates right after each pressure step (mean residual " + fmt("%+.2f", s.early_deg) +
+           " deg in the first 0.5 s vs " + fmt("%+.2f", s.late_deg) + " deg after the mark)";
+  if (effect == "gravity")
+    return "the model misses an angle at rest and low pressure (mean residual " + fmt("%+.2f", s.rest_deg) +
+           " deg at 0 kPa)";
+  return "its calibrated constants reshape the residual";
+}
+
+}  // namespace
+
+double effective_sample_size(const std::vector<double>& r, const std::vector<int>& segment) {
+  const double n = static_cast<double>(r.size());
+  if (r.size() < 3) return n;
+  double mean = 0.0;
+  for (double v : r) mean += v;
+  mean /= n;
+  double c0 = 0.0, c1 = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    c0 += sq(r[i] - mean);
+    if (i > 0 && segment[i] == segment[i - 1]) c1 += (r[i] - mean) * (r[i - 1] - mean);
+  }
+  const double rho = c0 > 0.0 ? std::clamp(c1 / c0, 0.0, 0.999) : 0.0;
+  return std::clamp(n * (1.0 - rho) / (1.0 + rho), std::min(n, 10.0), n);
+}
+
+DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (opt.out_dir.empty()) throw InputError("diagnose: --out DIR is required");
+  if (opt.max_effects < 1) throw InputError("diagnose: --max-effects must be >= 1");
+  std::vector<const CandidateEffect*> cands;
+  if (opt.candidates.empty())
+    for (const CandidateEffect& c : candidate_effects()) cands.push_back(&c);
+  else
+    for (const std::string& n : opt.candidates) cands.push_back(&candidate_effect(n));
+  std::unique_ptr<tbb::global_control> gc;
+  if (opt.threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
+
+  const Recording rec = read_measurements_csv(opt.data_path);
+  // Kept frames and metrics come from compare_recording; any model series gives the frames.
+  std::vector<Series> zero(rec.trials.size());
+  for (std::size_t k = 0; k < rec.trials.size(); ++k) {
+    zero[k].t_s = rec.trials[k].angle_deg.t_s;
+    zero[k].value.assign(zero[k].t_s.size(), 0.0);
+  }
+  const std::vector<ComparedFrame> frames = compare_recording(rec, zero).frames;
+  std::vector<int> segment;
+  for (const ComparedFrame& f : frames) segment.push_back(f.trial_index);
+
+  if (opt.progress) std::fprintf(stderr, "diagnose: tracing the elastic path ...\n");
+  const RomEvaluator rom(scene, rec, frames, opt.rom_points);
+  long rom_runs = 0;
+  std::mutex mu;
+
+  DiagnosisResult out;
+  auto metrics = [&](const Scene& s) { return compare_recording(rec, rom.series(s)); };
+  const Comparison base = metrics(scene);
+  ++rom_runs;
+  out.baseline_nrmse = base.nrmse;
+  for (const TrialComparison& t : base.trials) out.baseline_nrmse_per_trial.push_back(t.nrmse);
+  out.noise_floor_nrmse = base.noise_floor_nrmse;
+  const Signature sig = signature_of(base);
+
+  std::vector<std::string> selected_sets;
+  std::vector<std::pair<const CandidateEffect*, std::vector<double>>> chosen;  // selected, with constants
+  Comparison current = base;
+  double current_rss = base.rss_deg2;
+  std::vector<bool> used(cands.size(), false);
+  for (int round = 1; round <= opt.max_effects; ++round) {
+    std::vector<CandidateResult> results(cands.size());
+    std::vector<std::size_t> todo;
+    for (std::size_t i = 0; i < cands.size(); ++i)
+      if (!used[i]) todo.push_back(i);
+    if (todo.empty()) break;
+    const Scene cur_scene = scene.with(selected_sets);
+    tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t j) {
+      const CandidateEffect& c = *cands[todo[j]];
+      CandidateResult& r = results[todo[j]];
+      r.effect = c.name;
+      r.round = round;
+      for (const CandidateParameter& p : c.params) r.param_names.push_back(p.name);
+      auto rss = [&](const std::vector<double>& v) {
+        const Scene s = cur_scene.with(c.sets(cur_scene, v));
+        return rss_of(rom.at_frames(s), frames);
+      };
+      const Calibration cal = calibrate(c, rss, opt.max_evaluations);
+      r.evaluations = cal.evaluations;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        rom_runs += cal.evaluations;
+        if (opt.progress)
+          std::fprintf(stderr, "  round %d %-14s rss %.4g deg^2 (%d runs)\n", round, c.name.c_str(), cal.rss, cal.evaluations);
+      }
+      if (!std::isfinite(cal.rss)) {
+        r.error = cal.error.empty() ? "calibration failed" : cal.error;
+        r.nrmse = std::numeric_limits<double>::infinity();
+        return;
+      }
+      r.params = cal.values;
+      r.sets = c.sets(cur_scene, cal.values);
+      const Comparison cmp = metrics(cur_scene.with(r.sets));
+      r.nrmse = cmp.nrmse;
+      r.rss_deg2 = cmp.rss_deg2;
+      for (const TrialComparison& t : cmp.trials) r.nrmse_per_trial.push_back(t.nrmse);
+      std::vector<double> res;
+      for (const ComparedFrame& f : cmp.frames) res.push_back(f.model_deg - f.measured_deg);
+      const double n_eff = effective_sample_size(res, segment);
+      r.delta_aic = n_eff * std::log(std::max(cmp.rss_deg2, 1e-300) / std::max(current_rss, 1e-300)) +
+                    2.0 * static_cast<double>(c.params.size());
+      const double excess = sq(current.nrmse) - sq(out.noise_floor_nrmse);
+      r.removed = excess > 0.0 ? (sq(current.nrmse) - sq(cmp.nrmse)) / excess : 0.0;
+      r.significant = r.delta_aic <= opt.aic_threshold && r.removed >= opt.min_removed;
+      r.why = c.name + (r.significant ? " is likely missing: " : " does not explain the error: ") + "it removes " +
+              fmt("%.0f", 100.0 * std::max(0.0, r.removed)) + " % of the error above the noise floor (NRMSE " +
+              fmt("%.4f", current.nrmse) + " -> " + fmt("%.4f", cmp.nrmse) + ", delta AIC " + fmt("%.1f", r.delta_aic) +
+              " with " + std::to_string(c.params.size()) + " parameter(s)). Residual signature: " + evidence(c.name, sig) +
+              ". " + c.signature;
+    });
+    std::vector<std::size_t> order = todo;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return results[a].nrmse < results[b].nrmse; });
+    for (std::size_t i : order) out.candidates.push_back(results[i]);
+    const CandidateResult& best = results[order.front()];
+    if (!best.significant) break;
+    used[order.front()] = true;
+    chosen.emplace_back(cands[order.front()], best.params);
+    out.selected.push_back(best.effect);
+    if (round == 1) out.missing_effect = best.effect;
+    selected_sets.insert(selected_sets.end(), best.sets.begin(), best.sets.end());
+    current = metrics(scene.with(selected_sets));
+    current_rss = current.rss_deg2;
+  }
+  out.final_nrmse = current.nrmse;
+
+  // Space mapping (output correction): the reduced model is a 1-dof Ritz model and misjudges
+  // strongly localised effects (damage concentrated in the walls) by up to a factor ~2 in angle
+  // change (tests/app/test_path_model.cpp). Each refinement runs the full FEM once at the current
+  // constants, adds its frame-by-frame difference from the reduced model as a fixed correction,
+  // and re-calibrates each selected effect in turn from its current constants. At convergence the
+  // corrected reduced model equals the FEM at the fitted constants, so the constants are the FEM's.
+  auto fem_at_frames = [&](const Scene& s) {
+    DriveOptions d;
+    d.threads = opt.threads;
+    const DriveResult dr = simulate_recording(s, rec, d);
+    std::vector<double> v(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) v[i] = value_at(dr.trials[frames[i].trial_index].angle_deg, frames[i].t_s);
+    return v;
+  };
+  for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
+    if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d with the full FEM ...\n", it + 1);
+    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets));
+    const std::vector<double> romv = rom.at_frames(scene.with(selected_sets));
+    std::vector<double> corr(fem.size());
+    for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = fem[i] - romv[i];
+    for (std::size_t j = 0; j < chosen.size(); ++j) {
+      std::vector<std::string> others;
+      for (std::size_t o = 0; o < chosen.size(); ++o)
+        if (o != j) {
+          const std::vector<std::string> so = chosen[o].first->sets(scene, chosen[o].second);
+          others.insert(others.end(), so.begin(), so.end());
+        }
+      const Scene base_j = scene.with(others);
+      const CandidateEffect& c = *chosen[j].first;
+      auto rss = [&](const std::vector<double>& v) {
+        std::vector<double> m = rom.at_frames(base_j.with(c.sets(base_j, v)));
+        for (std::size_t i = 0; i < m.size(); ++i) m[i] += corr[i];
+        return rss_of(m, frames);
+      };
+      const Calibration cal = calibrate(c, rss, std::max(8, opt.max_evaluations / 2), &chosen[j].second);
+      rom_runs += cal.evaluations;
+      if (std::isfinite(cal.rss)) chosen[j].second = cal.values;
+    }
+    selected_sets.clear();
+    for (const auto& [c, v] : chosen) {
+      const std::vector<std::string> sc = c->sets(scene, v);
+      selected_sets.insert(selected_sets.end(), sc.begin(), sc.end());
+    }
+    out.refined_params.clear();
+    for (const auto& [c, v] : chosen) out.refined_params.push_back(v);
+  }
+  out.rom_runs = rom_runs;
+
+  const Scene fitted = scene.with(selected_sets);
+  out.fitted_toml = "# pneufem diagnose: the input scene plus the selected effects (" +
+                    (out.selected.empty() ? std::string("none") : out.selected.front()) +
+                    (out.selected.size() > 1 ? " + " + out.selected[1] : std::string()) + ") with calibrated constants.\n" +
+                    "# Data: " + opt.data_path + "\n" + fitted.to_toml();
+
+  if (opt.verify || opt.refine > 0) {
+    DriveOptions d;
+    d.threads = opt.threads;
+    out.verified_baseline_nrmse = compare_recording(rec, [&] {
+      std::vector<Series> v;
+      for (TrialTrace& t : simulate_recording(scene, rec, d).trials) v.push_back(std::move(t.angle_deg));
+      return v;
+    }()).nrmse;
+    out.verified_fitted_nrmse = compare_recording(rec, [&] {
+      std::vector<Series> v;
+      for (TrialTrace& t : simulate_recording(fitted, rec, d).trials) v.push_back(std::move(t.angle_deg));
+      return v;
+    }()).nrmse;
+  }
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // ---- outputs
+  fs::create_directories(opt.out_dir);
+  json::Object root;
+  root.add_str("version", version_string());
+  root.add_str("command", opt.command_line);
+  root.add_str("data", opt.data_path);
+  json::Object b;
+  b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
+  if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
+  root.add("baseline", b.str(2));
+  std::string cs = "[";
+  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
+    const CandidateResult& c = out.candidates[i];
+    json::Object p;
+    for (std::size_t j = 0; j < c.params.size(); ++j) p.add(c.param_names[j], c.params[j]);
+    json::Object o;
+    o.add_str("effect", c.effect).add("round", c.round).add("nrmse", c.nrmse);
+    o.add("nrmse_per_trial", json::array(c.nrmse_per_trial)).add("params", c.params.empty() ? "{}" : p.str(6));
+    std::string sets = "[";
+    for (std::size_t j = 0; j < c.sets.size(); ++j) sets += (j ? ", " : "") + json::quote(c.sets[j]);
+    o.add("sets", sets + "]").add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
+    o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add_str("why", c.why);
+    if (!c.error.empty()) o.add_str("error", c.error);
+    cs += (i ? ",\n    " : "\n    ") + o.str(4);
+  }
+  root.add("candidates", cs + "\n  ]");
+  root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
+  std::string sel = "[";
+  for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
+  root.add("selected", sel + "]");
+  if (!out.refined_params.empty()) {
+    std::string rp = "{";
+    for (std::size_t j = 0; j < chosen.size(); ++j) {
+      json::Object p;
+      for (std::size_t i = 0; i < chosen[j].first->params.size(); ++i) p.add(chosen[j].first->params[i].name, chosen[j].second[i]);
+      rp += (j ? ", " : "") + json::quote(chosen[j].first->name) + ": " + p.str(4);
+    }
+    root.add("refined_params", rp + "}");
+  }
+  root.add("noise_floor_nrmse", out.noise_floor_nrmse);
+  root.add("final_nrmse", out.final_nrmse);
+  if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
+  json::Object method;
+  method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
+                                  " material points, elastic path to " +
+                                  fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);
+  method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
+  root.add("method", method.str(2));
+  root.add("scene", scene.to_json());
+  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
+  write_file_atomic((fs::path(opt.out_dir) / "fitted.toml").string(), out.fitted_toml);
+  std::string csv = "round,effect,nrmse,delta_aic,removed_fraction,significant,evaluations,params\n";
+  for (const CandidateResult& c : out.candidates) {
+    std::string p;
+    for (std::size_t j = 0; j < c.params.size(); ++j) p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.params[j]);
+    csv += std::to_string(c.round) + "," + c.effect + "," + json::num(c.nrmse) + "," + json::num(c.delta_aic) + "," +
+           json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "\n";
+  }
+  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.csv").string(), csv);
+  HistoryEntry h;
+  h.time_utc = utc_now();
+  h.source = "diagnose";
+  h.label = "diagnose baseline (reduced model)";
+  h.scene_hash = scene_hash(scene);
+  h.nrmse = out.baseline_nrmse;
+  h.trial_nrmse = out.baseline_nrmse_per_trial;
+  append_history(opt.out_dir, h);
+  if (!out.selected.empty()) {
+    h.label = "diagnose + " + out.selected.front() + (out.selected.size() > 1 ? " + " + out.selected[1] : "") +
+              " (reduced model)";
+    h.scene_hash = scene_hash(fitted);
+    h.nrmse = out.final_nrmse;
+    h.trial_nrmse.clear();
+    append_history(opt.out_dir, h);
+  }
+  return out;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,97 @@
+#pragma once
+// `pneufem diagnose`: which physical effect is the model missing?
+//
+// 1. The recording (analysis/measurements.h) is compared with the scene's model (the baseline):
+//    residual = model - measured at every kept frame (outlier frames dropped, analysis/compare.h).
+// 2. Every candidate effect of the catalog (app/effect_catalog.h: stiffness, viscoelastic,
+//    mullins, fatigue, pressure_lag, gravity and any registered material effect) is added to the
+//    scene and its few bounded parameters are calibrated (NLopt BOBYQA in [0, 1]-scaled, log where
+//    the catalog says so, after a coarse start grid) to minimise the residual sum of squares.
+// 3. Candidates are ranked by the error they leave. An information criterion makes extra
+//    parameters earn their place: AIC = n_eff ln(RSS / n_eff) + 2 k, where n_eff is the number of
+//    frames corrected for the residual's autocorrelation (AR(1): n (1 - rho) / (1 + rho)): 30 fps
+//    frames of a smooth model error are not independent, and counting them as such would make
+//    any parameter "significant". A candidate is significant when delta AIC <= aic_threshold
+//    (-10: "essentially no support" for the worse model, Burnham & Anderson) AND it removes at
+//    least min_removed of the baseline's error above the noise floor (in squared NRMSE), so a
+//    statistically detectable but physically negligible gain is not reported as a missing effect.
+// 4. Greedy forward selection: the best significant candidate is added (with its calibrated
+//    constants) and the remaining candidates are tried again on top of it, up to max_effects.
+// 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
+//    trials, creep inside holds, first-trial vs later, lag after steps, offset at rest,
+//    proportional error) and the error it removes.
+//
+// Calibration runs the reduced path model (engine/path_model.h: 1-dof Ritz model on the elastic
+// FEM path of the same mesh, using the scene's own material code), hundreds of times faster than
+// the FEM; `verify` re-runs the baseline and the fitted scene through the full FEM
+// (app/drive.h) and reports those NRMSEs too.
+//
+// Outputs in out_dir: diagnosis.json (schema in the README), fitted.toml (the scene plus the
+// selected effects; `pneufem compare fitted.toml --data FILE` shows the drop), diagnosis.csv
+// (one row per candidate and round), and one line in history.jsonl per model variant.
+#include <string>
+#include <vector>
+
+#include "analysis/measurements.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+struct DiagnoseOptions {
+  std::string data_path;
+  std::string out_dir;
+  std::vector<std::string> candidates;  ///< names to try (empty = the whole catalog)
+  int max_effects = 2;                  ///< greedy forward selection depth
+  int max_evaluations = 40;             ///< reduced-model runs per candidate calibration
+  double aic_threshold = -10.0;
+  double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
+  int rom_points = 2000;                ///< material points of the reduced model
+  bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
+  int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
+  int threads = 0;
+  bool progress = false;
+  std::string command_line;
+};
+
+struct CandidateResult {
+  std::string effect;
+  int round = 1;                        ///< 1 = on the baseline, 2 = on top of the first selection, ...
+  std::vector<std::string> param_names; ///< "<name>_<unit>"-free names, as in the catalog
+  std::vector<double> params;
+  std::vector<std::string> sets;        ///< scene overrides that add it with these values
+  double nrmse = 0.0;                   ///< pooled full time-series NRMSE with the effect
+  std::vector<double> nrmse_per_trial;
+  double rss_deg2 = 0.0;
+  double delta_aic = 0.0;               ///< vs the model of this round without it
+  double removed = 0.0;                 ///< fraction of the excess squared error removed
+  bool significant = false;
+  int evaluations = 0;
+  std::string why;
+  std::string error;                    ///< non-empty when the calibration failed
+};
+
+struct DiagnosisResult {
+  double baseline_nrmse = 0.0;
+  std::vector<double> baseline_nrmse_per_trial;
+  double noise_floor_nrmse = 0.0;
+  std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
+  std::vector<std::string> selected;
+  std::string missing_effect;               ///< "" = none significant
+  double final_nrmse = 0.0;                 ///< reduced model with the selected effects
+  double verified_baseline_nrmse = -1.0;    ///< full FEM (verify), -1 when not run
+  double verified_fitted_nrmse = -1.0;
+  std::vector<std::vector<double>> refined_params;  ///< per selected effect, after refinement
+  std::string fitted_toml;
+  double wall_s = 0.0;
+  long rom_runs = 0;
+};
+
+/// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
+/// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
+DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options);
+
+/// AR(1) effective sample size of a residual sequence (segments = trials): n (1 - rho)/(1 + rho),
+/// rho the lag-1 autocorrelation within segments, clamped to [min(n, 10), n].
+double effective_sample_size(const std::vector<double>& residual, const std::vector<int>& segment);
+
+}  // namespace pneufem

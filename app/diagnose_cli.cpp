@@ -1,0 +1,80 @@
+#include "app/diagnose_cli.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "materials/errors.h"
+
+namespace pneufem {
+
+std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
+  auto c = std::make_unique<DiagnoseCommand>();
+  c->cmd = app.add_subcommand(
+      "diagnose",
+      "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, mullins, "
+      "fatigue, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
+      "them by the error they remove with an information criterion, and writes diagnosis.json and fitted.toml");
+  c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
+      ->check(CLI::ExistingFile);
+  c->cmd->add_option("--data", c->options.data_path, "Measurements: canonical CSV trial,time_s,pressure_kPa,angle_deg")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->cmd->add_option("--out", c->options.out_dir, "Output directory (diagnosis.json, fitted.toml, diagnosis.csv, history.jsonl)")
+      ->required();
+  c->cmd->add_option("--set", c->sets, "Override a scene key, e.g. --set mesh.h_mm=4 (repeatable)");
+  c->cmd->add_option("--candidates", c->candidates, "Comma-separated candidate effects to try (default: all)");
+  c->cmd->add_option("--max-effects", c->options.max_effects, "Greedy forward selection: at most this many effects")
+      ->check(CLI::Range(1, 6))
+      ->capture_default_str();
+  c->cmd->add_option("--evaluations", c->options.max_evaluations, "Reduced-model runs per candidate calibration")
+      ->check(CLI::Range(5, 1000))
+      ->capture_default_str();
+  c->cmd->add_option("--aic-threshold", c->options.aic_threshold, "A candidate must lower the AIC by at least this")
+      ->capture_default_str();
+  c->cmd->add_option("--min-removed", c->options.min_removed,
+                     "... and remove at least this fraction of the squared error above the noise floor")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  c->cmd->add_option("--rom-points", c->options.rom_points, "Material points of the reduced model")
+      ->check(CLI::Range(100, 10000000))
+      ->capture_default_str();
+  c->cmd->add_flag("--verify", c->options.verify, "Also run the baseline and the fitted scene with the full FEM");
+  c->cmd->add_option("--refine", c->options.refine,
+                     "Full-FEM corrections of the selected effects' constants (space mapping; each costs one FEM run "
+                     "plus a verification); recommended for damage effects (mullins, fatigue)")
+      ->check(CLI::Range(0, 5))
+      ->capture_default_str();
+  c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
+  return c;
+}
+
+int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
+  c.options.command_line = command_line;
+  c.options.progress = isatty(2);
+  c.options.candidates.clear();
+  std::string cur;
+  for (char ch : c.candidates + ",") {
+    if (ch == ',') {
+      if (!cur.empty()) c.options.candidates.push_back(cur);
+      cur.clear();
+    } else if (ch != ' ') {
+      cur += ch;
+    }
+  }
+  const Scene scene = Scene::load(c.scene_path, c.sets);
+  const DiagnosisResult r = run_diagnosis(scene, c.options);
+  std::printf("diagnose: baseline NRMSE %.4f (noise floor %.4f)\n", r.baseline_nrmse, r.noise_floor_nrmse);
+  for (const CandidateResult& k : r.candidates)
+    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  %s\n", k.round, k.effect.c_str(), k.nrmse, k.delta_aic,
+                k.significant ? "significant" : "");
+  if (r.verified_fitted_nrmse >= 0)
+    std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
+  std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json and fitted.toml\n",
+              r.missing_effect.empty() ? "none" : r.missing_effect.c_str(), r.selected.size(), r.final_nrmse, r.wall_s,
+              c.options.out_dir.c_str());
+  return 0;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,88 @@
+#pragma once
+// Simulating a recording: the model is driven by the MEASURED inlet pressure of every trial (not
+// by the scene's own [load] section, which is ignored and replaced — the scene keeps its meaning
+// for everything else: mesh, materials, solver, rest between trials), and its bending angle is
+// returned at the recording's own frame times, ready to be compared frame by frame.
+//
+// Pressure path (per trial):
+//  1. running median over window_s (odd sample count >= 5): removes sensor noise and valve
+//     spikes but keeps edges (on any monotone stretch — a ramp, a plateau corner — the median IS
+//     the centre sample, so a noise-free staircase passes through unchanged);
+//  2. Ramer-Douglas-Peucker simplification to within `pressure_tolerance_kPa` (vertical
+//     deviation): each kept sample becomes one breakpoint of a piecewise-linear history, i.e. one
+//     static state, so 400 Hz of noise does not become thousands of states. Auto tolerance:
+//     max(3 sigma, 0.05 kPa), sigma = 1.4826 MAD(first differences)/sqrt(2) of the raw record
+//     (3 sigma of the raw noise is above what survives the median, so noise breakpoints are
+//     rare; 0.05 kPa is ~0.1 % of a 45 kPa staircase and bounds the pressure error of a
+//     noise-free record);
+//  3. extra states so that the solved states are at most max_report_gap_s apart wherever the
+//     pressure changes (ramps) and, for models with history (creep, damage: Assembler state
+//     non-empty), everywhere, so relaxation inside holds is resolved; for elastic models a hold
+//     at constant pressure has a constant angle and needs no extra states.
+// A scene with a chamber-pressure lag (load.pressure_lag_s, scenes/pressure_lag.h) filters the
+// measured inlet pressure through it, as it would its own load.
+// Trial times are the recording's (times before 0 are allowed: the trial clock is shifted for
+// the engine and shifted back). All trials run in order through ONE quasi-static run, so
+// internal variables carry over; between trials the pressure is released to 0 and held for the
+// scene's load.rest_s.
+//
+// The model angle at a frame time is the linear interpolation between the two solved states
+// around it (frames before the first / after the last state of the trial take that state's
+// angle). Physics failures propagate as PhysicsError; bad input (a trial without pressure)
+// throws InputError naming the data file and trial. Results do not depend on `threads`.
+#include <string>
+#include <vector>
+
+#include "analysis/measurements.h"
+#include "engine/load_history.h"
+#include "engine/mesh.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+struct DriveOptions {
+  double pressure_tolerance_kPa = 0.0;  ///< RDP tolerance; 0 = auto (see above)
+  double median_window_s = 0.05;        ///< running-median window of the pressure (20 samples at 400 Hz)
+  double max_report_gap_s = 0.25;       ///< solved states at least this dense (see above)
+  int threads = 0;                      ///< 0 = all cores
+  bool progress = false;                ///< progress line on stderr
+  std::string vtu_dir;                  ///< "" = no files; else VTU of the `vtu_worst` worst states
+  int vtu_worst = 3;                    ///< states with the largest |model - measured| angle
+};
+
+struct TrialTrace {
+  int trial = 0;
+  Series angle_deg;  ///< model angle at every measured angle time of this trial (same t_s)
+  Series states_angle_deg, states_pressure_kPa;  ///< the solved states (for plots)
+};
+
+/// One written VTU of a worst state.
+struct WorstState {
+  int trial = 0;
+  double time_s = 0.0, model_deg = 0.0, measured_deg = 0.0;
+  std::string file;  ///< path of the VTU
+};
+
+struct DriveResult {
+  std::vector<TrialTrace> trials;  ///< in the recording's order
+  long states = 0;                 ///< equilibria solved
+  double wall_s = 0.0;
+  std::string scene_text;          ///< resolved scene (TOML), with a header saying the load was replaced
+  double tolerance_kPa = 0.0;      ///< the RDP tolerance used (auto or given)
+  std::vector<WorstState> worst;   ///< VTU files written (empty without vtu_dir)
+  MeshStats mesh;                  ///< statistics of the model's mesh (regions: elements_per_region)
+};
+
+DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt);
+
+/// Steps 1-2 above for one pressure series (kPa): the kept breakpoints. `tolerance_kPa` <= 0
+/// means auto; the tolerance used is stored in *used_kPa when given.
+Series simplify_pressure(const Series& pressure_kPa, double tolerance_kPa, double median_window_s,
+                         double* used_kPa = nullptr);
+
+/// The load history the model is driven with (steps 1-3); `t_offset_s[k]` is the recording time
+/// of engine time 0 of trial k. `rate_dependent` adds the hold states of step 3.
+LoadHistory measured_load(const Recording& rec, const DriveOptions& opt, double rest_s, bool rate_dependent,
+                          std::vector<double>& t_offset_s, double* used_tolerance_kPa = nullptr);
+
+}  // namespace pneufem

@@ -1,0 +1,331 @@
+#include "engine/path_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "materials/errors.h"
+
+namespace pneufem {
+
+namespace {
+
+/// F at quadrature point q of element e (q = -1: volume-weighted mean of the element's points,
+/// the centroid value for Tet10 since F is linear there).
+Mat3 deformation_gradient(const Mesh& mesh, const ElementGeometry& geom, const Eigen::VectorXd& u, int e, int q) {
+  const int* n = mesh.element(e);
+  auto at = [&](int qq) {
+    const double* g = geom.grad(e, qq);
+    Mat3 F = Mat3::Identity();
+    for (int a = 0; a < geom.npe; ++a) F += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+    return F;
+  };
+  if (q >= 0) return at(q);
+  Mat3 F = Mat3::Zero();
+  double wsum = 0.0;
+  for (int qq = 0; qq < geom.nqp; ++qq) {
+    F += geom.w(e, qq) * at(qq);
+    wsum += geom.w(e, qq);
+  }
+  return F / wsum;
+}
+
+/// Material points grouped by material, so each group is one batched Material::evaluate.
+struct Groups {
+  std::vector<const Material*> material;
+  std::vector<std::vector<int>> points;
+  std::vector<std::size_t> state_offset;  ///< per group, into the run's state vector
+  std::size_t state_size = 0;
+};
+
+Groups group_points(const Model& model, const std::vector<int>& pt_element) {
+  Groups g;
+  std::vector<int> group_of_part(model.parts.size(), -1);
+  for (std::size_t i = 0; i < pt_element.size(); ++i) {
+    const int part = model.element_part[pt_element[i]];
+    if (group_of_part[part] < 0) {
+      group_of_part[part] = static_cast<int>(g.material.size());
+      g.material.push_back(model.parts[part].material.get());
+      g.points.emplace_back();
+    }
+    g.points[group_of_part[part]].push_back(static_cast<int>(i));
+  }
+  for (std::size_t k = 0; k < g.material.size(); ++k) {
+    g.state_offset.push_back(g.state_size);
+    g.state_size += g.points[k].size() * static_cast<std::size_t>(g.material[k]->state_size());
+  }
+  return g;
+}
+
+/// Generalised force sum_points w P(F(theta)) : F'(theta) over the points of `g`, F linear in
+/// theta on path segment k (a = (theta - theta_k) / dth, possibly outside [0, 1] when
+/// extrapolating). Reads/writes the groups' history in state_old/state_new when given.
+double generalised_force(const Groups& g, const Mat3* F0, const Mat3* F1, double a, double dth,
+                         const std::vector<double>& weight, const std::vector<int>& pt_element, const TimeStep& ts,
+                         const std::vector<double>* state_old, std::vector<double>* state_new, std::vector<Mat3>& Fbuf,
+                         std::vector<PointResponse>& rbuf) {
+  double G = 0.0;
+  for (std::size_t gi = 0; gi < g.material.size(); ++gi) {
+    const std::vector<int>& pts = g.points[gi];
+    Fbuf.resize(pts.size());
+    rbuf.resize(pts.size());
+    for (std::size_t j = 0; j < pts.size(); ++j) Fbuf[j] = F0[pts[j]] + a * (F1[pts[j]] - F0[pts[j]]);
+    const std::size_t ss = static_cast<std::size_t>(g.material[gi]->state_size()) * pts.size();
+    std::span<const double> so = state_old ? std::span<const double>(*state_old).subspan(g.state_offset[gi], ss)
+                                           : std::span<const double>();
+    std::span<double> sn = state_new ? std::span<double>(*state_new).subspan(g.state_offset[gi], ss) : std::span<double>();
+    g.material[gi]->evaluate(Fbuf, ts, so, sn, rbuf, false);
+    for (std::size_t j = 0; j < pts.size(); ++j) {
+      const Mat3 dF = (F1[pts[j]] - F0[pts[j]]) / dth;
+      const double c = weight[pts[j]] * (rbuf[j].P().cwiseProduct(dF)).sum();
+      if (!std::isfinite(c))
+        throw PhysicsError("reduced model: non-finite stress in element " + std::to_string(pt_element[pts[j]] + 1) +
+                               "; the material or its effects are out of their valid range",
+                           pt_element[pts[j]], ts.time_s);
+      G += c;
+    }
+  }
+  return G;
+}
+
+}  // namespace
+
+PathModel::PathModel(const Model& reference, const PathModelOptions& options) : ref_(reference), opt_(options) {
+  if (!(opt_.dp_Pa > 0.0) || !(opt_.p_top_Pa > opt_.dp_Pa) || opt_.max_points < 1 || !(opt_.max_dt_s > 0.0))
+    throw InputError("path model: need 0 < dp_Pa < p_top_Pa, max_points >= 1 and max_dt_s > 0");
+  const Assembler asmb(reference);
+  if (asmb.state_size() != 0)
+    throw InputError("path model: the reference model must be elastic (materials without history)");
+  StaticSolver solver(asmb, opt_.newton);
+  const Eigen::VectorXd& mass = asmb.lumped_mass();
+  auto first_moment = [&](const Eigen::VectorXd& u) {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (int a = 0; a < reference.mesh.num_nodes(); ++a) s += mass[a] * u.segment<3>(3 * a);
+    return s;
+  };
+
+  // 1. Trace the elastic path (load control; ends quietly at a limit point).
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(reference.num_dofs());
+  std::vector<double> state;
+  std::vector<Eigen::VectorXd> us = {u};
+  theta_ = {0.0};
+  p_ = {0.0};
+  V_ = {asmb.cavity_volume(u)};
+  S_ = {Eigen::Vector3d::Zero()};
+  for (double p = opt_.dp_Pa; p <= opt_.p_top_Pa + 1e-9; p += opt_.dp_Pa) {
+    Eigen::VectorXd trial = u;
+    try {
+      solver.advance(p_.back(), p, 0.0, 0.0, state, trial);
+    } catch (const PhysicsError&) {
+      break;  // limit point (or inversion) beyond this pressure: the path ends here
+    }
+    const double th = unwrap_deg(bending_angle(reference, trial).angle_deg, theta_.back());
+    if (!(th > theta_.back())) break;  // the angle must increase along the path
+    u = trial;
+    us.push_back(u);
+    theta_.push_back(th);
+    p_.push_back(p);
+    V_.push_back(asmb.cavity_volume(u));
+    S_.push_back(first_moment(u));
+  }
+  if (theta_.size() < 3)
+    throw PhysicsError("path model: the elastic path could not be traced beyond " + std::to_string(p_.back()) +
+                       " Pa; check the model with pneufem simulate first");
+
+  // 2. Material points.
+  const Mesh& mesh = reference.mesh;
+  const ElementGeometry& geom = asmb.geometry();
+  const int ne = mesh.num_elements();
+  if (static_cast<long>(ne) * geom.nqp <= opt_.max_points) {
+    for (int e = 0; e < ne; ++e)
+      for (int q = 0; q < geom.nqp; ++q) {
+        pt_element_.push_back(e);
+        pt_qp_.push_back(q);
+        pt_weight_.push_back(geom.w(e, q));
+      }
+  } else if (ne <= opt_.max_points) {
+    for (int e = 0; e < ne; ++e) {
+      pt_element_.push_back(e);
+      pt_qp_.push_back(-1);
+      pt_weight_.push_back(geom.volume[e]);
+    }
+  } else {
+    // Importance sample: probability pi_e = (volume share + energy share at the path's top) / 2;
+    // systematic sampling of n positions on the cumulative distribution; each pick carries the
+    // Horvitz-Thompson weight vol_e / (n pi_e), so sums over picks estimate volume integrals
+    // without bias, while the high-energy elements (where damage lives) are densely covered.
+    std::vector<double> energy(ne);
+    double vtot = 0.0, etot = 0.0;
+    for (int e = 0; e < ne; ++e) {
+      const Mat3 F = deformation_gradient(mesh, geom, us.back(), e, -1);
+      PointResponse r;
+      std::vector<double> none;
+      reference.material_of(e).evaluate(std::span<const Mat3>(&F, 1), TimeStep{}, none, none,
+                                        std::span<PointResponse>(&r, 1), false);
+      energy[e] = std::max(0.0, r.psi()) * geom.volume[e];
+      vtot += geom.volume[e];
+      etot += energy[e];
+    }
+    const int n = opt_.max_points;
+    double cum = 0.0;
+    int next = 0;
+    for (int e = 0; e < ne && next < n; ++e) {
+      const double pi = 0.5 * geom.volume[e] / vtot + (etot > 0.0 ? 0.5 * energy[e] / etot : 0.5 * geom.volume[e] / vtot);
+      cum += pi;
+      while (next < n && (next + 0.5) / n < cum) {
+        pt_element_.push_back(e);
+        pt_qp_.push_back(-1);
+        pt_weight_.push_back(geom.volume[e] / (n * pi));
+        ++next;
+      }
+    }
+  }
+  const std::size_t np = pt_element_.size();
+  F_.resize(np * theta_.size());
+  for (std::size_t k = 0; k < theta_.size(); ++k)
+    for (std::size_t i = 0; i < np; ++i) F_[k * np + i] = deformation_gradient(mesh, geom, us[k], pt_element_[i], pt_qp_[i]);
+
+  // 3. The reference's generalised force on a fine grid of each segment: the difference form
+  // needs G_ref at every residual evaluation, and it never changes.
+  const Groups gr = group_points(reference, pt_element_);
+  std::vector<Mat3> Fbuf;
+  std::vector<PointResponse> rbuf;
+  Gref_.resize((theta_.size() - 1) * (kRefSub + 1));
+  for (std::size_t k = 0; k + 1 < theta_.size(); ++k)
+    for (int j = 0; j <= kRefSub; ++j)
+      Gref_[k * (kRefSub + 1) + j] =
+          generalised_force(gr, F_.data() + k * np, F_.data() + (k + 1) * np, static_cast<double>(j) / kRefSub,
+                            theta_[k + 1] - theta_[k], pt_weight_, pt_element_, TimeStep{}, nullptr, nullptr, Fbuf, rbuf);
+}
+
+int PathModel::segment(double theta) const {
+  const auto it = std::upper_bound(theta_.begin(), theta_.end(), theta);
+  const int k = static_cast<int>(it - theta_.begin()) - 1;
+  return std::clamp(k, 0, static_cast<int>(theta_.size()) - 2);
+}
+
+std::vector<double> PathModel::run(const Model& model, const PathLoad& load, PathRunStats* stats) const {
+  if (model.mesh.num_elements() != ref_.mesh.num_elements() || model.mesh.num_nodes() != ref_.mesh.num_nodes())
+    throw InputError("path model: the model's mesh differs from the reference mesh the path was traced on");
+  if (load.t_s.size() != load.p_Pa.size() || load.t_s.empty())
+    throw InputError("path model: the load needs as many times as pressures, at least one");
+  for (std::size_t i = 1; i < load.t_s.size(); ++i)
+    if (!(load.t_s[i] > load.t_s[i - 1])) throw InputError("path model: load times must increase strictly");
+
+  const std::size_t np = pt_element_.size();
+  const Groups gm = group_points(model, pt_element_);
+  const Groups gr = group_points(ref_, pt_element_);  // for extrapolation beyond the path
+  std::vector<double> state_old(gm.state_size), state_new(gm.state_size);
+  for (std::size_t k = 0; k < gm.material.size(); ++k) {
+    const int ss = gm.material[k]->state_size();
+    for (std::size_t j = 0; j < gm.points[k].size(); ++j)
+      gm.material[k]->init_state(std::span<double>(state_new).subspan(gm.state_offset[k] + j * ss, ss));
+  }
+  state_old = state_new;
+  PathRunStats st;
+  std::vector<Mat3> Fbuf;
+  std::vector<PointResponse> rbuf;
+
+  // Equilibrium residual in pressure units (Pa): p_el + (G_model - G_ref - g.S') / V' - p.
+  auto residual = [&](double theta, double p, const TimeStep& ts) {
+    ++st.evaluations;
+    const int k = segment(theta);
+    const double dth = theta_[k + 1] - theta_[k], a = (theta - theta_[k]) / dth;
+    const double p_el = p_[k] + a * (p_[k + 1] - p_[k]);
+    const double dV = (V_[k + 1] - V_[k]) / dth;
+    const double gS = model.gravity_m_s2.dot(S_[k + 1] - S_[k]) / dth;
+    const Mat3* F0 = F_.data() + k * np;
+    const double Gm = generalised_force(gm, F0, F0 + np, a, dth, pt_weight_, pt_element_, ts, &state_old, &state_new,
+                                        Fbuf, rbuf);
+    double Gr = 0.0;
+    if (a >= 0.0 && a <= 1.0) {  // cached reference force, linear between kRefSub sub-points
+      const double x = a * kRefSub;
+      const int j = std::min(static_cast<int>(x), kRefSub - 1);
+      const double* c = Gref_.data() + static_cast<std::size_t>(k) * (kRefSub + 1);
+      Gr = c[j] + (x - j) * (c[j + 1] - c[j]);
+    } else {
+      Gr = generalised_force(gr, F0, F0 + np, a, dth, pt_weight_, pt_element_, TimeStep{}, nullptr, nullptr, Fbuf, rbuf);
+    }
+    const double dG = Gm - Gr;
+    return p_el + (dG - gS) / dV - p;
+  };
+
+  const double p_scale = std::max(1.0, p_.back());
+  const double tol_Pa = 1e-7 * p_scale, tol_theta = 1e-9 * std::max(1.0, theta_.back());
+  double theta = 0.0, ratio = 1.0;
+  std::vector<double> out;
+  out.reserve(load.t_s.size());
+  // Equilibrium at (t, p) after a physical step dt from the committed state: a bracketed secant
+  // (Illinois) on the scalar residual; leaves the trial state of the root in state_new.
+  auto solve = [&](double t, double dt, double p) {
+    const TimeStep ts{t, dt};
+    double x0 = theta, f0 = residual(x0, p, ts);
+    if (std::abs(f0) > tol_Pa) {
+      const int k = segment(x0);
+      // Initial slope: the elastic path's, times the softening ratio seen at the last step.
+      double slope = ratio * (p_[k + 1] - p_[k]) / (theta_[k + 1] - theta_[k]);
+      double x1 = x0 - f0 / slope, f1 = residual(x1, p, ts);
+      int it = 0;
+      const double span = theta_.back() - theta_.front();
+      while (f0 * f1 > 0.0) {  // extrapolate until the root is bracketed
+        if (++it > 60 || std::abs(x1) > 20.0 * span + 360.0)
+          throw PhysicsError("reduced model: no equilibrium on the elastic path at t = " + std::to_string(t) +
+                                 " s, p = " + std::to_string(p) + " Pa (the softened model may have passed its limit "
+                                 "point); use the full FEM (pneufem simulate) to check this case",
+                             -1, t);
+        double s = (f1 - f0) / (x1 - x0);
+        if (!(s > 0.0)) s = slope;
+        double x2 = x1 - f1 / s;
+        const double max_step = 4.0 * std::abs(x1 - x0) + 1.0;
+        x2 = std::clamp(x2, x1 - max_step, x1 + max_step);
+        x0 = x1, f0 = f1;
+        x1 = x2, f1 = residual(x1, p, ts);
+      }
+      // Illinois false position inside [x0, x1].
+      int side = 0;
+      for (it = 0; it < 100 && std::abs(f1) > tol_Pa && std::abs(x1 - x0) > tol_theta; ++it) {
+        const double x2 = (x0 * f1 - x1 * f0) / (f1 - f0);
+        const double f2 = residual(x2, p, ts);
+        if (f2 * f1 < 0.0) {
+          x0 = x1, f0 = f1;
+          side = 0;
+        } else if (++side >= 2) {
+          f0 *= 0.5;
+        }
+        x1 = x2, f1 = f2;
+      }
+      if (x1 != x0) {
+        const int kk = segment(x1);
+        const double s_el = (p_[kk + 1] - p_[kk]) / (theta_[kk + 1] - theta_[kk]);
+        const double s_now = (f1 - f0) / (x1 - x0);
+        if (s_now > 0.0 && std::isfinite(s_now)) ratio = std::clamp(s_now / s_el, 0.05, 20.0);
+      }
+      x0 = x1;
+      residual(x0, p, ts);  // leaves the root's trial state in state_new
+    }
+    theta = x0;
+    if (theta > theta_.back() || theta < theta_.front()) st.beyond_path = true;
+    state_old.swap(state_new);  // commit
+    ++st.steps;
+  };
+
+  solve(load.t_s[0], 0.0, load.p_Pa[0]);
+  out.push_back(theta);
+  for (std::size_t i = 1; i < load.t_s.size(); ++i) {
+    const double t0 = load.t_s[i - 1], t1 = load.t_s[i];
+    const int m = std::max(1, static_cast<int>(std::ceil((t1 - t0) / opt_.max_dt_s - 1e-9)));
+    for (int j = 1; j <= m; ++j) {
+      const double f = static_cast<double>(j) / m;
+      const double t = t0 + f * (t1 - t0);
+      solve(t, (t1 - t0) / m, load.p_Pa[i - 1] + f * (load.p_Pa[i] - load.p_Pa[i - 1]));
+    }
+    out.push_back(theta);
+  }
+  if (stats) *stats = st;
+  return out;
+}
+
+}  // namespace pneufem

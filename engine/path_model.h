@@ -1,0 +1,91 @@
+#pragma once
+// A one-degree-of-freedom Ritz model along the elastic loading path — the fast evaluator that
+// calibration loops (pneufem diagnose) run hundreds of times instead of the full FEM.
+//
+// Idea. A pneu-net inflating under cavity pressure deforms along one dominant mode. The elastic
+// FEM solution u_el(p) traces a curve through displacement space; parametrised by its bending
+// angle theta it is the "path" u(theta). The reduced model keeps the deformation on this path
+// and only asks, at every physical time, WHICH point of the path is in equilibrium with the
+// current pressure, when the materials carry history (creep, Mullins, fatigue) or are scaled.
+// Virtual work along the path gives one scalar equation (G = generalised force, V = cavity
+// volume, S = sum_a m_a u_a the first mass moment of the displacement):
+//
+//     G_model(theta, history) = p V'(theta) + g . S'(theta)
+//
+// with G_model(theta) = sum_points w P(F(theta)) : F'(theta) evaluated with the scene's own
+// Material objects (the same decorators as the FEM, so any registered effect works). For the
+// reference (elastic) model the exact FEM identity G_ref(theta) = p_el(theta) V'(theta) holds,
+// so we solve the equation in difference form, which is EXACT for the reference model whatever
+// the quadrature of the reduced sum:
+//
+//     p_el(theta) + [G_model(theta) - G_ref(theta) - g . S'(theta)] / V'(theta) = p(t).
+//
+// Approximation: a model whose deformation leaves the elastic path (e.g. strongly localised
+// damage) is represented by its best path point (Ritz/Galerkin: first order in the shape change
+// for the angle, second order for the energy). Tests bound the angle error against the FEM for
+// every built-in effect. Material points: all quadrature points of small meshes; above
+// `max_points`, an importance sample of elements (probability ~ half volume share + half
+// strain-energy share at the top of the path, Horvitz-Thompson weights), deterministic.
+//
+// Units: SI; angles in degrees at the interface.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/model.h"
+#include "engine/static_solver.h"
+
+namespace pneufem {
+
+struct PathModelOptions {
+  double p_top_Pa = 60e3;        ///< trace the elastic path up to this pressure (or the limit point)
+  double dp_Pa = 1000.0;         ///< pressure spacing of the path samples
+  int max_points = 6000;         ///< material points kept (importance-sampled above this)
+  double max_dt_s = 0.25;        ///< largest physical sub-step of the history integration
+  StaticOptions newton;          ///< for tracing the path
+};
+
+/// A pressure history to replay: chamber pressure p_Pa[i] at global time t_s[i] (strictly
+/// increasing; linear in between); the model angle is returned at every t_s[i].
+struct PathLoad {
+  std::vector<double> t_s, p_Pa;
+};
+
+struct PathRunStats {
+  long steps = 0;
+  long evaluations = 0;
+  bool beyond_path = false;  ///< the solution left the traced path (extrapolated): trust it less
+};
+
+class PathModel {
+ public:
+  /// Traces the elastic path of `reference` (materials without history, no gravity) with Newton.
+  /// Stops early, without error, at a limit point (the path then ends there).
+  PathModel(const Model& reference, const PathModelOptions& options);
+
+  /// Angle history (deg) of `model` — same mesh as the reference, any materials and gravity —
+  /// under `load`. Throws InputError when the mesh differs, PhysicsError when no path point
+  /// balances the load (e.g. the pressure exceeds what the softened actuator can carry).
+  std::vector<double> run(const Model& model, const PathLoad& load, PathRunStats* stats = nullptr) const;
+
+  /// The traced path: angle (deg) and pressure (Pa) of each sample.
+  const std::vector<double>& path_angle_deg() const { return theta_; }
+  const std::vector<double>& path_pressure_Pa() const { return p_; }
+  int num_points() const { return static_cast<int>(pt_element_.size()); }
+
+ private:
+  int segment(double theta) const;  ///< path segment holding theta (clamped: linear extrapolation)
+
+  const Model& ref_;
+  PathModelOptions opt_;
+  std::vector<double> theta_, p_, V_;       ///< per path sample
+  std::vector<Eigen::Vector3d> S_;          ///< first mass moment of u per sample (kg m)
+  std::vector<int> pt_element_;             ///< element of each material point
+  std::vector<int> pt_qp_;                  ///< its quadrature point (-1 = element centroid)
+  std::vector<double> pt_weight_;           ///< quadrature weight (m^3)
+  std::vector<Mat3> F_;                     ///< [sample][point]
+  static constexpr int kRefSub = 16;        ///< cached reference force: sub-points per segment
+  std::vector<double> Gref_;                ///< [segment][kRefSub + 1]
+};
+
+}  // namespace pneufem

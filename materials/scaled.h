@@ -1,0 +1,44 @@
+#pragma once
+// A stiffness scale s > 0 on any material: psi_s = s psi, P_s = s P, A_s = s A (isochoric and
+// volumetric parts alike, so every modulus - shear and bulk - is multiplied by s).
+//
+// Why a decorator and not a per-law factor: every law (Yeoh, Ogden, St Venant-Kirchhoff, ...) gets
+// the same exact scaling from one small class, and the factor is 1 multiplication per stress entry.
+// Exact property used by the tests: for a hyperelastic body under pressure p alone, the scaled body
+// at pressure s p has the unscaled body's equilibrium at p (the residual s f_int(u) - s p g(u) = 0).
+//
+// Placement (scenes/build_model.cpp): the scale wraps the hyperelastic BASE and sits inside the
+// inelastic decorators, mullins(scaled(yeoh)) etc. Their energy thresholds (Mullins m, fatigue
+// W_th) therefore act on the scaled energy: a softer material reaches a fixed threshold later, as a
+// physically softer silicone would. The state layout is the base's (ScaledMaterial owns no state).
+#include "materials/material.h"
+
+namespace pneufem {
+
+class ScaledMaterial final : public Material {
+ public:
+  /// Throws InputError unless base is non-null and scale is finite and > 0.
+  ScaledMaterial(MaterialPtr base, double scale);
+
+  std::string name() const override;
+  int state_size() const override { return base_->state_size(); }
+  void init_state(std::span<double> state) const override { base_->init_state(state); }
+  void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
+                std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
+  PointFields fields(std::span<const double> state) const override { return base_->fields(state); }
+  double initial_shear_modulus() const override { return scale_ * base_->initial_shear_modulus(); }
+  double initial_bulk_modulus() const override { return scale_ * base_->initial_bulk_modulus(); }
+  bool is_split() const override { return base_->is_split(); }
+
+  double scale() const { return scale_; }
+  const MaterialPtr& base() const { return base_; }
+
+ private:
+  MaterialPtr base_;
+  double scale_;
+};
+
+/// `base` itself when scale == 1 (bit-for-bit the unscaled law), else a ScaledMaterial.
+MaterialPtr scale_material(MaterialPtr base, double scale);
+
+}  // namespace pneufem

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Regenerates the hidden-effect datasets of tests/app/test_diagnose.cpp with `pneufem synth`
+# (full FEM, noise, controller overshoot, outlier frames). Small scene so the tests fit in CI;
+# truth values chosen so each effect changes the angle well above the tracking noise on it.
+# Usage: scripts/make_hidden_datasets.sh [path/to/pneufem]   (takes ~20 min on 2 cores)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+EXE=${1:-build/app/pneufem}
+OUT=tests/data/hidden
+mkdir -p "$OUT"
+SCENE=(--set geometry.chambers=5 --set mesh.h_mm=6 --set load.max_kPa=30 --set load.step_kPa=10
+       --set load.hold_s=4 --set load.trials=3)
+RIG=(--pressure-rate 200 --angle-noise 0.05 --seed 7)
+gen() {  # name hidden extra-sets...
+  local name=$1 hidden=$2; shift 2
+  echo "== $name"
+  "$EXE" synth --hidden "$hidden" "${SCENE[@]}" "${RIG[@]}" "$@" --out "$OUT/$name.csv"
+}
+gen none none
+gen stiffness stiffness
+gen viscoelastic viscoelastic
+gen pressure_lag pressure_lag
+gen gravity gravity
+gen mullins mullins --set materials.silicone.mullins.m_MPa=0.001
+gen fatigue fatigue --set materials.silicone.fatigue.W_th_MPa=0.008 --set materials.silicone.fatigue.tau_s=200.0 --set solver.max_iterations=30

@@ -1,0 +1,329 @@
+// `pneufem compare` end to end: a tiny scene against a canonical CSV made from the model itself
+// (its staircase sampled at 400 Hz / 30 fps, driven through simulate_recording) plus a known
+// perturbation of the angle, so the metrics are non-trivial. The CLI's metrics.json must equal
+// the library's numbers, report.html must be well-formed and hold every figure, history.jsonl
+// must grow by one line per run, and malformed data must fail cleanly without touching DIR.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "analysis/compare.h"
+#include "app/compare.h"
+#include "app/compare_dlc.h"
+#include "app/drive.h"
+#include "materials/errors.h"
+#include "scenes/build_model.h"
+
+namespace pneufem {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code;
+  std::string out;
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(PNEUFEM_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (p && fgets(buf, sizeof buf, p)) out += buf;
+  const int status = p ? pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+long lines(const fs::path& p) {
+  const std::string s = slurp(p);
+  return static_cast<long>(std::count(s.begin(), s.end(), '\n'));
+}
+
+/// The number after the top-level key (two-space indent) of our metrics.json.
+double top_number(const std::string& json, const std::string& key) {
+  const std::string k = "\n  \"" + key + "\": ";
+  const std::size_t p = json.find(k);
+  if (p == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + p + k.size(), nullptr);
+}
+
+/// Tag balance of an HTML page with inline SVG: every non-void element closed in order.
+std::string html_problem(const std::string& h) {
+  static const std::vector<std::string> kVoid = {"meta", "br", "hr", "img", "input", "link"};
+  std::vector<std::string> stack;
+  for (std::size_t i = h.find('<'); i != std::string::npos; i = h.find('<', i + 1)) {
+    if (h.compare(i, 4, "<!--") == 0 || h.compare(i, 2, "<!") == 0 || h.compare(i, 2, "<?") == 0) continue;
+    const std::size_t e = h.find('>', i);
+    if (e == std::string::npos) return "unterminated tag";
+    const bool closing = h[i + 1] == '/';
+    const std::size_t n0 = i + (closing ? 2 : 1);
+    std::size_t n1 = n0;
+    while (n1 < e && (std::isalnum(static_cast<unsigned char>(h[n1])) || h[n1] == '-')) ++n1;
+    const std::string name = h.substr(n0, n1 - n0);
+    if (name.empty()) return "bad tag at " + std::to_string(i);
+    if (closing) {
+      if (stack.empty() || stack.back() != name) return "unexpected </" + name + "> at " + std::to_string(i);
+      stack.pop_back();
+    } else if (h[e - 1] != '/' && std::find(kVoid.begin(), kVoid.end(), name) == kVoid.end()) {
+      stack.push_back(name);
+    }
+  }
+  return stack.empty() ? "" : "unclosed <" + stack.back() + ">";
+}
+
+const char* kScene = R"([geometry]
+chambers = 3
+[mesh]
+h_mm = 6.0
+[load]
+max_kPa = 10.0
+step_kPa = 5.0
+hold_s = 4.0
+ramp_s = 0.5
+trials = 2
+)";
+
+class CompareCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("pneufem_compare_cli_" + std::to_string(::getpid())));
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_);
+    std::ofstream(*dir_ / "tiny.toml") << kScene;
+    const Scene scene = Scene::load((*dir_ / "tiny.toml").string());
+    const std::unique_ptr<BuiltModel> bm = build_model(scene);
+    Recording rec;
+    rec.source = "model";
+    for (std::size_t k = 0; k < bm->load.trials.size(); ++k) {
+      const TrialLoad& tl = bm->load.trials[k];
+      TrialRecording tr;
+      tr.trial = static_cast<int>(k + 1);
+      for (long i = 0; i <= std::lround(tl.duration() * 400); ++i) {
+        tr.pressure_kPa.t_s.push_back(i / 400.0);
+        tr.pressure_kPa.value.push_back(tl.pressure(i / 400.0) * 1e-3);
+      }
+      for (long j = 0; j / 30.0 <= tl.duration(); ++j) {
+        tr.angle_deg.t_s.push_back(j / 30.0);
+        tr.angle_deg.value.push_back(0.0);
+      }
+      rec.trials.push_back(tr);
+    }
+    const DriveResult model = simulate_recording(scene, rec, DriveOptions{});
+    // Known perturbation: trial 1 = model + a slow wobble, trial 2 = a 5 % stiffer-looking
+    // actuator (model / 1.05) lagging by a constant 0.2 deg.
+    for (std::size_t k = 0; k < rec.trials.size(); ++k)
+      for (std::size_t j = 0; j < rec.trials[k].angle_deg.t_s.size(); ++j) {
+        const double t = rec.trials[k].angle_deg.t_s[j], m = model.trials[k].angle_deg.value[j];
+        rec.trials[k].angle_deg.value[j] = k == 0 ? m + 0.1 * std::sin(t) : m / 1.05 - 0.2;
+      }
+    write_measurements_csv((*dir_ / "data.csv").string(), rec);
+    std::vector<Series> traces;
+    for (const TrialTrace& t : model.trials) traces.push_back(t.angle_deg);
+    expected_ = new Comparison(compare_recording(read_measurements_csv((*dir_ / "data.csv").string()), traces));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete expected_;
+    delete dir_;
+  }
+  static fs::path* dir_;
+  static Comparison* expected_;
+};
+fs::path* CompareCli::dir_ = nullptr;
+Comparison* CompareCli::expected_ = nullptr;
+
+TEST_F(CompareCli, WritesEverythingAndMatchesTheLibrary) {
+  const fs::path out = *dir_ / "out";
+  const std::string args = "compare " + (*dir_ / "tiny.toml").string() + " --data " + (*dir_ / "data.csv").string() +
+                           " --out " + out.string() + " --threads 2";
+  const Result r = run(args);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* f : {"metrics.json", "metrics.csv", "report.html", "history.jsonl", "scene.toml", "fig_trial_1.svg",
+                        "fig_trial_2.svg", "fig_angle_pressure.svg", "fig_nrmse.svg", "fig_abs_error.svg",
+                        "fig_error_spread.svg", "fig_residual_map.svg", "fig_residual_profile.svg", "fig_history.svg"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_TRUE(fs::exists(out / "vtu" / "worst_1.vtu"));
+  const std::string m = slurp(out / "metrics.json");
+  // Same data (the CSV round-trips bit for bit), same deterministic model: equal numbers.
+  EXPECT_DOUBLE_EQ(top_number(m, "nrmse"), expected_->nrmse);
+  EXPECT_DOUBLE_EQ(top_number(m, "rss_deg2"), expected_->rss_deg2);
+  EXPECT_EQ(top_number(m, "n"), static_cast<double>(expected_->n));
+  EXPECT_DOUBLE_EQ(top_number(m, "noise_floor_nrmse"), expected_->noise_floor_nrmse);
+  EXPECT_GT(expected_->nrmse, 1e-3) << "the perturbation must show";
+  ASSERT_EQ(expected_->trials.size(), 2u);
+  EXPECT_NE(m.find("\"nrmse_mark\": "), std::string::npos);
+  // metrics.csv: header + one row per trial x step.
+  long rows = 1;
+  for (const TrialComparison& t : expected_->trials) rows += static_cast<long>(t.steps.size());
+  EXPECT_EQ(lines(out / "metrics.csv"), rows);
+
+  const std::string html = slurp(out / "report.html");
+  EXPECT_EQ(html_problem(html), "");
+  std::size_t figs = 0;
+  for (const auto& e : fs::directory_iterator(out))
+    if (e.path().extension() == ".svg") ++figs;
+  std::size_t inlined = 0;
+  for (std::size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1)) ++inlined;
+  EXPECT_EQ(inlined, figs);
+  for (const char* s : {"Summary", "Where it fails", "Region sensitivity", "History"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);  // nothing loaded from elsewhere
+
+  EXPECT_EQ(lines(out / "history.jsonl"), 1);
+  const Result again = run(args + " --label second");
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_EQ(lines(out / "history.jsonl"), 2);
+  const std::vector<HistoryEntry> h = read_history(out.string());
+  ASSERT_EQ(h.size(), 2u);
+  EXPECT_EQ(h[0].label, "tiny.toml");
+  EXPECT_EQ(h[1].label, "second");
+  EXPECT_EQ(h[0].scene_hash, h[1].scene_hash);
+  EXPECT_DOUBLE_EQ(h[1].nrmse, expected_->nrmse);
+  EXPECT_EQ(h[1].trial_nrmse.size(), 2u);
+
+  // Malformed data: exit 2 naming file and line; DIR untouched (no temporary files, same history).
+  std::ofstream(*dir_ / "bad.csv") << "trial,time_s,pressure_kPa,angle_deg\n1,0,0.1,0\n1,0.0025,abc,\n";
+  const Result bad = run("compare " + (*dir_ / "tiny.toml").string() + " --data " + (*dir_ / "bad.csv").string() +
+                         " --out " + out.string());
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("bad.csv:3:"), std::string::npos) << bad.out;
+  EXPECT_EQ(lines(out / "history.jsonl"), 2);
+  for (const auto& e : fs::directory_iterator(out)) EXPECT_NE(e.path().extension(), ".tmp") << e.path();
+  const fs::path fresh = *dir_ / "fresh";
+  EXPECT_EQ(run("compare --data " + (*dir_ / "bad.csv").string() + " --out " + fresh.string()).code, 2);
+  EXPECT_FALSE(fs::exists(fresh));
+}
+
+TEST_F(CompareCli, RegionSensitivityFindsAPerturbedRegion) {
+  // Measured = the model with the roof 5 % softer. Linearised about scale 1 with the 0.9
+  // sensitivity, the roof's best scale is 0.95 up to the curvature of angle(scale) over
+  // [0.9, 1] (a few 1e-3 for a smooth response), and it explains nearly all of the residual.
+  const Scene scene = Scene::load((*dir_ / "tiny.toml").string());
+  Recording rec = read_measurements_csv((*dir_ / "data.csv").string());
+  const DriveResult soft = simulate_recording(scene.with({"regions.roof.stiffness_scale=0.95"}), rec, DriveOptions{});
+  for (std::size_t k = 0; k < rec.trials.size(); ++k) rec.trials[k].angle_deg = soft.trials[k].angle_deg;
+  write_measurements_csv((*dir_ / "soft.csv").string(), rec);
+  CompareRunOptions opt;
+  opt.data_path = (*dir_ / "soft.csv").string();
+  opt.out_dir = (*dir_ / "regions").string();
+  opt.regions = true;
+  const CompareRunResult r = run_compare(scene, opt);
+  ASSERT_GE(r.regions.size(), 2u);
+  const auto roof = std::find_if(r.regions.begin(), r.regions.end(), [](const RegionSensitivity& g) {
+    return g.region == "roof";
+  });
+  ASSERT_NE(roof, r.regions.end());
+  EXPECT_NEAR(roof->best_scale, 0.95, 0.01);
+  EXPECT_GT(roof->variance_fraction, 0.99);
+  const std::string m = slurp(*dir_ / "regions" / "metrics.json");
+  EXPECT_NE(m.find("\"region\": \"roof\""), std::string::npos);
+  EXPECT_NE(slurp(*dir_ / "regions" / "report.html").find("fig_regions"), std::string::npos);
+}
+
+TEST(CompareHistory, AppendsAndReadsBack) {
+  const fs::path d = fs::temp_directory_path() / ("pneufem_history_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  HistoryEntry e;
+  e.time_utc = "2026-01-01T00:00:00Z";
+  e.label = "quote \" and \\ backslash";
+  e.scene_hash = "0123456789abcdef";
+  e.nrmse = 0.125;
+  e.trial_nrmse = {0.1, std::nan(""), 0.15};
+  e.source = "diagnose";
+  append_history(d.string(), e);
+  append_history(d.string(), e);
+  const std::vector<HistoryEntry> h = read_history(d.string());
+  ASSERT_EQ(h.size(), 2u);
+  EXPECT_EQ(h[1].label, e.label);
+  EXPECT_EQ(h[1].source, "diagnose");
+  EXPECT_EQ(h[1].nrmse, 0.125);
+  ASSERT_EQ(h[1].trial_nrmse.size(), 3u);
+  EXPECT_TRUE(std::isnan(h[1].trial_nrmse[1]));
+  fs::remove_all(d);
+}
+
+/// DeepLabCut CSV: fixed parts f1, f2 straight down the screen, tip parts t1, t2 rotated by
+/// theta_k counter-clockwise on the screen (image y points down).
+std::string dlc_text(const std::vector<double>& theta_deg) {
+  std::string s = "scorer";
+  for (int i = 0; i < 12; ++i) s += ",net";
+  s += "\nbodyparts,f1,f1,f1,f2,f2,f2,t1,t1,t1,t2,t2,t2\ncoords";
+  for (int i = 0; i < 4; ++i) s += ",x,y,likelihood";
+  s += "\n";
+  char buf[256];
+  for (std::size_t k = 0; k < theta_deg.size(); ++k) {
+    const double a = theta_deg[k] * 3.14159265358979323846 / 180.0;
+    // (X, Y) with Y up: fixed direction (0, -1); tip direction (sin a, -cos a) = (0, -1) turned by a.
+    const double tx = 200.0, ty = -300.0, dx = 50.0 * std::sin(a), dy = -50.0 * std::cos(a);
+    std::snprintf(buf, sizeof buf, "%zu,100,100,0.99,100,200,0.99,%.6f,%.6f,0.99,%.6f,%.6f,0.99\n", k, tx, -ty, tx + dx,
+                  -(ty + dy));
+    s += buf;
+  }
+  return s;
+}
+
+TEST(CompareDlc, MapReplacesTheAnglesOfItsTrials) {
+  const fs::path d = fs::temp_directory_path() / ("pneufem_dlc_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  std::vector<double> theta(40, 0.0);
+  for (std::size_t k = 15; k < theta.size(); ++k) theta[k] = 3.0 * static_cast<double>(k - 15);
+  std::ofstream(d / "t2.csv") << dlc_text(theta);
+  std::ofstream(d / "map.toml") << "fixed_parts = [\"f1\", \"f2\"]\ntip_parts = [\"t1\", \"t2\"]\nfps = 20.0\n"
+                                   "[[trials]]\ntrial = 2\nfile = \"t2.csv\"\nt0_s = 0.5\n";
+  Recording p;
+  p.source = "p.csv";
+  for (int n = 1; n <= 2; ++n) {
+    TrialRecording tr;
+    tr.trial = n;
+    tr.pressure_kPa = {{0.0, 1.0, 2.0}, {0.0, 5.0, 5.0}};
+    tr.angle_deg = {{0.0}, {7.0}};
+    p.trials.push_back(tr);
+  }
+  const Recording r = merge_deeplabcut(p, (d / "map.toml").string());
+  EXPECT_EQ(r.trials[0].angle_deg.value, std::vector<double>{7.0});  // unmapped trial keeps its CSV angle
+  const Series& a = r.trials[1].angle_deg;
+  ASSERT_EQ(a.t_s.size(), theta.size());
+  // Coordinates carry 6 decimals on 50-100 px segments: ~1e-8 rad, so 1e-4 deg is rounding only.
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    EXPECT_NEAR(a.t_s[k], 0.5 + static_cast<double>(k) / 20.0, 1e-12);
+    EXPECT_NEAR(a.value[k], theta[k], 1e-4) << "frame " << k;
+  }
+  // Errors name the map file, line and key.
+  std::ofstream(d / "bad.toml") << "fixed_parts = [\"f1\", \"f2\"]\ntip_parts = [\"t1\", \"t2\"]\nfsp = 30\n";
+  try {
+    merge_deeplabcut(p, (d / "bad.toml").string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml:3:1: key 'fsp': unknown key"), std::string::npos) << e.what();
+  }
+  std::ofstream(d / "bad2.toml") << "fixed_parts = [\"f1\", \"f2\"]\ntip_parts = [\"t1\", \"t2\"]\n"
+                                    "[[trials]]\ntrial = 9\nfile = \"t2.csv\"\n";
+  try {
+    merge_deeplabcut(p, (d / "bad2.toml").string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad2.toml:4:9: key 'trials.trial': trial 9 has no pressure in p.csv"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(d);
+}
+
+}  // namespace
+}  // namespace pneufem

@@ -1,0 +1,146 @@
+// pneufem diagnose on recordings with a hidden effect. The datasets in tests/data/hidden were made
+// by `pneufem synth` (scripts/make_hidden_datasets.sh): the FULL FEM of a small pneu-net with the
+// effect switched on, driven by a simulated controller (overshoot), sampled at 200 Hz / 30 fps
+// with sensor noise, tracking noise (0.05 deg) and outlier frames. Diagnose does not know the
+// truth; it calibrates every candidate with the reduced path model and must
+//   * rank the hidden effect first and call it the missing effect (none for the control data),
+//   * bring the error down to near the noise floor,
+//   * recover constants near the truth.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "app/diagnose.h"
+#include "app/effect_catalog.h"
+#include "scenes/scene.h"
+
+namespace fs = std::filesystem;
+
+namespace pneufem {
+namespace {
+
+// The scene the datasets were generated with (scripts/make_hidden_datasets.sh), effects off.
+const std::vector<std::string> kScene = {"geometry.chambers=5", "mesh.h_mm=6.0",  "load.max_kPa=30.0",
+                                         "load.step_kPa=10.0",  "load.hold_s=4.0", "load.trials=3"};
+
+std::string data(const std::string& name) { return std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/" + name + ".csv"; }
+
+DiagnosisResult diagnose(const std::string& name, int refine = 0) {
+  DiagnoseOptions o;
+  o.data_path = data(name);
+  o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_" + name)).string();
+  fs::remove_all(o.out_dir);
+  o.refine = refine;
+  o.max_effects = 1;  // one hidden effect: the second round is exercised in the CLI test below
+  const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
+  std::printf("%s: baseline %.4f, floor %.4f, final %.4f (FEM %.4f); ranking:", name.c_str(), r.baseline_nrmse,
+              r.noise_floor_nrmse, r.final_nrmse, r.verified_fitted_nrmse);
+  for (const CandidateResult& c : r.candidates) {
+    std::printf(" %s %.4f (dAIC %.0f%s)", c.effect.c_str(), c.nrmse, c.delta_aic, c.significant ? ", sig" : "");
+    for (std::size_t i = 0; i < c.params.size(); ++i) std::printf(" %s=%.4g", c.param_names[i].c_str(), c.params[i]);
+    std::printf(";");
+  }
+  std::printf("\n");
+  EXPECT_TRUE(fs::exists(fs::path(o.out_dir) / "diagnosis.json"));
+  EXPECT_TRUE(fs::exists(fs::path(o.out_dir) / "fitted.toml"));
+  return r;
+}
+
+double param(const DiagnosisResult& r, const std::string& name) {
+  const CandidateResult& c = r.candidates.front();
+  for (std::size_t i = 0; i < c.param_names.size(); ++i)
+    if (c.param_names[i] == name) return c.params[i];
+  ADD_FAILURE() << "no parameter " << name;
+  return NAN;
+}
+
+TEST(EffectiveSampleSize, WhiteAndCorrelatedResiduals) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  const int n = 20000;
+  std::vector<double> white(n), ar(n);
+  std::vector<int> seg(n, 0);
+  double x = 0.0;
+  const double rho = 0.9;
+  for (int i = 0; i < n; ++i) {
+    white[i] = n01(rng);
+    x = rho * x + std::sqrt(1 - rho * rho) * n01(rng);
+    ar[i] = x;
+  }
+  // White: rho_hat ~ N(0, 1/n) -> n_eff within a few % of n. AR(1) 0.9: n (0.1 / 1.9) = 1053;
+  // rho_hat has sd ~ sqrt((1 - rho^2)/n) = 0.003 -> n_eff within ~10 %.
+  EXPECT_GT(effective_sample_size(white, seg), 0.95 * n);
+  EXPECT_NEAR(effective_sample_size(ar, seg), n * 0.1 / 1.9, 0.1 * n * 0.1 / 1.9);
+}
+
+TEST(HiddenEffect, NoneGivesNoMissingEffect) {
+  const DiagnosisResult r = diagnose("none");
+  EXPECT_EQ(r.missing_effect, "");
+  EXPECT_TRUE(r.selected.empty());
+}
+
+// Tolerances on the recovered constants: the reduced model reproduces uniform softening and
+// viscoelasticity within ~1 % of the angle (test_path_model), so stiffness, viscoelastic and lag
+// constants come back within ~10-30 % (the noise and the controller overshoot limit them too).
+TEST(HiddenEffect, Stiffness) {
+  const DiagnosisResult r = diagnose("stiffness");
+  EXPECT_EQ(r.missing_effect, "stiffness");
+  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+  EXPECT_NEAR(param(r, "scale"), candidate_effect("stiffness").params[0].truth, 0.05);
+}
+
+TEST(HiddenEffect, Viscoelastic) {
+  const DiagnosisResult r = diagnose("viscoelastic");
+  EXPECT_EQ(r.missing_effect, "viscoelastic");
+  // Measured: final 0.023 with a floor of 0.013. The remainder is the reduced model's own error
+  // for creep under the overshooting inlet (~1 % of the angle range), hence 2x floor + 0.005.
+  EXPECT_LT(r.final_nrmse, 2.0 * r.noise_floor_nrmse + 0.005);
+  const CandidateEffect& c = candidate_effect("viscoelastic");
+  // gamma and tau trade off (a larger, slower term looks alike over 4 s holds): gamma within 50 %,
+  // tau within 30 % (measured 0.68 vs 0.5 and 3.4 s vs 4 s).
+  EXPECT_NEAR(param(r, c.params[0].name), c.params[0].truth, 0.5 * c.params[0].truth);
+  EXPECT_NEAR(param(r, c.params[1].name), c.params[1].truth, 0.3 * c.params[1].truth);
+}
+
+TEST(HiddenEffect, PressureLag) {
+  const DiagnosisResult r = diagnose("pressure_lag");
+  EXPECT_EQ(r.missing_effect, "pressure_lag");
+  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+  const CandidateEffect& c = candidate_effect("pressure_lag");
+  EXPECT_NEAR(param(r, c.params[0].name), c.params[0].truth, 0.2 * c.params[0].truth);
+}
+
+TEST(HiddenEffect, Gravity) {
+  const DiagnosisResult r = diagnose("gravity");
+  EXPECT_EQ(r.missing_effect, "gravity");
+  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+  const CandidateEffect& c = candidate_effect("gravity");
+  EXPECT_NEAR(param(r, c.params[0].name), c.params[0].truth, 20.0);
+}
+
+TEST(HiddenEffect, Mullins) {
+  const DiagnosisResult r = diagnose("mullins");
+  EXPECT_EQ(r.missing_effect, "mullins");
+  // Measured final 0.019 vs floor 0.0095: the reduced model's shape error for damage localised in
+  // the walls (test_path_model) is what remains; the constants are therefore biased (r 1.9 vs 3,
+  // m 0.004 vs 0.001 MPa) and only checked for order of magnitude; --refine corrects them with
+  // the FEM (too costly for CI; BENCHMARKS.md).
+  EXPECT_LT(r.final_nrmse, 2.0 * r.noise_floor_nrmse + 0.005);
+  EXPECT_LT(r.final_nrmse, 0.3 * r.baseline_nrmse);
+  EXPECT_GT(param(r, "r"), 1.2);
+  EXPECT_NEAR(std::log10(param(r, "m_MPa")), std::log10(0.001), 1.0);
+}
+
+TEST(HiddenEffect, Fatigue) {
+  const DiagnosisResult r = diagnose("fatigue");
+  EXPECT_EQ(r.missing_effect, "fatigue");
+  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+}
+
+}  // namespace
+}  // namespace pneufem

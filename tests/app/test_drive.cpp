@@ -1,0 +1,258 @@
+// Simulating a recording (app/drive.h): a recording made from the model itself (the scene's own
+// staircase sampled like the rig, 400 Hz pressure and 30 fps frames) must reproduce the angles
+// of a direct run of that staircase; sensor noise on the pressure may change them only within a
+// bound derived from the denoising; results are bit-identical for 1 and 2 threads.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "analysis/steps.h"
+#include "app/drive.h"
+#include "engine/assembly.h"
+#include "materials/errors.h"
+#include "scenes/build_model.h"
+#include "scenes/pressure_lag.h"
+
+namespace pneufem {
+namespace {
+
+/// A tiny elastic pneu-net: 3 chambers, coarse mesh, 0-10-20-30 kPa in 4 s holds, two trials.
+Scene tiny_scene() {
+  return Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=30", "load.step_kPa=10", "load.hold_s=4",
+                          "load.ramp_s=0.5", "load.trials=2", "output.vtu=\"none\""});
+}
+
+/// The scene's own staircase sampled at 400 Hz (pressure) and 30 fps (frames; angle 0), with
+/// Gaussian noise of sigma_kPa on the pressure.
+Recording sampled_staircase(const Scene& scene, double sigma_kPa, unsigned seed) {
+  const std::unique_ptr<BuiltModel> bm = build_model(scene);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Recording rec;
+  rec.source = "staircase";
+  for (std::size_t k = 0; k < bm->load.trials.size(); ++k) {
+    const TrialLoad& tl = bm->load.trials[k];
+    TrialRecording tr;
+    tr.trial = static_cast<int>(k + 1);
+    for (long i = 0; i <= std::lround(tl.duration() * 400); ++i) {
+      const double t = i / 400.0;
+      tr.pressure_kPa.t_s.push_back(t);
+      tr.pressure_kPa.value.push_back(tl.pressure(t) * 1e-3 + sigma_kPa * noise(rng));
+    }
+    for (long j = 0; j / 30.0 <= tl.duration(); ++j) {
+      tr.angle_deg.t_s.push_back(j / 30.0);
+      tr.angle_deg.value.push_back(0.0);
+    }
+    rec.trials.push_back(tr);
+  }
+  return rec;
+}
+
+struct Direct {
+  std::vector<StateRecord> records;  ///< reports at each step's mark and end
+};
+
+Direct direct_run(const Scene& scene) {
+  const std::unique_ptr<BuiltModel> bm = build_model(scene);
+  const Assembler asmb(bm->model);
+  QuasiStaticRun run(asmb, bm->solver.quasi_static);
+  Direct d;
+  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { d.records.push_back(r); });
+  return d;
+}
+
+// Shared, computed on first use: ctest runs every test in its own process, so a test that needs
+// none of these pays nothing for them.
+class DriveTest : public ::testing::Test {
+ protected:
+  static const Scene& scene() {
+    static const Scene s = tiny_scene();
+    return s;
+  }
+  static const Direct& direct() {
+    static const Direct d = direct_run(scene());
+    return d;
+  }
+  static const DriveResult& clean() {
+    static const DriveResult r = [] {
+      DriveOptions opt;
+      opt.threads = 2;
+      return simulate_recording(scene(), sampled_staircase(scene(), 0.0, 1), opt);
+    }();
+    return r;
+  }
+};
+
+TEST_F(DriveTest, NoiseFreeRecordingReproducesTheDirectRun) {
+  // Noise-free: the running median passes the monotone staircase unchanged and RDP keeps exactly
+  // its corners, so both runs solve the same pressures; the model is elastic, so the angle at a
+  // pressure does not depend on the path. What remains is the equilibrium tolerance (|R| <=
+  // 1e-8 |f|) reached from different starting states; 1e-6 deg is ~1e-6 of the angles here and
+  // far below anything a comparison with measurements resolves (observed: ~2e-14 deg).
+  constexpr double kTol_deg = 1e-6;
+  ASSERT_EQ(clean().trials.size(), 2u);
+  for (const StateRecord& r : direct().records) {
+    const TrialTrace& tt = clean().trials[static_cast<std::size_t>(r.trial - 1)];
+    EXPECT_NEAR(value_at(tt.states_angle_deg, r.time_s), r.angle_deg, kTol_deg) << "trial " << r.trial << " t " << r.time_s;
+  }
+  // Model angle at every frame: same times as the frames; inside holds (after the ramp) it is
+  // the level's angle.
+  for (const TrialTrace& tt : clean().trials) {
+    ASSERT_FALSE(tt.angle_deg.t_s.empty());
+    for (std::size_t j = 0; j < tt.angle_deg.t_s.size(); ++j) {
+      const double t = tt.angle_deg.t_s[j];
+      const double in_step = std::fmod(t, 4.0);
+      if (in_step < 0.6 || in_step > 3.9) continue;
+      for (const StateRecord& r : direct().records) {
+        if (r.trial == tt.trial && std::floor(r.time_s / 4.0 - 1e-9) == std::floor(t / 4.0)) {
+          EXPECT_NEAR(tt.angle_deg.value[j], r.angle_deg, kTol_deg) << "frame at " << t;
+        }
+      }
+    }
+  }
+  EXPECT_GT(std::abs(direct().records.back().angle_deg), 1.0) << "the actuator must bend for this test to mean anything";
+}
+
+TEST_F(DriveTest, PressureNoiseChangesTheAnglesOnlyWithinTheDenoisingBound) {
+  const double sigma = 0.2;  // kPa, a typical inlet sensor
+  DriveOptions opt;
+  opt.threads = 2;
+  const DriveResult noisy = simulate_recording(scene(), sampled_staircase(scene(), sigma, 3), opt);
+  // Pressure error of a hold: RDP keeps within `tol` of the running median, whose own error is
+  // below 5 standard errors of a 21-sample median (1.2533 sigma / sqrt(21)). The angle error is
+  // at most that times the steepest dtheta/dp, bounded by 1.5 x the largest secant slope between
+  // levels (the curve's tangent stays within 50 % of its secant over one 5 kPa step).
+  const double p_err = noisy.tolerance_kPa + 5 * 1.2533 * sigma / std::sqrt(21.0);
+  double slope = 0;
+  for (std::size_t i = 1; i < direct().records.size(); ++i) {
+    const StateRecord &a = direct().records[i - 1], &b = direct().records[i];
+    if (b.trial == a.trial && std::abs(b.pressure_Pa - a.pressure_Pa) > 1.0)
+      slope = std::max(slope, std::abs(b.angle_deg - a.angle_deg) / (std::abs(b.pressure_Pa - a.pressure_Pa) * 1e-3));
+  }
+  ASSERT_GT(slope, 0.0);
+  const double bound_deg = 1.5 * slope * p_err;
+  for (const StateRecord& r : direct().records) {
+    const TrialTrace& tt = noisy.trials[static_cast<std::size_t>(r.trial - 1)];
+    EXPECT_NEAR(value_at(tt.states_angle_deg, r.time_s), r.angle_deg, bound_deg) << "t " << r.time_s;
+  }
+  // Noise must not become states: 400 Hz x 16 s of noise would be thousands.
+  EXPECT_LE(noisy.states, 3 * clean().states + 20) << "clean " << clean().states;
+}
+
+TEST_F(DriveTest, BitIdenticalForOneAndTwoThreads) {
+  DriveOptions one;
+  one.threads = 1;
+  const DriveResult r1 = simulate_recording(scene(), sampled_staircase(scene(), 0.0, 1), one);
+  ASSERT_EQ(r1.trials.size(), clean().trials.size());
+  for (std::size_t k = 0; k < r1.trials.size(); ++k) {
+    EXPECT_EQ(r1.trials[k].angle_deg.value, clean().trials[k].angle_deg.value);
+    EXPECT_EQ(r1.trials[k].states_angle_deg.value, clean().trials[k].states_angle_deg.value);
+  }
+}
+
+TEST_F(DriveTest, ChamberPressureLagActsOnTheMeasuredInlet) {
+  // With load.pressure_lag_s the solved states carry the chamber pressure, the exact first-order
+  // response (scenes/pressure_lag.h) to the inlet: within the lag's 0.05 kPa breakpoint tolerance
+  // plus rounding, also in the rise right after a step, where the inlet is 10 kPa away.
+  const double tau_s = 0.3;
+  const Scene lagged = scene().with({"load.pressure_lag_s=0.3"});
+  DriveOptions opt;
+  opt.threads = 2;
+  const DriveResult r = simulate_recording(lagged, sampled_staircase(scene(), 0.0, 1), opt);
+  const std::unique_ptr<BuiltModel> bm = build_model(scene());  // the inlet staircase
+  for (double t : {4.2, 4.5, 4.8, 5.5, 8.3, 9.0}) {
+    const double exact_kPa = lagged_pressure(bm->load.trials[0], tau_s, t) * 1e-3;
+    EXPECT_NEAR(value_at(r.trials[0].states_pressure_kPa, t), exact_kPa, 0.05 + 1e-9) << "t " << t;
+  }
+  EXPECT_GT(std::abs(lagged_pressure(bm->load.trials[0], tau_s, 4.5) - bm->load.trials[0].pressure(4.5)), 1e3)
+      << "the lag must matter at the test times";
+}
+
+TEST(Drive, CreepCarriesOverBetweenTrialsAsInADirectRun) {
+  // Viscoelastic silicone (one Prony term, tau = 2 s, so a 3 s hold creeps visibly and trial 2
+  // starts before trial 1's creep has recovered). Both runs solve the same pressures but at
+  // different physical time steps (the drive adds a state every 0.5 s in holds); the engine's
+  // step control bounds the viscous-strain change per step by time_tol = 0.01, so they differ by
+  // the time-discretisation error only: observed 6e-5 deg, bound 1e-3 deg.
+  constexpr double kTol_deg = 1e-3;
+  const Scene scene = tiny_scene().with({"load.max_kPa=20", "load.hold_s=3", "materials.silicone.viscoelastic.enabled=true",
+                                         "materials.silicone.viscoelastic.gamma=[0.3]",
+                                         "materials.silicone.viscoelastic.tau_s=[2.0]"});
+  const Direct direct = direct_run(scene);
+  DriveOptions opt;
+  opt.threads = 2;
+  opt.max_report_gap_s = 0.5;
+  const DriveResult drive = simulate_recording(scene, sampled_staircase(scene, 0.0, 1), opt);
+  for (const StateRecord& r : direct.records) {
+    const double a = value_at(drive.trials[static_cast<std::size_t>(r.trial - 1)].states_angle_deg, r.time_s);
+    EXPECT_NEAR(a, r.angle_deg, kTol_deg) << "trial " << r.trial << " t " << r.time_s;
+  }
+  // The carry-over is real: the same step of trial 2 bends more than in trial 1 (unrecovered
+  // creep), by far more than the tolerance, and within a hold the angle creeps.
+  const std::size_t half = direct.records.size() / 2;
+  EXPECT_GT(direct.records[2 + half].angle_deg - direct.records[2].angle_deg, 10 * kTol_deg);
+  EXPECT_GT(direct.records[3].angle_deg - direct.records[2].angle_deg, 5 * kTol_deg);  // mark -> end: 0.5 s
+}
+
+TEST(Drive, SimplifyKeepsTheCornersOfANoiseFreeStaircase) {
+  Series p;
+  for (int i = 0; i <= 4000; ++i) {
+    const double t = i / 400.0;  // 0..10 s: 0 kPa, ramp 2-2.5 s to 5 kPa, hold
+    p.t_s.push_back(t);
+    p.value.push_back(t < 2 ? 0.0 : t < 2.5 ? 10.0 * (t - 2) : 5.0);
+  }
+  double tol = 0;
+  const Series s = simplify_pressure(p, 0.0, 0.05, &tol);
+  EXPECT_EQ(tol, 0.05);  // noise-free: the floor
+  ASSERT_EQ(s.t_s.size(), 4u);
+  EXPECT_EQ(s.t_s[1], 2.0);
+  EXPECT_EQ(s.t_s[2], 2.5);
+  EXPECT_EQ(s.value[2], 5.0);
+}
+
+TEST(Drive, HoldStatesOnlyForModelsWithHistory) {
+  Recording rec;
+  rec.source = "r.csv";
+  TrialRecording tr;
+  tr.trial = 3;
+  tr.pressure_kPa = {{-1.0, 0.0, 9.0}, {5.0, 5.0, 5.0}};
+  rec.trials.push_back(tr);
+  DriveOptions opt;
+  std::vector<double> offset;
+  const LoadHistory elastic = measured_load(rec, opt, 0.0, false, offset);
+  EXPECT_EQ(offset, std::vector<double>{-1.0});
+  EXPECT_EQ(elastic.trials[0].time_s.size(), 2u);  // constant pressure: no extra states
+  const LoadHistory creep = measured_load(rec, opt, 0.0, true, offset);
+  const std::vector<double>& t = creep.trials[0].time_s;
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_DOUBLE_EQ(t.back(), 10.0);
+  for (std::size_t i = 1; i < t.size(); ++i) EXPECT_LE(t[i] - t[i - 1], opt.max_report_gap_s + 1e-12);
+  rec.trials[0].pressure_kPa = {};
+  try {
+    measured_load(rec, opt, 0.0, false, offset);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("r.csv: trial 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(DriveTest, WritesTheWorstStatesAsVtu) {
+  Recording rec = sampled_staircase(scene(), 0.0, 1);
+  // Measured 1000 deg throughout trial 2 (constant: no outlier frames), 0 in trial 1: the states
+  // of trial 2 are the worst.
+  for (double& v : rec.trials[1].angle_deg.value) v = 1000.0;
+  DriveOptions opt;
+  opt.vtu_dir = (std::filesystem::temp_directory_path() / ("pneufem_drive_vtu_" + std::to_string(::getpid()))).string();
+  const DriveResult r = simulate_recording(scene(), rec, opt);
+  ASSERT_EQ(r.worst.size(), 3u);
+  EXPECT_EQ(r.worst[0].trial, 2);
+  for (const WorstState& w : r.worst) EXPECT_TRUE(std::filesystem::exists(w.file)) << w.file;
+  std::filesystem::remove_all(opt.vtu_dir);
+}
+
+}  // namespace
+}  // namespace pneufem
