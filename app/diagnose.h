@@ -14,7 +14,9 @@
 //    any parameter "significant". A candidate is significant when delta AIC <= aic_threshold
 //    (-10: "essentially no support" for the worse model, Burnham & Anderson) AND it removes at
 //    least min_removed of the baseline's error above the noise floor (in squared NRMSE), so a
-//    statistically detectable but physically negligible gain is not reported as a missing effect.
+//    statistically detectable but physically negligible gain is not reported as a missing effect;
+//    and its NRMSE gain must be at least min_gain_of_floor x the noise floor (near the floor the
+//    excess is tiny and fitting noise can remove much of it).
 // 4. Greedy forward selection: the best significant candidate is added (with its calibrated
 //    constants) and the remaining candidates are tried again on top of it, up to max_effects.
 // 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
@@ -45,6 +47,7 @@ struct DiagnoseOptions {
   int max_evaluations = 40;             ///< reduced-model runs per candidate calibration
   double aic_threshold = -10.0;
   double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
+  double min_gain_of_floor = 0.1;       ///< ... and NRMSE gain of at least this times the noise floor
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
   int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
