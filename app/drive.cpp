@@ -59,35 +59,6 @@ std::vector<double> running_median(const std::vector<double>& x, int h) {
   return out;
 }
 
-/// Ramer-Douglas-Peucker on (t, p) with the vertical deviation from the chord (a pressure
-/// tolerance); iterative, so a 10^5-sample record cannot overflow the stack.
-std::vector<char> rdp_keep(const std::vector<double>& t, const std::vector<double>& p, double tol) {
-  std::vector<char> keep(t.size(), 0);
-  if (t.empty()) return keep;
-  keep.front() = keep.back() = 1;
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, t.size() - 1}};
-  while (!todo.empty()) {
-    const auto [a, b] = todo.back();
-    todo.pop_back();
-    if (b <= a + 1) continue;
-    double worst = -1.0;
-    std::size_t wi = a;
-    for (std::size_t i = a + 1; i < b; ++i) {
-      const double w = (t[i] - t[a]) / (t[b] - t[a]);
-      const double d = std::abs(p[i] - ((1 - w) * p[a] + w * p[b]));
-      if (d > worst) {
-        worst = d;
-        wi = i;
-      }
-    }
-    if (worst > tol) {
-      keep[wi] = 1;
-      todo.emplace_back(a, wi);
-      todo.emplace_back(wi, b);
-    }
-  }
-  return keep;
-}
 
 /// Linear interpolation of (t, v) at x, clamped to the end values outside [t.front(), t.back()].
 double interp_clamped(const std::vector<double>& t, const std::vector<double>& v, double x) {

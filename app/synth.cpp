@@ -54,31 +54,6 @@ class Noise {
   bool has_spare_ = false;
 };
 
-// Ramer-Douglas-Peucker: keeps the fewest samples whose linear interpolation is within tol of all.
-void simplify(const std::vector<double>& t, const std::vector<double>& p, double tol, std::vector<char>& keep) {
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, t.size() - 1}};
-  keep.assign(t.size(), 0);
-  keep.front() = keep.back() = 1;
-  while (!todo.empty()) {
-    const auto [a, b] = todo.back();
-    todo.pop_back();
-    double worst = -1.0;
-    std::size_t wi = a;
-    for (std::size_t i = a + 1; i < b; ++i) {
-      const double w = (t[i] - t[a]) / (t[b] - t[a]);
-      const double d = std::abs(p[i] - ((1 - w) * p[a] + w * p[b]));
-      if (d > worst) {
-        worst = d;
-        wi = i;
-      }
-    }
-    if (worst > tol) {
-      keep[wi] = 1;
-      todo.push_back({a, wi});
-      todo.push_back({wi, b});
-    }
-  }
-}
 
 void check(bool ok, const std::string& option, const std::string& what) {
   if (!ok) throw InputError(option + ": " + what);
@@ -220,8 +195,7 @@ SynthResult run_synth(const SynthOptions& o) {
     for (long i = 0; i <= n; ++i) ts.push_back(static_cast<double>(i) / o.pressure_rate_Hz);
     if (ts.back() < T) ts.push_back(T);
     for (double t : ts) ps.push_back(controller_pressure_kPa(t_cmd[k], dL[k], o.controller_hz, o.controller_damping, t));
-    std::vector<char> keep;
-    simplify(ts, ps, o.inlet_tolerance_kPa, keep);
+    const std::vector<char> keep = rdp_keep(ts, ps, o.inlet_tolerance_kPa);
     TrialLoad& tl = inlet.trials[k];
     tl.time_s.clear();
     tl.pressure_Pa.clear();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "materials/errors.h"
 
@@ -87,6 +88,34 @@ LoadHistory staircase(double p_max, double dp, double hold_s, double ramp_s, int
     << " trial(s)";
   h.description = s.str();
   return h;
+}
+
+std::vector<char> rdp_keep(const std::vector<double>& t, const std::vector<double>& p, double tol) {
+  std::vector<char> keep(t.size(), 0);
+  if (t.empty()) return keep;
+  keep.front() = keep.back() = 1;
+  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, t.size() - 1}};
+  while (!todo.empty()) {
+    const auto [a, b] = todo.back();
+    todo.pop_back();
+    if (b <= a + 1) continue;
+    double worst = -1.0;
+    std::size_t wi = a;
+    for (std::size_t i = a + 1; i < b; ++i) {
+      const double w = (t[i] - t[a]) / (t[b] - t[a]);
+      const double d = std::abs(p[i] - ((1 - w) * p[a] + w * p[b]));
+      if (d > worst) {
+        worst = d;
+        wi = i;
+      }
+    }
+    if (worst > tol) {
+      keep[wi] = 1;
+      todo.emplace_back(a, wi);
+      todo.emplace_back(wi, b);
+    }
+  }
+  return keep;
 }
 
 }  // namespace pneufem

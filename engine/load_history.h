@@ -27,6 +27,11 @@ struct LoadHistory {
 /// The paper's staircase: levels 0, dp, ..., p_max, each held `hold_s` (the pressure reaches a
 /// level within `ramp_s`), `trials` repetitions; reports at start + mark_s and at the end of
 /// each hold (plus every `output_every_s` if > 0).
+/// Ramer-Douglas-Peucker: flags (1) the fewest samples of (t, v) whose linear interpolation stays
+/// within `tol` (vertical deviation) of every sample; the first and last are always kept.
+/// Iterative, so a 10^5-sample pressure record cannot overflow the stack.
+std::vector<char> rdp_keep(const std::vector<double>& t, const std::vector<double>& v, double tol);
+
 LoadHistory staircase(double p_max_Pa, double dp_Pa, double hold_s, double ramp_s, int trials,
                       double mark_s, double rest_s, double output_every_s = 0.0);
 

@@ -165,26 +165,6 @@ std::map<std::string, double> region_scales(const Scene& s, const Mesh& mesh) {
   return out;
 }
 
-// Ramer-Douglas-Peucker simplification of (t, p) to within tol (max vertical deviation).
-void rdp(const std::vector<double>& t, const std::vector<double>& p, std::size_t a, std::size_t b, double tol,
-         std::vector<char>& keep) {
-  if (b <= a + 1) return;
-  double worst = -1.0;
-  std::size_t wi = a;
-  for (std::size_t i = a + 1; i < b; ++i) {
-    const double w = (t[i] - t[a]) / (t[b] - t[a]);
-    const double d = std::abs(p[i] - ((1 - w) * p[a] + w * p[b]));
-    if (d > worst) {
-      worst = d;
-      wi = i;
-    }
-  }
-  if (worst > tol) {
-    keep[wi] = 1;
-    rdp(t, p, a, wi, tol, keep);
-    rdp(t, p, wi, b, tol, keep);
-  }
-}
 
 }  // namespace
 
@@ -636,9 +616,7 @@ LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, d
   LoadHistory h;
   for (auto& [trial, tp] : data) {
     auto& [ts, ps] = tp;
-    std::vector<char> keep(ts.size(), 0);
-    keep.front() = keep.back() = 1;
-    rdp(ts, ps, 0, ts.size() - 1, tol_kPa, keep);
+    const std::vector<char> keep = rdp_keep(ts, ps, tol_kPa);
     TrialLoad tl;
     const double t0 = ts.front();
     for (std::size_t i = 0; i < ts.size(); ++i)
