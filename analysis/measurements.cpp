@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "analysis/csv_scan.h"
+#include "materials/atomic_file.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -289,26 +290,7 @@ std::string format_measurements_csv(const Recording& rec) {
 }
 
 void write_measurements_csv(const std::string& path, const Recording& rec) {
-  namespace fs = std::filesystem;
-  const std::string text = format_measurements_csv(rec);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "': check that the directory exists and is writable");
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::runtime_error("failed writing '" + path + "' (disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot move '" + tmp + "' to '" + path + "': " + ec.message());
-  }
+  write_file_atomic(path, format_measurements_csv(rec));
 }
 
 }  // namespace pneufem

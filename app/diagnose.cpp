@@ -244,6 +244,7 @@ struct Calibration {
   double rss = std::numeric_limits<double>::infinity();
   int evaluations = 0;
   std::string error;
+  std::vector<CalibrationPoint> trace;
 };
 
 /// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
@@ -258,11 +259,14 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
     for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
     double r = std::numeric_limits<double>::infinity();
     ++best.evaluations;
+    std::string err;
     try {
       r = rss(v);
     } catch (const std::exception& e) {
-      if (best.error.empty()) best.error = e.what();
+      err = e.what();
+      if (best.error.empty()) best.error = err;
     }
+    best.trace.push_back({v, r, err});
     if (r < best.rss) {
       best.rss = r;
       best.values = v;
@@ -484,6 +488,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
 
   if (opt.progress) std::fprintf(stderr, "diagnose: tracing the elastic path ...\n");
   const RomEvaluator rom(scene, rec, frames, opt.rom_points);
+  if (opt.progress)
+    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s)\n",
+                 rom.path().path_pressure_Pa().back() * 1e-3, rom.path().num_points(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   long rom_runs = 0;
   std::mutex mu;
 
@@ -518,13 +526,17 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
         const Scene s = cur_scene.with(c.sets(cur_scene, v));
         return rss_of(rom.at_frames(s), frames);
       };
+      const auto tc = std::chrono::steady_clock::now();
       const Calibration cal = calibrate(c, rss, opt.max_evaluations);
+      r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
       r.evaluations = cal.evaluations;
+      r.trace = cal.trace;
       {
         std::lock_guard<std::mutex> lock(mu);
         rom_runs += cal.evaluations;
         if (opt.progress)
-          std::fprintf(stderr, "  round %d %-14s rss %.4g deg^2 (%d runs)\n", round, c.name.c_str(), cal.rss, cal.evaluations);
+          std::fprintf(stderr, "  round %d %-14s rss %.4g deg^2 (%d runs, %.1f s)\n", round, c.name.c_str(), cal.rss,
+                       cal.evaluations, r.wall_s);
       }
       if (!std::isfinite(cal.rss)) {
         r.error = cal.error.empty() ? "calibration failed" : cal.error;
@@ -661,7 +673,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     std::string sets = "[";
     for (std::size_t j = 0; j < c.sets.size(); ++j) sets += (j ? ", " : "") + json::quote(c.sets[j]);
     o.add("sets", sets + "]").add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
-    o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add_str("why", c.why);
+    o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add("wall_s", c.wall_s);
+    o.add_str("why", c.why);
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }
@@ -700,6 +713,18 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
            json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "\n";
   }
   write_file_atomic((fs::path(opt.out_dir) / "diagnosis.csv").string(), csv);
+  std::string tr = "round,effect,evaluation,params,rss_deg2,error\n";
+  for (const CandidateResult& c : out.candidates)
+    for (std::size_t i = 0; i < c.trace.size(); ++i) {
+      std::string p;
+      for (std::size_t j = 0; j < c.trace[i].params.size(); ++j)
+        p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.trace[i].params[j]);
+      std::string e = c.trace[i].error;
+      std::replace(e.begin(), e.end(), '"', '\'');
+      tr += std::to_string(c.round) + "," + c.effect + "," + std::to_string(i + 1) + "," + p + "," +
+            (std::isfinite(c.trace[i].rss_deg2) ? json::num(c.trace[i].rss_deg2) : std::string("inf")) + ",\"" + e + "\"\n";
+    }
+  write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
   HistoryEntry h;
   h.time_utc = utc_now();
   h.source = "diagnose";

@@ -30,7 +30,9 @@
 //
 // Outputs in out_dir: diagnosis.json (schema in the README), fitted.toml (the scene plus the
 // selected effects; `pneufem compare fitted.toml --data FILE` shows the drop), diagnosis.csv
-// (one row per candidate and round), and one line in history.jsonl per model variant.
+// (one row per candidate and round), calibration.csv (every reduced-model evaluation of every
+// calibration: parameters, RSS or the error that made it fail), and one line in history.jsonl per
+// model variant.
 #include <string>
 #include <vector>
 
@@ -56,6 +58,14 @@ struct DiagnoseOptions {
   std::string command_line;
 };
 
+/// One reduced-model evaluation of a calibration (written to calibration.csv: the landscape the
+/// optimiser saw, so a user can tell a flat objective from failed evaluations).
+struct CalibrationPoint {
+  std::vector<double> params;
+  double rss_deg2 = 0.0;  ///< +inf when the evaluation failed
+  std::string error;      ///< why it failed (empty when it did not)
+};
+
 struct CandidateResult {
   std::string effect;
   int round = 1;                        ///< 1 = on the baseline, 2 = on top of the first selection, ...
@@ -69,6 +79,8 @@ struct CandidateResult {
   double removed = 0.0;                 ///< fraction of the excess squared error removed
   bool significant = false;
   int evaluations = 0;
+  double wall_s = 0.0;                  ///< calibration wall time (s)
+  std::vector<CalibrationPoint> trace;  ///< every evaluation, in order
   std::string why;
   std::string error;                    ///< non-empty when the calibration failed
 };

@@ -45,6 +45,7 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
                      "plus a verification); recommended for damage effects (mullins, fatigue)")
       ->check(CLI::Range(0, 5))
       ->capture_default_str();
+  c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
   c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));
   return c;
@@ -52,7 +53,7 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
 
 int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   c.options.command_line = command_line;
-  c.options.progress = isatty(2);
+  c.options.progress = c.progress || isatty(2);
   c.options.candidates.clear();
   std::string cur;
   for (char ch : c.candidates + ",") {

@@ -15,6 +15,7 @@ struct DiagnoseCommand {
   std::string scene_path;
   std::vector<std::string> sets;
   std::string candidates;  ///< comma-separated
+  bool progress = false;   ///< --progress: report on stderr even when it is not a terminal
   DiagnoseOptions options;
 };
 

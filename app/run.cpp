@@ -27,27 +27,6 @@ namespace fs = std::filesystem;
 
 std::string version_string() { return std::string(PNEUFEM_VERSION) + " (" + PNEUFEM_GIT + ")"; }
 
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "': check that the directory exists and is writable");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::runtime_error("failed writing '" + path + "' (disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot move '" + tmp + "' to '" + path + "': " + ec.message());
-  }
-}
-
 namespace {
 
 std::string mesh_stats_json(const MeshStats& s) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "engine/quasi_static.h"
+#include "materials/atomic_file.h"  // write_file_atomic, used by every app command
 #include "scenes/scene.h"
 
 namespace pneufem {
@@ -42,8 +43,6 @@ struct RunResult {
 /// scene argument is ignored and out_dir/scene.toml is used.
 RunResult run_simulation(const Scene& scene, const RunOptions& options);
 
-/// Writes `text` to `path` atomically; throws std::runtime_error naming the path on failure.
-void write_file_atomic(const std::string& path, const std::string& text);
 
 /// pneufem's version string (project version + git description at build time).
 std::string version_string();

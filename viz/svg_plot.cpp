@@ -9,6 +9,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "materials/atomic_file.h"
+
 namespace pneufem::svg {
 
 namespace {
@@ -630,26 +632,6 @@ std::string Figure::svg_element() const {
 
 std::string Figure::svg() const { return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n" + svg_element(); }
 
-void Figure::save(const std::string& path) const {
-  namespace fs = std::filesystem;
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "': check that the directory exists and is writable");
-    out << svg();
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::runtime_error("failed writing '" + path + "' (disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot move '" + tmp + "' to '" + path + "': " + ec.message());
-  }
-}
+void Figure::save(const std::string& path) const { write_file_atomic(path, svg()); }
 
 }  // namespace pneufem::svg

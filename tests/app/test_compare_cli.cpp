@@ -20,33 +20,17 @@
 #include "app/drive.h"
 #include "materials/errors.h"
 #include "scenes/build_model.h"
+#include "tests/app/cli_helpers.h"
 
 namespace pneufem {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code;
-  std::string out;
-};
+using Result = pneufem::test::CliResult;
+inline Result run(const std::string& args) { return pneufem::test::run_cli(args); }
+using pneufem::test::slurp;
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(PNEUFEM_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (p && fgets(buf, sizeof buf, p)) out += buf;
-  const int status = p ? pclose(p) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 long lines(const fs::path& p) {
   const std::string s = slurp(p);

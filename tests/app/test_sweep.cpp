@@ -16,6 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/app/cli_helpers.h"
+
 #include "materials/errors.h"
 
 namespace {
@@ -134,33 +136,12 @@ TEST(SweepDesign, ValuesAreWrittenAsSceneText) {
 // ---------------------------------------------------------------------------------------------
 // End to end through the binary
 
-struct Result {
-  int code;
-  std::string out;
-};
+using Result = pneufem::test::CliResult;
+inline Result run(const std::string& args) { return pneufem::test::run_cli(args); }
+using pneufem::test::slurp;
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(PNEUFEM_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (p && fgets(buf, sizeof buf, p)) out += buf;
-  const int status = p ? pclose(p) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("pneufem_sweep_" + name);
-  fs::remove_all(d);
-  return d;
-}
+fs::path fresh_dir(const std::string& name) { return pneufem::test::fresh_dir("sweep_" + name); }
 
 std::size_t count(const std::string& s, const std::string& what) {
   std::size_t n = 0;

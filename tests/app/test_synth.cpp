@@ -7,14 +7,13 @@
 #include <functional>
 #include <sstream>
 
-#include <sys/wait.h>
-
 #include <gtest/gtest.h>
 
 #include "analysis/measurements.h"
 #include "analysis/steps.h"
 #include "app/synth.h"
 #include "materials/errors.h"
+#include "tests/app/cli_helpers.h"
 
 namespace pneufem {
 namespace {
@@ -34,12 +33,7 @@ fs::path dir() {
   return d;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using pneufem::test::slurp;
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -179,13 +173,8 @@ TEST(Synth, BadHiddenNameListsTheCandidates) {
 // the candidates.
 TEST(Synth, CommandLine) {
   auto run = [](const std::string& args) {
-    const std::string cmd = std::string(PNEUFEM_EXE) + " synth " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    std::string out;
-    char buf[4096];
-    while (p && fgets(buf, sizeof buf, p)) out += buf;
-    const int status = p ? pclose(p) : -1;
-    return std::make_pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, out);
+    const test::CliResult r = test::run_cli("synth " + args);
+    return std::make_pair(r.code, r.out);
   };
   const auto [code, out] = run("--hidden creep --out " + (dir() / "cli.csv").string());
   EXPECT_EQ(code, 2) << out;
