@@ -1,14 +1,51 @@
 #include "engine/linear_solver.h"
 
+#include <malloc.h>
+
+#include <cstdlib>
+#include <mutex>
+
 #include <Eigen/CholmodSupport>
 
+// Optional runtime hooks of the OpenMP and OpenBLAS libraries CHOLMOD is linked against. Weak, so
+// pneufem still links and runs against another BLAS or a CHOLMOD without OpenMP (then they are null).
+extern "C" {
+void omp_set_max_active_levels(int) __attribute__((weak));
+void openblas_set_num_threads(int) __attribute__((weak));
+}
+
 namespace pneufem {
+namespace {
+
+// Process settings that make the direct solver fast on a small machine. Measured on 2 cores
+// (BENCHMARKS.md, "direct solver threading"): the elastic path trace of diagnose went from 71 s to
+// 27 s, with system time from 65 s to 2 s.
+//  * Debian's CHOLMOD opens OpenMP regions with an explicit num_threads(4) and OpenBLAS starts its
+//    own pthreads; next to our TBB workers on 2 cores they oversubscribe the machine and spend most
+//    of the time spinning and in futex calls. pneufem's parallelism is TBB (elements, sweep
+//    points), so the solver runs single-threaded: OpenMP regions are serialised (max active
+//    levels 0; an explicit num_threads clause ignores OMP_NUM_THREADS) and OpenBLAS uses one
+//    thread. Setting OMP_NUM_THREADS / OPENBLAS_NUM_THREADS in the environment keeps the user's.
+//  * Every numeric factorisation allocates the permuted matrix afresh. Blocks above glibc's mmap
+//    threshold (at most 32 MiB by default) are mmapped and unmapped each time, so every
+//    factorisation page-faults its whole working set; raising the thresholds keeps the memory in
+//    the heap for reuse.
+void configure_process() {
+  if (!std::getenv("OMP_NUM_THREADS") && omp_set_max_active_levels) omp_set_max_active_levels(0);
+  if (!std::getenv("OPENBLAS_NUM_THREADS") && openblas_set_num_threads) openblas_set_num_threads(1);
+  mallopt(M_MMAP_THRESHOLD, 512 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
+}  // namespace
 
 struct LinearSolver::Impl {
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
 };
 
 LinearSolver::LinearSolver() : impl_(std::make_unique<Impl>()) {
+  static std::once_flag once;
+  std::call_once(once, configure_process);
   // Do not let CHOLMOD print or abort on a non-positive-definite matrix; we check info().
   impl_->llt.cholmod().print = 0;
   impl_->llt.cholmod().quick_return_if_not_posdef = 1;
