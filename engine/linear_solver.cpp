@@ -26,15 +26,23 @@ namespace {
 //    points), so the solver runs single-threaded: OpenMP regions are serialised (max active
 //    levels 0; an explicit num_threads clause ignores OMP_NUM_THREADS) and OpenBLAS uses one
 //    thread. Setting OMP_NUM_THREADS / OPENBLAS_NUM_THREADS in the environment keeps the user's.
+//    The OpenMP setting is per thread in libgomp (a TBB worker starts from the global defaults),
+//    so it is applied on the calling thread before every CHOLMOD call.
 //  * Every numeric factorisation allocates the permuted matrix afresh. Blocks above glibc's mmap
 //    threshold (at most 32 MiB by default) are mmapped and unmapped each time, so every
 //    factorisation page-faults its whole working set; raising the thresholds keeps the memory in
 //    the heap for reuse.
+bool serialise_openmp = false;
+
 void configure_process() {
-  if (!std::getenv("OMP_NUM_THREADS") && omp_set_max_active_levels) omp_set_max_active_levels(0);
+  serialise_openmp = !std::getenv("OMP_NUM_THREADS") && omp_set_max_active_levels;
   if (!std::getenv("OPENBLAS_NUM_THREADS") && openblas_set_num_threads) openblas_set_num_threads(1);
   mallopt(M_MMAP_THRESHOLD, 512 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
+void serialise_openmp_on_this_thread() {
+  if (serialise_openmp) omp_set_max_active_levels(0);
 }
 
 }  // namespace
@@ -53,6 +61,7 @@ LinearSolver::LinearSolver() : impl_(std::make_unique<Impl>()) {
 LinearSolver::~LinearSolver() = default;
 
 bool LinearSolver::factorize(const SparseMatrix& K) {
+  serialise_openmp_on_this_thread();
   if (!analysed_) {
     impl_->llt.analyzePattern(K);
     analysed_ = true;
@@ -63,6 +72,9 @@ bool LinearSolver::factorize(const SparseMatrix& K) {
   return has_factor_;
 }
 
-Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const { return impl_->llt.solve(b); }
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
+  serialise_openmp_on_this_thread();
+  return impl_->llt.solve(b);
+}
 
 }  // namespace pneufem
