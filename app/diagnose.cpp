@@ -249,11 +249,17 @@ struct Calibration {
 
 /// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
 /// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
-/// (several) from the best grid point. Failed evaluations (no equilibrium) count as +infinity.
+/// (several) from the best grid point.
+/// The optimiser sees log(rss), which has the same minimiser: near a limit point the RSS of
+/// neighbouring constants spans six decades (a softened model that snaps through is off by tens
+/// of degrees), and BOBYQA's quadratic models of the raw RSS are then dominated by those points.
+/// A failed evaluation (no equilibrium) is recorded as +infinity but scores as one decade worse
+/// than the worst finite RSS seen, so it repels the search without breaking the model.
 Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
                       int budget, const std::vector<double>* start = nullptr) {
   const std::size_t k = c.params.size();
   Calibration best;
+  double worst = 1.0;  // largest finite RSS seen (deg^2), for the failure score
   auto eval = [&](const std::vector<double>& x) {
     std::vector<double> v(k);
     for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
@@ -271,7 +277,11 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
       best.rss = r;
       best.values = v;
     }
-    return std::isfinite(r) ? r : 1e300;
+    if (std::isfinite(r)) {
+      worst = std::max(worst, r);
+      return std::log(std::max(r, 1e-300));
+    }
+    return std::log(std::max(worst, 1e-300)) + std::log(10.0);
   };
   if (k == 0) {
     eval({});
@@ -280,12 +290,11 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
   // Coarse grid (and the catalog's initial point).
   std::vector<double> x0(k);
   for (std::size_t i = 0; i < k; ++i) x0[i] = scale(c.params[i], start ? (*start)[i] : c.params[i].initial);
-  eval(x0);
+  double fbest = eval(x0);
   // From a given start (refinement): a local search only, in a cell of +-1/per around it.
   const int per = start ? 6 : (k == 1 ? 5 : 3);
   std::vector<int> idx(k, 0);
   std::vector<double> xbest = x0;
-  double fbest = best.rss;
   while (!start) {
     std::vector<double> x(k);
     for (std::size_t i = 0; i < k; ++i) x[i] = (idx[i] + 0.5) / per;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <set>
@@ -142,24 +143,59 @@ SynthResult run_synth(const SynthOptions& o) {
   std::vector<std::string> hidden = o.hidden;
   hidden.erase(std::remove(hidden.begin(), hidden.end(), std::string("none")), hidden.end());
   SynthResult res;
-  json::Object effects;
+  std::vector<std::pair<const CandidateEffect*, std::vector<std::string>>> effect_sets;
   for (const std::string& name : hidden) {
     const CandidateEffect& c = candidate_effect(name);
     std::vector<double> values;
+    for (const CandidateParameter& p : c.params) values.push_back(p.truth);
+    effect_sets.emplace_back(&c, c.sets(base, values));
+    res.hidden_sets.insert(res.hidden_sets.end(), effect_sets.back().second.begin(), effect_sets.back().second.end());
+  }
+  const Scene scene = base.with(res.hidden_sets).with(o.sets);
+  // The truth as the simulation saw it: a --set may override a hidden effect's constant, so each
+  // parameter is read back from the resolved scene where it maps to one scalar key (found by
+  // perturbing the parameter and seeing which override changes); otherwise, when one of the
+  // effect's keys was overridden, the value is unknown to the catalog and written as null.
+  json::Object effects;
+  auto key_of = [](const std::string& set) { return set.substr(0, set.find('=')); };
+  std::set<std::string> user_keys;
+  for (const std::string& set : o.sets) user_keys.insert(key_of(set));
+  for (const auto& [c, sets] : effect_sets) {
     json::Object params;
-    for (const CandidateParameter& p : c.params) {
-      values.push_back(p.truth);
-      params.add(p.name, p.truth);
+    std::vector<double> truth;
+    for (const CandidateParameter& p : c->params) truth.push_back(p.truth);
+    for (std::size_t i = 0; i < c->params.size(); ++i) {
+      std::vector<double> bumped = truth;
+      bumped[i] = truth[i] * 1.37 + 0.11;
+      const std::vector<std::string> other = c->sets(base, bumped);
+      std::vector<std::string> keys;
+      for (std::size_t j = 0; j < sets.size() && j < other.size(); ++j)
+        if (sets[j] != other[j]) keys.push_back(key_of(sets[j]));
+      bool overridden = false;
+      for (const std::string& k : keys) overridden = overridden || user_keys.count(k) > 0;
+      // The parameter is the key's value itself when one key changes and it holds exactly truth[i].
+      bool direct = false;
+      if (keys.size() == 1)
+        for (const std::string& set : sets)
+          if (key_of(set) == keys[0]) {
+            char* end = nullptr;
+            const std::string v = set.substr(keys[0].size() + 1);
+            const double x = std::strtod(v.c_str(), &end);
+            direct = end && *end == '\0' && std::abs(x - truth[i]) <= 1e-12 * std::abs(truth[i]);
+          }
+      if (!overridden)
+        params.add(c->params[i].name, truth[i]);
+      else if (direct)
+        params.add(c->params[i].name, scene.number(keys[0]));
+      else
+        params.add(c->params[i].name, std::string("null"));
     }
-    const std::vector<std::string> sets = c.sets(base, values);
     std::string keys = "[";
     for (std::size_t i = 0; i < sets.size(); ++i) keys += (i ? ", " : "") + json::quote(sets[i]);
     json::Object e;
     e.add("truth", params.str(6)).add("sets", keys + "]");
-    effects.add(name, e.str(4));
-    res.hidden_sets.insert(res.hidden_sets.end(), sets.begin(), sets.end());
+    effects.add(c->name, e.str(4));
   }
-  const Scene scene = base.with(res.hidden_sets).with(o.sets);
   if (scene.string("load.protocol") != "staircase")
     scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
   if (scene.string("solver.mode") != "quasi_static")

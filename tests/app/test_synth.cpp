@@ -11,6 +11,8 @@
 
 #include "analysis/measurements.h"
 #include "analysis/steps.h"
+#include "app/effect_catalog.h"
+#include "app/json.h"
 #include "app/synth.h"
 #include "materials/errors.h"
 #include "tests/app/cli_helpers.h"
@@ -154,6 +156,24 @@ TEST(Synth, HiddenPressureLagDelaysTheAngle) {
     EXPECT_LT(value_at(a1, t_step + 0.5), value_at(a0, t_step + 0.5) - 0.2 * step_angle) << t_step;
     EXPECT_NEAR(value_at(a1, t_step + 3.9), value_at(a0, t_step + 3.9), 2e-3 * step_angle) << t_step;
   }
+}
+
+// truth.json records the constants the simulation used: a --set that overrides a hidden effect's
+// scalar constant replaces the catalog's truth, one that overrides a derived key (gravity's angle
+// becomes a vector) makes it unknown (null) rather than wrong.
+TEST(Synth, TruthRecordsOverriddenConstants) {
+  SynthOptions o = options("override.csv", {"fatigue", "gravity"});
+  o.sets.insert(o.sets.end(), {"load.trials=1", "load.max_kPa=5", "load.hold_s=2", "load.mark_s=1",
+                               "materials.silicone.fatigue.tau_s=300.0", "gravity.g_m_s2=[0.0, 0.0, -9.81]"});
+  o.threads = 1;
+  run_synth(o);
+  const std::string j = slurp(dir() / "override.truth.json");
+  const CandidateEffect& f = candidate_effect("fatigue");
+  ASSERT_EQ(f.params[1].name, "tau_s");
+  ASSERT_NE(f.params[1].truth, 300.0);
+  EXPECT_NE(j.find("\"tau_s\": 300"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"W_th_MPa\": " + json::num(f.params[0].truth)), std::string::npos) << j;
+  EXPECT_NE(j.find("\"" + candidate_effect("gravity").params[0].name + "\": null"), std::string::npos) << j;
 }
 
 TEST(Synth, BadHiddenNameListsTheCandidates) {
