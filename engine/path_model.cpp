@@ -267,10 +267,22 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
       const int k = segment(x0);
       // Initial slope: the elastic path's, times the softening ratio seen at the last step.
       double slope = ratio * (p_[k + 1] - p_[k]) / (theta_[k + 1] - theta_[k]);
-      double x1 = x0 - f0 / slope, f1 = residual(x1, p, ts);
+      // A trial point leaving the traced path stops at its end first: inside the path the residual
+      // is the model's, outside it an extrapolation, and a secant step that overshoots (strongly
+      // softened or recovering states, a vent from the top level to 0) must not find a spurious
+      // root out there. At theta = 0 the residual is -p (no stress in the undeformed state), so a
+      // drop in pressure is always bracketed inside the path.
+      auto keep_on_path = [&](double from, double to) {
+        if (from > theta_.front() && to < theta_.front()) return theta_.front();
+        if (from < theta_.back() && to > theta_.back()) return theta_.back();
+        return to;
+      };
+      double x1 = keep_on_path(x0, x0 - f0 / slope), f1 = residual(x1, p, ts);
       int it = 0;
       const double span = theta_.back() - theta_.front();
-      while (f0 * f1 > 0.0) {  // extrapolate until the root is bracketed
+      // Extrapolate until the root is bracketed, or the secant has converged from one side (it
+      // often does on a smooth residual; without this exit it would stall and report no root).
+      while (f0 * f1 > 0.0 && std::abs(f1) > tol_Pa) {
         if (++it > 60 || std::abs(x1) > 20.0 * span + 360.0)
           throw PhysicsError("reduced model: no equilibrium on the elastic path at t = " + std::to_string(t) +
                                  " s, p = " + std::to_string(p) + " Pa (the softened model may have passed its limit "
@@ -280,7 +292,7 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
         if (!(s > 0.0)) s = slope;
         double x2 = x1 - f1 / s;
         const double max_step = 4.0 * std::abs(x1 - x0) + 1.0;
-        x2 = std::clamp(x2, x1 - max_step, x1 + max_step);
+        x2 = keep_on_path(x1, std::clamp(x2, x1 - max_step, x1 + max_step));
         x0 = x1, f0 = f1;
         x1 = x2, f1 = residual(x1, p, ts);
       }

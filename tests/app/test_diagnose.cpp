@@ -126,26 +126,28 @@ TEST(HiddenEffect, Gravity) {
 TEST(HiddenEffect, Mullins) {
   const DiagnosisResult r = diagnose("mullins");
   EXPECT_EQ(r.missing_effect, "mullins");
-  // Measured final 0.019 vs floor 0.0095: the reduced model's shape error for damage localised in
-  // the walls (test_path_model) is what remains; the constants are therefore biased (r 1.9 vs 3,
-  // m 0.004 vs 0.001 MPa) and only checked for order of magnitude; --refine corrects them with
-  // the FEM (too costly for CI; BENCHMARKS.md).
-  EXPECT_LT(r.final_nrmse, 2.0 * r.noise_floor_nrmse + 0.005);
-  EXPECT_LT(r.final_nrmse, 0.3 * r.baseline_nrmse);
-  EXPECT_GT(param(r, "r"), 1.2);
+  // Measured final 0.0098 vs floor 0.0095 (r 2.5 vs 3, m 0.0031 vs 0.001 MPa): the reduced model's
+  // shape error for damage localised in the walls (test_path_model) biases the constants, and r
+  // and m trade off (a smaller r with a larger m softens alike), so r within 1.0 and m to an order
+  // of magnitude; --refine corrects them with the FEM (too costly for CI; BENCHMARKS.md).
+  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+  EXPECT_NEAR(param(r, "r"), 3.0, 1.0);
   EXPECT_NEAR(std::log10(param(r, "m_MPa")), std::log10(0.001), 1.0);
 }
 
-// DISABLED (known failure, issue 4 note): on this dataset (fatigue W_th = 8 kPa, tau = 200 s, close
-// to the actuator's limit point) the calibration stays at a start-grid point (W_th 5.4 kPa, tau
-// 3100 s; NRMSE 0.0405) and "stiffness" wins (0.0287 vs baseline 0.0436, floor 0.0084). Suspected:
-// reduced-model evaluations near the truth fail (no equilibrium on the elastic path: the model
-// overestimates localised damage ~2x, test_path_model) and count as +inf, so BOBYQA cannot get
-// there. Kept compiled so it is run by hand: --gtest_also_run_disabled_tests.
-TEST(HiddenEffect, DISABLED_Fatigue) {
+// Fatigue (W_th = 8 kPa, tau = 200 s, energy driver) softens the interior walls over the trials.
+// Like Mullins it is damage localised in the walls, which the reduced model overestimates ~2x
+// (test_path_model); here that leaves more of the error (measured final 0.0158, floor 0.0084),
+// hence 2x the floor + 0.005; the constants trade off (a lower
+// threshold with a slower rate looks alike over three trials) and are biased by that
+// overestimate: each within a factor of 3 of the truth (measured W_th 4.8 kPa, tau 330 s).
+TEST(HiddenEffect, Fatigue) {
   const DiagnosisResult r = diagnose("fatigue");
   EXPECT_EQ(r.missing_effect, "fatigue");
-  EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
+  EXPECT_LT(r.final_nrmse, 2.0 * r.noise_floor_nrmse + 0.005);
+  EXPECT_LT(r.final_nrmse, 0.5 * r.baseline_nrmse);
+  EXPECT_NEAR(std::log10(param(r, "W_th_MPa")), std::log10(0.008), std::log10(3.0));
+  EXPECT_NEAR(std::log10(param(r, "tau_s")), std::log10(200.0), std::log10(3.0));
 }
 
 }  // namespace
