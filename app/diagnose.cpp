@@ -607,7 +607,16 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   };
   for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
     if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d with the full FEM ...\n", it + 1);
-    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets));
+    std::vector<double> fem;
+    try {
+      fem = fem_at_frames(scene.with(selected_sets));
+    } catch (const PhysicsError& e) {
+      // The FEM cannot follow the fitted constants (e.g. a softened actuator past its limit
+      // point): keep the constants of the last completed round and say so.
+      out.fem_error = "refinement " + std::to_string(it + 1) + " stopped, the full FEM failed at the current constants: " + e.what();
+      if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", out.fem_error.c_str());
+      break;
+    }
     const std::vector<double> romv = rom.at_frames(scene.with(selected_sets));
     std::vector<double> corr(fem.size());
     for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = fem[i] - romv[i];
@@ -648,16 +657,21 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   if (opt.verify || opt.refine > 0) {
     DriveOptions d;
     d.threads = opt.threads;
-    out.verified_baseline_nrmse = compare_recording(rec, [&] {
-      std::vector<Series> v;
-      for (TrialTrace& t : simulate_recording(scene, rec, d).trials) v.push_back(std::move(t.angle_deg));
-      return v;
-    }()).nrmse;
-    out.verified_fitted_nrmse = compare_recording(rec, [&] {
-      std::vector<Series> v;
-      for (TrialTrace& t : simulate_recording(fitted, rec, d).trials) v.push_back(std::move(t.angle_deg));
-      return v;
-    }()).nrmse;
+    auto fem_nrmse = [&](const Scene& s, const char* which) {
+      if (opt.progress) std::fprintf(stderr, "diagnose: verifying the %s scene with the full FEM ...\n", which);
+      try {
+        std::vector<Series> v;
+        for (TrialTrace& t : simulate_recording(s, rec, d).trials) v.push_back(std::move(t.angle_deg));
+        return compare_recording(rec, v).nrmse;
+      } catch (const PhysicsError& e) {
+        const std::string msg = std::string("the full FEM of the ") + which + " scene failed: " + e.what();
+        out.fem_error += (out.fem_error.empty() ? "" : "; ") + msg;
+        if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", msg.c_str());
+        return -1.0;
+      }
+    };
+    out.verified_baseline_nrmse = fem_nrmse(scene, "baseline");
+    out.verified_fitted_nrmse = fem_nrmse(fitted, "fitted");
   }
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -704,6 +718,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   root.add("noise_floor_nrmse", out.noise_floor_nrmse);
   root.add("final_nrmse", out.final_nrmse);
   if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
+  if (!out.fem_error.empty()) root.add_str("fem_error", out.fem_error);
   json::Object method;
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
                                   " material points, elastic path to " +

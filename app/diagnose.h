@@ -95,6 +95,9 @@ struct DiagnosisResult {
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
   double verified_baseline_nrmse = -1.0;    ///< full FEM (verify), -1 when not run
   double verified_fitted_nrmse = -1.0;
+  /// Why a full-FEM run of --verify / --refine failed ("" = none failed). The diagnosis itself is
+  /// still written: the reduced-model result does not depend on it.
+  std::string fem_error;
   std::vector<std::vector<double>> refined_params;  ///< per selected effect, after refinement
   std::string fitted_toml;
   double wall_s = 0.0;
