@@ -278,10 +278,21 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
       ++stats_.cutbacks;
       ds *= 0.5;
       if (ds * std::abs(span) < opt_.min_increment_Pa) {
+        // The hint depends on what Newton saw: a tangent that had to be regularised (not positive
+        // definite) means the structure is at or past a limit point; a positive-definite tangent
+        // with a residual still falling means Newton merely ran out of iterations.
         std::ostringstream s;
-        s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure
-          << ". Hint: the actuator may be at a ballooning limit point, where a load-controlled static "
-             "solve cannot continue; use solver.mode = \"explicit\" (dynamic) beyond it, or a stiffer/thicker design.";
+        s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure;
+        if (r.regularised > 0)
+          s << ". Hint: the tangent stiffness is not positive definite there, so the actuator is at a limit "
+               "point (ballooning, or a softened part giving way), where a load-controlled static solve cannot "
+               "continue; use solver.mode = \"explicit\" (dynamic) beyond it, or a stiffer/thicker design.";
+        else
+          s << ". Hint: the tangent stayed positive definite (no limit point detected) and Newton did not converge "
+               "within solver.max_iterations = "
+            << opt_.max_iterations
+            << "; strongly nonlinear states (a membrane fabric, softened damage) can need 30-40 iterations: raise "
+               "solver.max_iterations, or reduce solver.max_increment_kPa.";
         throw PhysicsError(s.str(), -1, ta);
       }
       continue;

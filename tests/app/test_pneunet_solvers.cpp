@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include "engine/assembly.h"
 #include "engine/quasi_static.h"
+#include "materials/errors.h"
 #include "engine/static_solver.h"
 #include "scenes/build_model.h"
 
@@ -33,6 +35,33 @@ TEST(PneuNetSolvers, QuasiStaticDriverGivesTheSameAngleWithEitherMethod) {
   EXPECT_GT(a_n, 0.05);
   // rel_tol 1e-8 on both: agreement to 1e-3 of the angle is conservative.
   EXPECT_NEAR(a_r, a_n, 1e-3 * a_n);
+}
+
+// A stall with a positive-definite tangent is Newton running out of iterations, not a limit
+// point: the error must say which key to raise instead of blaming the design. Two Newton
+// iterations without chord steps to a zero tolerance fail at every increment size while the
+// tangent of this barely loaded actuator stays positive definite.
+TEST(PneuNetSolvers, StallWithoutLimitPointPointsToMaxIterations) {
+  std::vector<std::string> sets = kSmall;
+  sets.insert(sets.end(), {"solver.max_iterations=2", "load.max_kPa=5.0"});
+  auto bm = build_model(Scene::load("", sets));
+  Assembler A(bm->model);
+  StaticOptions opt = bm->solver.quasi_static.newton;
+  opt.rel_tol = 0.0;
+  opt.abs_tol_N = 0.0;
+  opt.chord_steps = 0;
+  StaticSolver solver(A, opt);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  std::vector<double> state;
+  std::string msg;
+  try {
+    solver.advance(0.0, 5e3, 0.0, 0.0, state, u);
+  } catch (const PhysicsError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("static continuation stalled"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("no limit point detected"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("solver.max_iterations = 2"), std::string::npos) << msg;
 }
 
 }  // namespace
