@@ -85,6 +85,52 @@ std::string noise_json(const SynthOptions& o) {
   return j.str(2);
 }
 
+/// "key" of a "key=value" override.
+std::string key_of(const std::string& set) { return set.substr(0, set.find('=')); }
+
+/// truth.json's entry of one hidden effect: the truth as the simulation saw it. A --set (in
+/// `user_keys`) may override a hidden effect's constant, so each parameter is read back from the
+/// resolved scene where it maps to one scalar key (found by perturbing the parameter and seeing
+/// which override changes); otherwise, when one of its keys was overridden, the value is unknown to
+/// the catalog and written as null rather than wrong.
+std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::string>& sets, const Scene& base,
+                              const Scene& resolved, const std::set<std::string>& user_keys) {
+  json::Object params;
+  std::vector<double> truth;
+  for (const CandidateParameter& p : c.params) truth.push_back(p.truth);
+  for (std::size_t i = 0; i < c.params.size(); ++i) {
+    std::vector<double> bumped = truth;
+    bumped[i] = truth[i] * 1.37 + 0.11;
+    const std::vector<std::string> other = c.sets(base, bumped);
+    std::vector<std::string> keys;
+    for (std::size_t j = 0; j < sets.size() && j < other.size(); ++j)
+      if (sets[j] != other[j]) keys.push_back(key_of(sets[j]));
+    bool overridden = false;
+    for (const std::string& k : keys) overridden = overridden || user_keys.count(k) > 0;
+    // The parameter is the key's value itself when one key changes and it holds exactly truth[i].
+    bool direct = false;
+    if (keys.size() == 1)
+      for (const std::string& set : sets)
+        if (key_of(set) == keys[0]) {
+          char* end = nullptr;
+          const std::string v = set.substr(keys[0].size() + 1);
+          const double x = std::strtod(v.c_str(), &end);
+          direct = end && *end == '\0' && std::abs(x - truth[i]) <= 1e-12 * std::abs(truth[i]);
+        }
+    if (!overridden)
+      params.add(c.params[i].name, truth[i]);
+    else if (direct)
+      params.add(c.params[i].name, resolved.number(keys[0]));
+    else
+      params.add(c.params[i].name, std::string("null"));
+  }
+  std::string keys = "[";
+  for (std::size_t i = 0; i < sets.size(); ++i) keys += (i ? ", " : "") + json::quote(sets[i]);
+  json::Object e;
+  e.add("truth", params.str(6)).add("sets", keys + "]");
+  return e.str(4);
+}
+
 }  // namespace
 
 double controller_pressure_kPa(const std::vector<double>& t_cmd, const std::vector<double>& dL, double f_n,
@@ -152,50 +198,10 @@ SynthResult run_synth(const SynthOptions& o) {
     res.hidden_sets.insert(res.hidden_sets.end(), effect_sets.back().second.begin(), effect_sets.back().second.end());
   }
   const Scene scene = base.with(res.hidden_sets).with(o.sets);
-  // The truth as the simulation saw it: a --set may override a hidden effect's constant, so each
-  // parameter is read back from the resolved scene where it maps to one scalar key (found by
-  // perturbing the parameter and seeing which override changes); otherwise, when one of the
-  // effect's keys was overridden, the value is unknown to the catalog and written as null.
   json::Object effects;
-  auto key_of = [](const std::string& set) { return set.substr(0, set.find('=')); };
   std::set<std::string> user_keys;
   for (const std::string& set : o.sets) user_keys.insert(key_of(set));
-  for (const auto& [c, sets] : effect_sets) {
-    json::Object params;
-    std::vector<double> truth;
-    for (const CandidateParameter& p : c->params) truth.push_back(p.truth);
-    for (std::size_t i = 0; i < c->params.size(); ++i) {
-      std::vector<double> bumped = truth;
-      bumped[i] = truth[i] * 1.37 + 0.11;
-      const std::vector<std::string> other = c->sets(base, bumped);
-      std::vector<std::string> keys;
-      for (std::size_t j = 0; j < sets.size() && j < other.size(); ++j)
-        if (sets[j] != other[j]) keys.push_back(key_of(sets[j]));
-      bool overridden = false;
-      for (const std::string& k : keys) overridden = overridden || user_keys.count(k) > 0;
-      // The parameter is the key's value itself when one key changes and it holds exactly truth[i].
-      bool direct = false;
-      if (keys.size() == 1)
-        for (const std::string& set : sets)
-          if (key_of(set) == keys[0]) {
-            char* end = nullptr;
-            const std::string v = set.substr(keys[0].size() + 1);
-            const double x = std::strtod(v.c_str(), &end);
-            direct = end && *end == '\0' && std::abs(x - truth[i]) <= 1e-12 * std::abs(truth[i]);
-          }
-      if (!overridden)
-        params.add(c->params[i].name, truth[i]);
-      else if (direct)
-        params.add(c->params[i].name, scene.number(keys[0]));
-      else
-        params.add(c->params[i].name, std::string("null"));
-    }
-    std::string keys = "[";
-    for (std::size_t i = 0; i < sets.size(); ++i) keys += (i ? ", " : "") + json::quote(sets[i]);
-    json::Object e;
-    e.add("truth", params.str(6)).add("sets", keys + "]");
-    effects.add(c->name, e.str(4));
-  }
+  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys));
   if (scene.string("load.protocol") != "staircase")
     scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
   if (scene.string("solver.mode") != "quasi_static")
