@@ -259,7 +259,9 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
                       int budget, const std::vector<double>* start = nullptr) {
   const std::size_t k = c.params.size();
   Calibration best;
-  double worst = 1.0;  // largest finite RSS seen (deg^2), for the failure score
+  // Largest finite RSS seen (deg^2), for the failure score; starts at 1e6 deg^2 (tens of degrees
+  // RMS over a recording) so that a failure before any large RSS never scores like a good fit.
+  double worst = 1e6;
   auto eval = [&](const std::vector<double>& x) {
     std::vector<double> v(k);
     for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
