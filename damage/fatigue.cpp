@@ -14,6 +14,50 @@ namespace {
 // Floor of the stored integrity 1 - d: keeps it strictly positive even if 1/(1 + a) underflows after
 // an absurd overload (it is never reached with finite drivers in practice).
 constexpr double kMinIntegrity = std::numeric_limits<double>::min();
+
+/// Backward-Euler integrity update: the root s in (0, s_old] of s + a s^n = s_old, and ds/da.
+struct IntegrityUpdate {
+  double s = 1.0;
+  double ds_da = 0.0;
+};
+IntegrityUpdate integrity_update(double s_old, double a, double n) {
+  IntegrityUpdate u;
+  if (a == 0.0) {
+    u.s = s_old;
+    u.ds_da = -std::pow(s_old, n);
+    return u;
+  }
+  if (n == 1.0) {
+    u.s = s_old / (1.0 + a);
+  } else {
+    // f(s) = s + a s^n - s_old is increasing and convex on s > 0 with f(s_old) >= 0: Newton from
+    // s_old decreases monotonically to the root (never overshoots below it, so s stays > 0).
+    // Stop once a step no longer changes s beyond rounding; 60 iterations cover any a that leaves s
+    // above kMinIntegrity (quadratic once near the root).
+    double s = s_old;
+    for (int it = 0; it < 60; ++it) {
+      const double sn1 = std::pow(s, n - 1.0);
+      const double f = s + a * sn1 * s - s_old;
+      const double step = f / (1.0 + n * a * sn1);
+      const double next = s - step;
+      if (!(next > 0.0)) {  // only possible through rounding at absurd overloads
+        s = s * 0.5;
+        continue;
+      }
+      if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * s) {
+        s = next;
+        break;
+      }
+      s = next;
+    }
+    u.s = s;
+  }
+  u.s = std::max(u.s, kMinIntegrity);
+  // Implicit differentiation of s + a s^n = s_old: ds/da = -s^n / (1 + n a s^(n-1)).
+  const double sn1 = std::pow(u.s, n - 1.0);
+  u.ds_da = -sn1 * u.s / (1.0 + n * a * sn1);
+  return u;
+}
 }  // namespace
 
 FatigueRate fatigue_rate(double X, const FatigueParams& p) {
@@ -31,7 +75,7 @@ FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(s
   const std::string me = "fatigue";
   detail::require_split_base(base_, me);
   detail::require_potential_base(base_, me);
-  detail::require_finite(me, {{"tau", p.tau_s}, {"q", p.q}, {"d_fail", p.d_fail}});
+  detail::require_finite(me, {{"tau", p.tau_s}, {"q", p.q}, {"d_fail", p.d_fail}, {"n", p.n}});
   if (p.driver == FatigueDriver::energy) {
     detail::require_finite(me, {{"W_th", p.W_th_Pa}});
     detail::require(p.W_th_Pa > 0.0, me,
@@ -46,6 +90,9 @@ FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(s
   detail::require(p.q >= 1.0, me,
                   "q must be >= 1 (exponent of the threshold excess; q > 1 gives a continuous tangent), got " +
                       detail::num(p.q));
+  detail::require(p.n >= 1.0 && p.n <= 20.0, me,
+                  "n must lie in [1, 20] (integrity exponent: 1 = first-order kinetics, larger saturates "
+                  "sooner), got " + detail::num(p.n));
   detail::require(p.d_fail > 0.0 && p.d_fail < 1.0, me,
                   "d_fail must lie in (0, 1) (damage at which a point counts as failed), got " + detail::num(p.d_fail));
 }
@@ -78,11 +125,12 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
     }
     const FatigueRate rate = fatigue_rate(X, p_);
     const double a = dt_over_tau * rate.g;
-    const double s_new = std::max(s_old / (1.0 + a), kMinIntegrity);
+    const IntegrityUpdate upd = integrity_update(s_old, a, p_.n);
+    const double s_new = upd.s;
     if (!ps.own_new.empty()) ps.own_new[0] = s_new;
     if (tangent) {
-      // d s_new / dF = -s_new / (1 + a) (dt / tau) g'(X) dX/dF
-      const double ds_dX = -s_new / (1.0 + a) * dt_over_tau * rate.dg_dX;
+      // d s_new / dF = ds/da (dt / tau) g'(X) dX/dF
+      const double ds_dX = upd.ds_da * dt_over_tau * rate.dg_dX;
       r.A_iso *= s_new;
       if (ds_dX != 0.0) r.A_iso += ds_dX * flatten(r.P_iso) * flatten(dX_dF).transpose();
     }

@@ -2,9 +2,9 @@
 // Progressive (cyclic, time-driven) fatigue damage of the isochoric response: a rate law in the
 // spirit of FEBio's reactive fatigue material (FEBioMech, FEReactiveFatigue: bonds break at a rate
 // set by a damage criterion and the surviving fraction carries the load), reduced here to one
-// irreversible scalar d in [0, 1) with first-order kinetics:
+// irreversible scalar d in [0, 1):
 //
-//   dd/dt = (1/tau) g (1 - d),       g = < X / X_th - 1 >^q,   <x> = max(x, 0),
+//   dd/dt = (1/tau) g (1 - d)^n,     g = < X / X_th - 1 >^q,   <x> = max(x, 0),
 //   P_iso = (1 - d) P0_iso,          psi_iso = (1 - d) W0        (strain equivalence, Lemaitre),
 //
 // with the driver X either the effective (undamaged) isochoric energy W0 = psi_iso of the base
@@ -12,16 +12,27 @@
 // lambda_th > 1). Below the threshold d does not change at all; above it, a higher driver breaks
 // faster. q > 1 makes g, and with it the consistent tangent, continuous at the threshold.
 //
-// Time integration over the physical increment dt (TimeStep::dt_s), backward Euler with g at the end
-// of the increment, has the closed form (a = dt g / tau):
-//   d_new = (d_old + a) / (1 + a),   i.e.   1 - d_new = (1 - d_old) / (1 + a),
-// so d_new is in [d_old, 1): damage never decreases and never reaches 1 (first-order accurate; the
-// exact solution at constant g is 1 - d = (1 - d_old) exp(-g dt / tau)). The integrity 1 - d is what
-// is stored, which keeps it strictly positive (no rounding of d up to 1).
+// The integrity exponent n >= 1 sets how growth slows as damage accumulates. n = 1 is first-order
+// kinetics (a constant overload halves the integrity every tau ln2 / g). n > 1 saturates: the rate
+// falls like (1 - d)^n, so already-damaged points damage ever more slowly and damage spreads to
+// neighbours instead of running away at the hot spots (a structure softens, its stretch at a given
+// pressure rises, and with n = 1 that feedback makes the damage, and the error it causes, accelerate
+// trial after trial). It is the damage-dependent rate of continuum fatigue laws written in the
+// remaining integrity: only the still-intact fraction can break, and it breaks ever more slowly.
 //
-// Consistent tangent (the trial d_new depends on F through the driver):
-//   A_iso = (1 - d_new) A0_iso - P0_iso (x) d d_new/dF,
-//   d d_new/dF = (1 - d_new)/(1 + a) (dt/tau) g'(X) dX/dF,
+// Time integration over the physical increment dt (TimeStep::dt_s) is backward Euler with g at the
+// end of the increment. With the integrity s = 1 - d and a = dt g / tau it reads
+//   s_new + a s_new^n = s_old,
+// which for n = 1 has the closed form s_new = s_old / (1 + a) and for n > 1 is solved by scalar Newton
+// (the left side is increasing and convex in s > 0, so Newton from s_old converges monotonically from
+// above). s_new is in (0, s_old]: damage never decreases and never reaches 1 (first-order accurate;
+// the exact solution at constant g is s = s_old exp(-a) for n = 1 and
+// s = (s_old^(1-n) + (n-1) a)^(-1/(n-1)) for n > 1). The integrity is what is stored, which keeps it
+// strictly positive (no rounding of d up to 1).
+//
+// Consistent tangent (the trial s_new depends on F through the driver):
+//   A_iso = s_new A0_iso + P0_iso (x) d s_new/dF,
+//   d s_new/dF = -s_new^n / (1 + n a s_new^(n-1)) (dt/tau) g'(X) dX/dF,
 //   dX/dF = P0_iso (energy; needs a base whose psi_iso is a potential of P_iso) or
 //   dX/dF = F n (x) n / lambda (stretch; n the unit eigenvector of C of its largest eigenvalue).
 // With dt = 0 (a static solve in pseudo time) the law is the elastic base scaled by the committed 1 - d.
@@ -45,8 +56,8 @@ enum class FatigueDriver {
 };
 
 /// W_th_Pa > 0 (threshold energy density, J/m^3 = Pa), tau_s > 0 (s, time scale of the damage rate),
-/// q >= 1 (exponent), d_fail in (0, 1) (failure criterion). With the stretch driver lambda_th > 1
-/// replaces W_th_Pa (which is then ignored).
+/// q >= 1 (exponent), d_fail in (0, 1) (failure criterion), n >= 1 (integrity exponent; 1 = the
+/// first-order law). With the stretch driver lambda_th > 1 replaces W_th_Pa (which is then ignored).
 struct FatigueParams {
   double W_th_Pa = 0.0;
   double tau_s = 0.0;
@@ -54,9 +65,10 @@ struct FatigueParams {
   double d_fail = 0.9;
   FatigueDriver driver = FatigueDriver::energy;
   double lambda_th = 0.0;
+  double n = 1.0;
 };
 
-/// Driver excess and damage rate at one point, dd/dt = rate (1 - d) with rate = g / tau.
+/// Driver excess and damage rate at one point, dd/dt = (g / tau) (1 - d)^n.
 struct FatigueRate {
   double X = 0.0;       ///< driver value (J/m^3 or dimensionless stretch)
   double g = 0.0;       ///< <X/X_th - 1>^q

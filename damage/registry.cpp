@@ -41,11 +41,12 @@ std::vector<MaterialEffect> builtins() {
   {
     MaterialEffect e;
     e.name = "fatigue";
-    e.doc = "progressive fatigue damage dd/dt = <X/X_th - 1>^q (1 - d) / tau above a threshold";
+    e.doc = "progressive fatigue damage dd/dt = <X/X_th - 1>^q (1 - d)^n / tau above a threshold";
     e.params = {{"W_th_MPa", "MPa", "threshold isochoric energy density (driver = energy)", 0.02, 0.003, 0.1, true},
                 {"lambda_th", "1", "threshold stretch (driver = max_principal_stretch)", 1.5, 1.05, 3.0, false},
                 {"tau_s", "s", "time scale of the damage rate", 1000.0, 100.0, 1e5, true},
                 {"q", "1", ">= 1; exponent of the overload", 2.0, 1.0, 4.0, false},
+                {"n", "1", ">= 1; integrity exponent (> 1: growth slows as damage accumulates)", 1.0, 1.0, 6.0, false},
                 {"d_fail", "1", "damage at which a point is flagged failed", 0.9, 0.5, 0.99, false}};
     e.decorate = [](MaterialPtr base, const std::map<std::string, double>& p) {
       FatigueParams f;
@@ -53,6 +54,7 @@ std::vector<MaterialEffect> builtins() {
       f.lambda_th = p.at("lambda_th");
       f.tau_s = p.at("tau_s");
       f.q = p.at("q");
+      f.n = p.at("n");
       f.d_fail = p.at("d_fail");
       return make_fatigue(std::move(base), f);  // driver = energy; scenes choose it with `driver`
     };

@@ -184,7 +184,7 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
   }
   if (on("fatigue")) {
     const std::string K = T + ".fatigue";
-    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "d_fail"}, "fatigue");
+    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail"}, "fatigue");
     FatigueParams f;
     const std::string driver = s.string(K + ".driver");
     if (driver == "energy")
@@ -197,6 +197,7 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
     f.lambda_th = s.number(K + ".lambda_th");
     f.tau_s = s.number(K + ".tau_s");
     f.q = s.number(K + ".q");
+    f.n = s.number(K + ".n");
     f.d_fail = s.number(K + ".d_fail");
     e.fatigue = f;
   }

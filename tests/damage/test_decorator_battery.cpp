@@ -110,6 +110,8 @@ const FatigueParams kFatigue{2e3, 100.0, 2.0, 0.5};
 const FatigueParams kFatigueStretch{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2};
 const ViscoParams kVisco{{0.5, 0.3}, {0.1, 2.0}};
 const FatigueParams kFatigueInStack{2e3, 50.0, 2.0, 0.5};
+// Saturating law (integrity exponent n = 3): the tangent goes through the scalar Newton's ds/da.
+const FatigueParams kFatigueSaturating{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2, 3.0};
 
 MaterialPtr stack() {
   return make_viscoelastic(make_fatigue(make_mullins(ecoflex(), kMullins), kFatigueInStack), kVisco);
@@ -159,6 +161,11 @@ std::vector<Case> cases() {
          for (int n = 0; n < 3; ++n) mp.advance(uniaxial(1.8), 10.0);
        },
        10.0, false, nullptr},  // dX/dF = F n n / lambda is not P0: no simple guard, exercised by the FD
+      {"fatigue_stretch_saturating", [] { return make_fatigue(ecoflex(), kFatigueSaturating); },
+       [](MaterialPoint& mp) {
+         for (int n = 0; n < 3; ++n) mp.advance(uniaxial(1.8), 10.0);
+       },
+       10.0, false, nullptr},
       {"viscoelastic", [] { return make_viscoelastic(ecoflex(), kVisco); },
        [](MaterialPoint& mp) {
          std::mt19937 rng(5);

@@ -94,6 +94,66 @@ TEST(Fatigue, ConstantDriverMatchesExactSolutionAtFirstOrder) {
   }
 }
 
+// Saturating law, integrity exponent n = 3, constant driver: ds/dt = -(g/tau) s^n has the exact
+// solution s(T) = (s0^(1-n) + (n-1) g T/tau)^(-1/(n-1)). Every increment must satisfy its backward-Euler
+// equation s_new + a s_new^n = s_old to rounding, and N increments must converge to the exact solution
+// at first order (the error halves when N doubles: observed order in [0.9, 1.1] once N >= 40).
+TEST(Fatigue, SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution) {
+  FatigueParams p = kParams;
+  p.n = 3.0;
+  const Mat3 F = uniaxial(1.6);
+  const double g = std::pow(base_energy(F) / p.W_th_Pa - 1.0, p.q);
+  const double T = 4.0 * p.tau_s / g;  // g T / tau = 4: s = 1/3 (n = 1 would give exp(-4) = 0.018)
+  const double s_exact = std::pow(1.0 + (p.n - 1.0) * g * T / p.tau_s, -1.0 / (p.n - 1.0));
+  std::vector<double> err;
+  for (int N : {10, 20, 40, 80, 160, 320}) {
+    MaterialPoint mp(make_fatigue(ecoflex(), p));
+    const double a = g * (T / N) / p.tau_s;
+    double s_prev = 1.0;
+    for (int k = 0; k < N; ++k) {
+      mp.advance(F, T / N);
+      const double s = 1.0 - damage(mp);
+      // Residual of the implicit update relative to s_old: a few ulps (Newton stops at 4 eps).
+      ASSERT_NEAR(s + a * std::pow(s, p.n), s_prev, 1e-14) << "N = " << N << ", increment " << k;
+      ASSERT_LT(s, s_prev);
+      s_prev = s;
+    }
+    err.push_back(s_prev - s_exact);
+  }
+  for (std::size_t i = 2; i < err.size(); ++i) {
+    const double order = std::log2(err[i - 1] / err[i]);
+    EXPECT_GT(order, 0.9) << "pair " << i;
+    EXPECT_LT(order, 1.1) << "pair " << i;
+  }
+  EXPECT_LT(std::abs(err.back()), 0.01 * s_exact);  // N = 320 within 1 % of the exact integrity
+}
+
+// At the same damage and driver the saturating law grows (1 - d)^(n-1) times slower than n = 1: one
+// short increment from the same committed damage d0 gives Delta d ratio -> (1 - d0)^(n-1) as dt -> 0.
+TEST(Fatigue, SaturatingRateScalesWithIntegrityPower) {
+  const Mat3 F = uniaxial(2.0);
+  FatigueParams p1 = kParams, p3 = kParams;
+  p3.n = 3.0;
+  const double g = std::pow(base_energy(F) / kParams.W_th_Pa - 1.0, kParams.q);
+  MaterialPoint m1(make_fatigue(ecoflex(), p1));
+  m1.advance(F, kParams.tau_s / g);  // a = 1: d0 = 0.5 with n = 1
+  const double s0 = 1.0 - damage(m1);
+  ASSERT_NEAR(s0, 0.5, 1e-12);
+  // The n = 3 point with the same committed integrity, reached in one increment of its own update.
+  MaterialPoint m3(make_fatigue(ecoflex(), p3));
+  // Backward Euler in one increment: s0 + a s0^3 = 1 -> a = (1 - s0) / s0^3, dt = a tau / g.
+  m3.advance(F, (1.0 - s0) / std::pow(s0, 3.0) * kParams.tau_s / g);
+  ASSERT_NEAR(1.0 - damage(m3), s0, 1e-12);
+  const double dt = 1e-5;  // a = g dt / tau ~ 5e-5
+  const double d1 = damage(m1), d3 = damage(m3);
+  m1.advance(F, dt);
+  m3.advance(F, dt);
+  const double ratio = (damage(m3) - d3) / (damage(m1) - d1);
+  // The two BE updates differ from the rate ratio by O(a) = 5e-5 relative (expand 1/(1 + a) and
+  // the Newton root to first order); 1e-3 leaves room for rounding of the small differences.
+  EXPECT_NEAR(ratio, s0 * s0, 1e-3 * s0 * s0);
+}
+
 TEST(Fatigue, BelowThresholdDamageIsExactlyConstant) {
   MaterialPoint mp(make_fatigue(ecoflex(), kParams));
   for (int n = 0; n < 5; ++n) mp.advance(uniaxial(2.0), 1.0);
@@ -168,6 +228,7 @@ TEST(Fatigue, RejectsBadParameters) {
   expect_error({5e3, 10.0, 0.5, 0.5}, "fatigue: q must be >= 1");
   expect_error({5e3, 10.0, 2.0, 1.0}, "fatigue: d_fail must lie in (0, 1)");
   expect_error({5e3, 10.0, 2.0, 0.0}, "fatigue: d_fail must lie in (0, 1)");
+  expect_error({5e3, 10.0, 2.0, 0.5, FatigueDriver::energy, 0.0, 0.5}, "fatigue: n must lie in [1, 20]");
   expect_error({5e3, INFINITY, 2.0, 0.5}, "fatigue: tau must be a finite number");
   expect_error({0.0, 10.0, 2.0, 0.5, FatigueDriver::max_principal_stretch, 1.0}, "fatigue: lambda_th must be > 1");
   try {
