@@ -1,6 +1,7 @@
 #include "app/diagnose.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "app/compare.h"
 #include "app/drive.h"
 #include "app/effect_catalog.h"
+#include "app/elastic_curve.h"
 #include "app/json.h"
 #include "app/run.h"
 #include "engine/angle.h"
@@ -74,13 +76,17 @@ class RomEvaluator {
     d.max_report_gap_s = 0.5;  // creep and damage inside holds: 0.5 s states, linear in between
     inlet_ = measured_load(rec, d, base.number("load.rest_s"), true, offset_);
     rest_s_ = base.number("load.rest_s");
+    for (const TrialLoad& tr : inlet_.trials)
+      for (double p : tr.pressure_Pa) inlet_max_Pa_ = std::max(inlet_max_Pa_, p);
   }
 
   const PathModel& path() const { return *path_; }
 
-  /// Model angle (deg) at every frame of `frames_` for the variant scene.
-  std::vector<double> at_frames(const Scene& variant) const {
-    const std::vector<std::vector<double>> per_trial = simulate(variant, true);
+  /// Model angle (deg) at every frame of `frames_` for the variant scene. With `rig_surrogate` an
+  /// elastic variant with gravity in the y-z plane takes its FEM curve from the rig-angle
+  /// interpolation (rig_angle_curve) instead of its own FEM sweep: for calibrating the rig angle.
+  std::vector<double> at_frames(const Scene& variant, bool rig_surrogate = false) const {
+    const std::vector<std::vector<double>> per_trial = simulate(variant, true, rig_surrogate);
     std::vector<double> out(frames_.size());
     std::vector<std::size_t> next(rec_.trials.size(), 0);
     for (std::size_t i = 0; i < frames_.size(); ++i) out[i] = per_trial[frames_[i].trial_index][next[frames_[i].trial_index]++];
@@ -100,7 +106,7 @@ class RomEvaluator {
 
  private:
   /// Per trial, the model angle at the kept frames (kept_only) or at every angle sample.
-  std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only) const {
+  std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only, bool rig_surrogate = false) const {
     const std::unique_ptr<BuiltModel> bm = build_model(variant);
     const double lag = variant.has("load.pressure_lag_s") ? variant.number("load.pressure_lag_s") : 0.0;
     const LoadHistory load = lag > 0.0 ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
@@ -121,14 +127,17 @@ class RomEvaluator {
       // tests/app/test_path_model.cpp); gravity loads a different deformation mode, which the
       // 1-dof reduced model cannot represent, so then the sweep is the full static FEM (fewer
       // points, quadratic interpolation; cached by scene without the lag).
-      double hi = 0.0;
-      for (const TrialLoad& tr : load.trials)
-        for (double p : tr.pressure_Pa) hi = std::max(hi, p);
-      const bool fem = bm->model.gravity_m_s2.norm() > 0.0;
-      const int n = fem ? 16 : 120;
+      // Curves span the inlet's peak pressure, which a lagged chamber pressure never exceeds, so
+      // every lag shares one curve per scene (the cache key leaves the lag out).
+      const double hi = inlet_max_Pa_;
+      const Vec3 g = bm->model.gravity_m_s2;
+      const bool fem = g.norm() > 0.0;
+      const int n = fem ? kFemCurvePoints : 120;
       std::vector<double> th;
-      if (fem) {
-        th = elastic_curve(variant, *bm, hi, n);
+      if (fem && rig_surrogate && g.x() == 0.0) {
+        th = rig_angle_curve(variant, g, hi, n);
+      } else if (fem) {
+        th = elastic_curve(variant, bm.get(), hi, n);
       } else {
         PathLoad pl;
         for (int i = 0; i <= n; ++i) {
@@ -189,24 +198,45 @@ class RomEvaluator {
     return out;
   }
 
-  /// Angles (deg) of the static FEM equilibria at p = hi i / n, i = 0..n (cached).
-  std::vector<double> elastic_curve(const Scene& variant, const BuiltModel& bm, double hi, int n) const {
+  static constexpr int kFemCurvePoints = 16;
+
+  /// The elastic FEM curve of `variant` (gravity g = |g| (0, cos phi, -sin phi), phi the rig angle)
+  /// interpolated over phi from the curves at five rig angles (app/elastic_curve.h): calibrating
+  /// phi then costs five FEM sweeps instead of one per evaluation (26 with the default budget). The
+  /// calibrated phi is evaluated with its own sweep (series()), so the reported error is the FEM's,
+  /// not the interpolation's (tests/app/test_elastic_curve.cpp checks the interpolation between
+  /// nodes against direct sweeps; tests/app/test_diagnose.cpp the RSS at the calibrated angle).
+  std::vector<double> rig_angle_curve(const Scene& variant, const Vec3& g, double hi, int n) const {
+    const double G = g.norm(), phi = std::atan2(-g.z(), g.y());
+    std::array<std::vector<double>, kRigAngleNodes> node;
+    tbb::parallel_for(0, kRigAngleNodes, [&](int j) {
+      const double a = rig_angle_node_rad(j);
+      // Components below 1e-12 G are exactly 0 (cos 90 deg is 6e-17), as the gravity candidate writes them.
+      auto clean = [G](double x) { return std::abs(x) < 1e-12 * G ? 0.0 : x; };
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[0.0, %.17g, %.17g]", clean(G * std::cos(a)), clean(-G * std::sin(a)));
+      node[j] = elastic_curve(variant.with({buf}), nullptr, hi, n);
+    });
+    const std::array<double, kRigAngleNodes> w = rig_angle_weights(phi);
+    std::vector<double> th(node[0].size(), 0.0);
+    for (int j = 0; j < kRigAngleNodes; ++j)
+      for (std::size_t i = 0; i < th.size(); ++i) th[i] += w[j] * node[j][i];
+    return th;
+  }
+
+  /// Angles (deg) of the static FEM equilibria at p = hi i / n, i = 0..n (cached by scene; `bm`
+  /// is the variant's built model, or null to build it on a cache miss).
+  std::vector<double> elastic_curve(const Scene& variant, const BuiltModel* bm_in, double hi, int n) const {
     const std::string key = variant.with({"load.pressure_lag_s=0.0"}).to_toml();
     {
       std::lock_guard<std::mutex> lock(cache_mu_);
       const auto it = curves_.find(key);
       if (it != curves_.end()) return it->second;
     }
-    const Assembler A(bm.model);
-    StaticSolver solver(A, bm.solver.quasi_static.newton);
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(bm.model.num_dofs());
-    std::vector<double> state;
-    solver.advance(0.0, 0.0, 0.0, 0.0, state, u);  // gravity alone
-    std::vector<double> th = {bending_angle(bm.model, u).angle_deg};
-    for (int i = 1; i <= n; ++i) {
-      solver.advance(hi * (i - 1) / n, hi * i / n, 0.0, 0.0, state, u);
-      th.push_back(unwrap_deg(bending_angle(bm.model, u).angle_deg, th.back()));
-    }
+    std::unique_ptr<BuiltModel> own;
+    if (!bm_in) own = build_model(variant);
+    const BuiltModel& bm = bm_in ? *bm_in : *own;
+    const std::vector<double> th = static_angle_curve(bm, hi, n);
     std::lock_guard<std::mutex> lock(cache_mu_);
     curves_[key] = th;
     return th;
@@ -220,7 +250,7 @@ class RomEvaluator {
   std::unique_ptr<PathModel> path_;
   LoadHistory inlet_;
   std::vector<double> offset_;
-  double rest_s_ = 0.0, p_max_Pa_ = 0.0;
+  double rest_s_ = 0.0, p_max_Pa_ = 0.0, inlet_max_Pa_ = 0.0;
 };
 
 double rss_of(const std::vector<double>& model, const std::vector<ComparedFrame>& frames) {
@@ -535,7 +565,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       for (const CandidateParameter& p : c.params) r.param_names.push_back(p.name);
       auto rss = [&](const std::vector<double>& v) {
         const Scene s = cur_scene.with(c.sets(cur_scene, v));
-        return rss_of(rom.at_frames(s), frames);
+        return rss_of(rom.at_frames(s, c.rig_angle), frames);
       };
       const auto tc = std::chrono::steady_clock::now();
       const Calibration cal = calibrate(c, rss, opt.max_evaluations);

@@ -133,6 +133,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     // phi = 90 deg: g = -z, towards the fabric side (horizontal actuator bending downwards). The
     // half model (x >= 0) keeps the symmetry since g_x = 0.
     e.params = {{"rig_angle_deg", "deg", 0.0, 180.0, 90.0, 90.0, false}};
+    e.rig_angle = true;
     e.sets = [e](const Scene&, const std::vector<double>& v) {
       require_count(e, v);
       constexpr double g = 9.81, kPi = 3.14159265358979323846;

@@ -29,6 +29,9 @@ struct CandidateEffect {
   std::string description;  ///< one line, plain words
   std::string signature;    ///< residual signature it explains, plain words (diagnose's "why")
   bool history = false;     ///< the response depends on the load history (creep, damage)
+  /// The only parameter is the rig angle (the gravity direction in the y-z plane): diagnose then
+  /// calibrates on FEM curves interpolated over the angle (five sweeps) instead of one sweep per run.
+  bool rig_angle = false;
   std::vector<CandidateParameter> params;
   /// `--set` overrides (key=value) that add the effect with these parameter values (one per param,
   /// in order) to `scene`. Throws InputError for a wrong number of values.

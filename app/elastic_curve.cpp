@@ -1,0 +1,45 @@
+#include "app/elastic_curve.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/static_solver.h"
+#include "scenes/build_model.h"
+
+namespace pneufem {
+
+std::vector<double> static_angle_curve(const BuiltModel& bm, double hi_Pa, int n) {
+  const Assembler A(bm.model);
+  StaticSolver solver(A, bm.solver.quasi_static.newton);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm.model.num_dofs());
+  std::vector<double> state;
+  solver.advance(0.0, 0.0, 0.0, 0.0, state, u);  // gravity alone
+  std::vector<double> th = {bending_angle(bm.model, u).angle_deg};
+  for (int i = 1; i <= n; ++i) {
+    solver.advance(hi_Pa * (i - 1) / n, hi_Pa * i / n, 0.0, 0.0, state, u);
+    th.push_back(unwrap_deg(bending_angle(bm.model, u).angle_deg, th.back()));
+  }
+  return th;
+}
+
+double rig_angle_node_rad(int j) { return j * 3.14159265358979323846 / 4.0; }
+
+std::array<double, kRigAngleNodes> rig_angle_weights(double phi_rad) {
+  auto basis = [](double a) {
+    Eigen::Matrix<double, kRigAngleNodes, 1> b;
+    b << 1.0, std::cos(a), std::sin(a), std::cos(2 * a), std::sin(2 * a);
+    return b;
+  };
+  // Interpolation matrix M_jk = basis_k(phi_j): f(phi) = basis(phi)^T M^-1 f_nodes, so the weights
+  // solve M^T w = basis(phi).
+  Eigen::Matrix<double, kRigAngleNodes, kRigAngleNodes> M;
+  for (int j = 0; j < kRigAngleNodes; ++j) M.row(j) = basis(rig_angle_node_rad(j)).transpose();
+  const Eigen::Matrix<double, kRigAngleNodes, 1> w = M.transpose().partialPivLu().solve(basis(phi_rad));
+  std::array<double, kRigAngleNodes> out;
+  for (int j = 0; j < kRigAngleNodes; ++j) out[j] = w(j);
+  return out;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,28 @@
+#pragma once
+// Elastic response curves for diagnose: the bending angle of a history-free scene as a function of
+// the chamber pressure, from static FEM equilibria, and its interpolation over the rig angle (the
+// direction of gravity), which lets diagnose calibrate the rig angle on five FEM sweeps.
+#include <array>
+#include <vector>
+
+namespace pneufem {
+
+struct BuiltModel;
+
+/// Angles (deg, unwrapped) of the static FEM equilibria at p = hi_Pa i / n, i = 0..n (gravity and
+/// every other load of the model on; internal variables are not evolved: elastic models only).
+/// Throws PhysicsError when an equilibrium cannot be found.
+std::vector<double> static_angle_curve(const BuiltModel& bm, double hi_Pa, int n);
+
+/// Rig angle phi: gravity g = |g| (0, cos phi, -sin phi) in the scene frame (y along the actuator,
+/// z up); 0 = hanging tip-down, pi/2 = horizontal with the fabric side down.
+constexpr int kRigAngleNodes = 5;
+/// Node j = 0..4 of the interpolation: j pi / 4 (0, 45, 90, 135, 180 deg).
+double rig_angle_node_rad(int j);
+/// Weights w_j with f(phi) = sum_j w_j f(phi_j) for every trigonometric polynomial
+/// f = a0 + a1 cos phi + b1 sin phi + a2 cos 2phi + b2 sin 2phi (exact at the nodes).
+/// Why this basis: the angle is a smooth function of the load direction; its first harmonic is the
+/// linear response to the actuator's weight and the second the leading nonlinearity in it.
+std::array<double, kRigAngleNodes> rig_angle_weights(double phi_rad);
+
+}  // namespace pneufem
