@@ -82,11 +82,9 @@ class RomEvaluator {
 
   const PathModel& path() const { return *path_; }
 
-  /// Model angle (deg) at every frame of `frames_` for the variant scene. With `rig_surrogate` an
-  /// elastic variant with gravity in the y-z plane takes its FEM curve from the rig-angle
-  /// interpolation (rig_angle_curve) instead of its own FEM sweep: for calibrating the rig angle.
-  std::vector<double> at_frames(const Scene& variant, bool rig_surrogate = false) const {
-    const std::vector<std::vector<double>> per_trial = simulate(variant, true, rig_surrogate);
+  /// Model angle (deg) at every frame of `frames_` for the variant scene.
+  std::vector<double> at_frames(const Scene& variant) const {
+    const std::vector<std::vector<double>> per_trial = simulate(variant, true);
     std::vector<double> out(frames_.size());
     std::vector<std::size_t> next(rec_.trials.size(), 0);
     for (std::size_t i = 0; i < frames_.size(); ++i) out[i] = per_trial[frames_[i].trial_index][next[frames_[i].trial_index]++];
@@ -104,9 +102,15 @@ class RomEvaluator {
     return out;
   }
 
- private:
   /// Per trial, the model angle at the kept frames (kept_only) or at every angle sample.
-  std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only, bool rig_surrogate = false) const {
+  /// True when a run of `variant` costs a static FEM sweep (elastic with gravity), not the reduced model.
+  bool uses_fem_sweeps(const Scene& variant) const {
+    const std::unique_ptr<BuiltModel> bm = build_model(variant);
+    return !has_history(bm->model) && bm->model.gravity_m_s2.norm() > 0.0;
+  }
+
+ private:
+  std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only) const {
     const std::unique_ptr<BuiltModel> bm = build_model(variant);
     const double lag = variant.has("load.pressure_lag_s") ? variant.number("load.pressure_lag_s") : 0.0;
     const LoadHistory load = lag > 0.0 ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
@@ -130,13 +134,10 @@ class RomEvaluator {
       // Curves span the inlet's peak pressure, which a lagged chamber pressure never exceeds, so
       // every lag shares one curve per scene (the cache key leaves the lag out).
       const double hi = inlet_max_Pa_;
-      const Vec3 g = bm->model.gravity_m_s2;
-      const bool fem = g.norm() > 0.0;
+      const bool fem = bm->model.gravity_m_s2.norm() > 0.0;
       const int n = fem ? kFemCurvePoints : 120;
       std::vector<double> th;
-      if (fem && rig_surrogate && g.x() == 0.0) {
-        th = rig_angle_curve(variant, g, hi, n);
-      } else if (fem) {
+      if (fem) {
         th = elastic_curve(variant, bm.get(), hi, n);
       } else {
         PathLoad pl;
@@ -149,12 +150,7 @@ class RomEvaluator {
       for (std::size_t k = 0; k < nt; ++k) {
         const TrialLoad& tr = load.trials[k];
         for (double t : times[k]) {
-          const double p = tr.pressure(std::clamp(t, 0.0, tr.duration()));
-          const double x = hi > 0.0 ? std::clamp(p / hi, 0.0, 1.0) * n : 0.0;
-          // Quadratic (3-point Lagrange) interpolation on the nearest samples.
-          const int c = std::clamp(static_cast<int>(std::lround(x)), 1, n - 1);
-          const double u = x - c;
-          out[k].push_back(th[c] + 0.5 * u * (th[c + 1] - th[c - 1]) + 0.5 * u * u * (th[c + 1] - 2 * th[c] + th[c - 1]));
+          out[k].push_back(curve_at(th, hi, tr.pressure(std::clamp(t, 0.0, tr.duration()))));
         }
       }
       return out;
@@ -184,7 +180,23 @@ class RomEvaluator {
       }
       g += rest;
     }
-    const std::vector<double> th = path_->run(bm->model, pl);
+    std::vector<double> th = path_->run(bm->model, pl);
+    if (bm->model.gravity_m_s2.norm() > 0.0) {
+      // Gravity loads a deformation mode the 1-dof reduced model cannot carry: add the elastic
+      // FEM's gravity offset at the same pressure, theta_g(p) - theta_0(p) (exact for the elastic
+      // model; for history effects it neglects how their softening changes the sag, a second-order
+      // term). Two static sweeps per gravity vector (cached).
+      const Scene el = elastic_reference(variant);
+      const Vec3 gv = bm->model.gravity_m_s2;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
+      const double hi = inlet_max_Pa_;
+      const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
+      const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
+      std::vector<double> off(cg.size());
+      for (std::size_t i = 0; i < cg.size(); ++i) off[i] = cg[i] - c0[i];
+      for (std::size_t i = 0; i < th.size(); ++i) th[i] += curve_at(off, hi, pl.p_Pa[i]);
+    }
     for (std::size_t k = 0; k < nt; ++k) {
       const TrialLoad& tr = load.trials[k];
       for (double t : times[k]) {
@@ -200,28 +212,14 @@ class RomEvaluator {
 
   static constexpr int kFemCurvePoints = 16;
 
-  /// The elastic FEM curve of `variant` (gravity g = |g| (0, cos phi, -sin phi), phi the rig angle)
-  /// interpolated over phi from the curves at five rig angles (app/elastic_curve.h): calibrating
-  /// phi then costs five FEM sweeps instead of one per evaluation (26 with the default budget). The
-  /// calibrated phi is evaluated with its own sweep (series()), so the reported error is the FEM's,
-  /// not the interpolation's (tests/app/test_elastic_curve.cpp checks the interpolation between
-  /// nodes against direct sweeps; tests/app/test_diagnose.cpp the RSS at the calibrated angle).
-  std::vector<double> rig_angle_curve(const Scene& variant, const Vec3& g, double hi, int n) const {
-    const double G = g.norm(), phi = std::atan2(-g.z(), g.y());
-    std::array<std::vector<double>, kRigAngleNodes> node;
-    tbb::parallel_for(0, kRigAngleNodes, [&](int j) {
-      const double a = rig_angle_node_rad(j);
-      // Components below 1e-12 G are exactly 0 (cos 90 deg is 6e-17), as the gravity candidate writes them.
-      auto clean = [G](double x) { return std::abs(x) < 1e-12 * G ? 0.0 : x; };
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[0.0, %.17g, %.17g]", clean(G * std::cos(a)), clean(-G * std::sin(a)));
-      node[j] = elastic_curve(variant.with({buf}), nullptr, hi, n);
-    });
-    const std::array<double, kRigAngleNodes> w = rig_angle_weights(phi);
-    std::vector<double> th(node[0].size(), 0.0);
-    for (int j = 0; j < kRigAngleNodes; ++j)
-      for (std::size_t i = 0; i < th.size(); ++i) th[i] += w[j] * node[j][i];
-    return th;
+  /// A curve sampled at p = hi i / n (n = th.size() - 1) at pressure p (quadratic 3-point Lagrange
+  /// interpolation on the nearest samples; p clamped to [0, hi]).
+  static double curve_at(const std::vector<double>& th, double hi, double p) {
+    const int n = static_cast<int>(th.size()) - 1;
+    const double x = hi > 0.0 ? std::clamp(p / hi, 0.0, 1.0) * n : 0.0;
+    const int c = std::clamp(static_cast<int>(std::lround(x)), 1, n - 1);
+    const double u = x - c;
+    return th[c] + 0.5 * u * (th[c + 1] - th[c - 1]) + 0.5 * u * u * (th[c + 1] - 2 * th[c] + th[c - 1]);
   }
 
   /// Angles (deg) of the static FEM equilibria at p = hi i / n, i = 0..n (cached by scene; `bm`
@@ -267,6 +265,23 @@ double unscale(const CandidateParameter& p, double x) {
 double scale(const CandidateParameter& p, double v) {
   v = std::clamp(v, p.lo, p.hi);
   return p.log ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
+}
+
+/// Parameter values of the interpolation nodes (app/elastic_curve.h): the rig angle's five angles
+/// (deg), or Chebyshev-Lobatto nodes of the calibration coordinate (log or linear over the bounds).
+std::vector<double> interpolation_nodes(ParameterInterpolation how, const CandidateParameter& p) {
+  std::vector<double> v;
+  if (how == ParameterInterpolation::rig_angle) {
+    for (int j = 0; j < kRigAngleNodes; ++j) v.push_back(rig_angle_node_rad(j) * 180.0 / 3.14159265358979323846);
+  } else {
+    for (int j = 0; j < kSmoothNodes; ++j) v.push_back(unscale(p, smooth_node(j)));
+  }
+  return v;
+}
+/// Rig-angle weights for a value in degrees.
+std::vector<double> interpolation_weights(ParameterInterpolation, const CandidateParameter&, double value_deg) {
+  const auto w = rig_angle_weights(value_deg * 3.14159265358979323846 / 180.0);
+  return {w.begin(), w.end()};
 }
 
 struct Calibration {
@@ -563,9 +578,60 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       r.effect = c.name;
       r.round = round;
       for (const CandidateParameter& p : c.params) r.param_names.push_back(p.name);
+      // Where every run costs a static FEM sweep (elastic with gravity), a one-parameter candidate
+      // with a declared interpolation is calibrated on the model interpolated between a few node
+      // runs (app/elastic_curve.h): 5-7 sweeps instead of one per evaluation. The calibrated value
+      // is then evaluated exactly (metrics() below), so the reported error is the FEM's.
+      std::vector<std::vector<double>> node_frames;
+      std::vector<double> node_x;  // calibration coordinate of each usable node (smooth)
+      if (c.interpolation != ParameterInterpolation::none && c.params.size() == 1 &&
+          rom.uses_fem_sweeps(cur_scene.with(c.sets(cur_scene, {c.params[0].initial})))) {
+        const std::vector<double> at = interpolation_nodes(c.interpolation, c.params[0]);
+        std::vector<std::vector<double>> nf(at.size());
+        tbb::parallel_for(std::size_t{0}, at.size(), [&](std::size_t node) {
+          try {
+            nf[node] = rom.at_frames(cur_scene.with(c.sets(cur_scene, {at[node]})));
+          } catch (const PhysicsError&) {
+            // A node the FEM cannot reach (e.g. a softened actuator past its limit point).
+          }
+        });
+        if (c.interpolation == ParameterInterpolation::rig_angle) {
+          bool all = true;  // the trigonometric basis needs every node
+          for (const auto& f : nf) all = all && !f.empty();
+          if (all) node_frames = std::move(nf);
+        } else {
+          // Keep the longest run of consecutive reachable nodes (>= 4: a cubic at least); values
+          // outside it are run one by one (and fail there like the nodes did).
+          std::size_t best_lo = 0, best_len = 0;
+          for (std::size_t lo = 0; lo < nf.size();) {
+            std::size_t hi = lo;
+            while (hi < nf.size() && !nf[hi].empty()) ++hi;
+            if (hi - lo > best_len) best_lo = lo, best_len = hi - lo;
+            lo = hi + 1;
+          }
+          if (best_len >= 4)
+            for (std::size_t node = best_lo; node < best_lo + best_len; ++node) {
+              node_frames.push_back(std::move(nf[node]));
+              node_x.push_back(scale(c.params[0], at[node]));
+            }
+        }
+      }
       auto rss = [&](const std::vector<double>& v) {
+        std::vector<double> w;
+        if (!node_frames.empty() && c.interpolation == ParameterInterpolation::rig_angle) {
+          w = interpolation_weights(c.interpolation, c.params[0], v[0]);
+        } else if (!node_frames.empty()) {
+          const double x = scale(c.params[0], v[0]);
+          if (x >= node_x.front() - 1e-12 && x <= node_x.back() + 1e-12) w = lagrange_weights(node_x, x);
+        }
+        if (!w.empty()) {
+          std::vector<double> m(frames.size(), 0.0);
+          for (std::size_t node = 0; node < w.size(); ++node)
+            for (std::size_t i = 0; i < m.size(); ++i) m[i] += w[node] * node_frames[node][i];
+          return rss_of(m, frames);
+        }
         const Scene s = cur_scene.with(c.sets(cur_scene, v));
-        return rss_of(rom.at_frames(s, c.rig_angle), frames);
+        return rss_of(rom.at_frames(s), frames);
       };
       const auto tc = std::chrono::steady_clock::now();
       const Calibration cal = calibrate(c, rss, opt.max_evaluations);

@@ -53,6 +53,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     // scale in [0.5, 2]: batch-to-batch and cure variation of Ecoflex moduli is tens of percent;
     // truth 1.3 is a 30 % stiffer batch.
     e.params = {{"scale", "1", 0.5, 2.0, 1.0, 1.3, true}};
+    e.interpolation = ParameterInterpolation::smooth;
     e.sets = [e](const Scene& s, const std::vector<double>& v) {
       require_count(e, v);
       std::vector<std::string> out;
@@ -133,7 +134,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     // phi = 90 deg: g = -z, towards the fabric side (horizontal actuator bending downwards). The
     // half model (x >= 0) keeps the symmetry since g_x = 0.
     e.params = {{"rig_angle_deg", "deg", 0.0, 180.0, 90.0, 90.0, false}};
-    e.rig_angle = true;
+    e.interpolation = ParameterInterpolation::rig_angle;
     e.sets = [e](const Scene&, const std::vector<double>& v) {
       require_count(e, v);
       constexpr double g = 9.81, kPi = 3.14159265358979323846;

@@ -15,6 +15,11 @@
 
 namespace pneufem {
 
+/// none: run by run; rig_angle: the parameter is the rig angle in [0, 180] deg (trigonometric
+/// basis); smooth: a smooth response over the bounds (polynomial on Chebyshev nodes of the
+/// calibration coordinate, log or linear).
+enum class ParameterInterpolation { none, rig_angle, smooth };
+
 struct CandidateParameter {
   std::string name;   ///< e.g. "tau_s"
   std::string unit;   ///< e.g. "s"
@@ -29,9 +34,9 @@ struct CandidateEffect {
   std::string description;  ///< one line, plain words
   std::string signature;    ///< residual signature it explains, plain words (diagnose's "why")
   bool history = false;     ///< the response depends on the load history (creep, damage)
-  /// The only parameter is the rig angle (the gravity direction in the y-z plane): diagnose then
-  /// calibrates on FEM curves interpolated over the angle (five sweeps) instead of one sweep per run.
-  bool rig_angle = false;
+  /// How diagnose may interpolate the model over this candidate's single parameter when every run
+  /// costs a static FEM sweep (an elastic model with gravity); see app/elastic_curve.h.
+  ParameterInterpolation interpolation = ParameterInterpolation::none;
   std::vector<CandidateParameter> params;
   /// `--set` overrides (key=value) that add the effect with these parameter values (one per param,
   /// in order) to `scene`. Throws InputError for a wrong number of values.

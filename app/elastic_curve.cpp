@@ -42,4 +42,26 @@ std::array<double, kRigAngleNodes> rig_angle_weights(double phi_rad) {
   return out;
 }
 
+double smooth_node(int j) { return 0.5 * (1.0 - std::cos(j * 3.14159265358979323846 / (kSmoothNodes - 1))); }
+
+std::vector<double> lagrange_weights(const std::vector<double>& nodes, double x) {
+  std::vector<double> w(nodes.size());
+  for (std::size_t j = 0; j < nodes.size(); ++j) {
+    double l = 1.0;
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+      if (k != j) l *= (x - nodes[k]) / (nodes[j] - nodes[k]);
+    w[j] = l;
+  }
+  return w;
+}
+
+std::array<double, kSmoothNodes> smooth_weights(double x) {
+  std::vector<double> nodes;
+  for (int j = 0; j < kSmoothNodes; ++j) nodes.push_back(smooth_node(j));
+  const std::vector<double> w = lagrange_weights(nodes, x);
+  std::array<double, kSmoothNodes> out;
+  for (int j = 0; j < kSmoothNodes; ++j) out[j] = w[j];
+  return out;
+}
+
 }  // namespace pneufem

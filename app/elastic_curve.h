@@ -25,4 +25,15 @@ double rig_angle_node_rad(int j);
 /// linear response to the actuator's weight and the second the leading nonlinearity in it.
 std::array<double, kRigAngleNodes> rig_angle_weights(double phi_rad);
 
+/// Polynomial interpolation of degree kSmoothNodes - 1 on [0, 1] for a smooth response in a
+/// calibration coordinate (e.g. log of a stiffness scale): Chebyshev-Lobatto nodes
+/// x_j = (1 - cos(j pi / (kSmoothNodes - 1))) / 2, which include the ends and keep the Lebesgue
+/// constant small (no Runge oscillation near the bounds).
+constexpr int kSmoothNodes = 7;
+double smooth_node(int j);
+/// Lagrange weights w_j(x), sum_j w_j f(x_j) = f(x) for every polynomial of degree <= kSmoothNodes - 1.
+std::array<double, kSmoothNodes> smooth_weights(double x);
+/// Lagrange weights on any distinct nodes (diagnose drops nodes the FEM cannot reach).
+std::vector<double> lagrange_weights(const std::vector<double>& nodes, double x);
+
 }  // namespace pneufem

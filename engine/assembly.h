@@ -73,7 +73,9 @@ class Assembler {
 
   /// Largest change between two material histories of any point's damage plus viscous strain
   /// (Material::fields); the physical-time step control of rate-dependent runs.
-  double max_history_change(std::span<const double> before, std::span<const double> after) const;
+  /// `worst_element` (optional) receives the element of that point (-1 when nothing changed).
+  double max_history_change(std::span<const double> before, std::span<const double> after,
+                            int* worst_element = nullptr) const;
 
   /// Deformation gradients and responses at the element's quadrature points (for output).
   void point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,

@@ -155,7 +155,23 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
   if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
   double t = s.g0;
+  long steps = 0;
+  double last_change = 0.0, last_h = 0.0;
+  int last_element = -1;
   while (t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1))) {
+    if (++steps > opt_.max_segment_steps) {
+      std::ostringstream m;
+      m << "physical time stepping stalled: " << opt_.max_segment_steps << " steps in the load segment "
+        << s.g0 << " -> " << s.g1 << " s (global time; pressure " << s.p0 * 1e-3 << " -> " << s.p1 * 1e-3
+        << " kPa) reached only t = " << t << " s; last step " << last_h << " s with a history change of "
+        << last_change << " (time_tol " << opt_.time_tol << ")";
+      if (last_element >= 0) m << ", fastest at element " << last_element;
+      m << ". Hint: "
+        << "damage or viscous strain there changes faster than time_tol per min_dt_s (a point running away: "
+           "check the damage constants, e.g. a smaller fatigue rate or a saturating law, fatigue.n > 1), or "
+           "raise solver.time_tol / solver.max_segment_steps if the history is meant to change this fast";
+      throw PhysicsError(m.str(), last_element, t);
+    }
     double h = std::min(dt_suggest_, s.g1 - t);
     if (s.g1 - (t + h) < 0.25 * h) h = s.g1 - t;  // do not leave a sliver
     const Eigen::VectorXd u_saved = u_;
@@ -173,7 +189,9 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       ++stats_.rejected_steps;
       continue;
     }
-    const double change = asm_.max_history_change(state_saved, state_);
+    const double change = asm_.max_history_change(state_saved, state_, &last_element);
+    last_change = change;
+    last_h = h;
     if (change > 2.0 * opt_.time_tol && h > opt_.min_dt_s * (1.0 + 1e-9)) {
       u_ = u_saved;
       state_ = state_saved;

@@ -35,6 +35,10 @@ struct QuasiStaticOptions {
   double time_tol = 0.01;   ///< max change of damage / viscous strain per physical step
   double min_dt_s = 1e-3;   ///< smallest physical step
   double max_dt_s = 4.0;    ///< largest physical step (rate-dependent materials only)
+  /// Physical steps (accepted + rejected) allowed in one load segment (a ramp, a hold, a rest)
+  /// before the run stops with the element whose history changes fastest: a history that keeps
+  /// the step near min_dt_s would otherwise look like a hang (tens of thousands of Newton solves).
+  long max_segment_steps = 5000;
 };
 
 /// One reported state.

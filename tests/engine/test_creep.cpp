@@ -12,6 +12,7 @@
 
 #include "damage/effects.h"
 #include "engine/quasi_static.h"
+#include "materials/errors.h"
 #include "tests/engine/test_meshes.h"
 
 namespace pneufem {
@@ -26,7 +27,7 @@ struct CreepRun {
   long states = 0;
 };
 
-CreepRun creep(double time_tol, double max_dt = 1.0) {
+CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 5000) {
   Mesh mesh = box(1.0, 1.0, 1.0, 1, 1, 1, ElementType::Tet10);
   MaterialPtr base = neo_hookean(kMu, 1e3 * kMu);
   Model model = single_part_model(mesh, make_viscoelastic(base, ViscoParams{{kGamma}, {kTau}}));
@@ -46,6 +47,7 @@ CreepRun creep(double time_tol, double max_dt = 1.0) {
   QuasiStaticOptions opt;
   opt.time_tol = time_tol;
   opt.max_dt_s = max_dt;
+  opt.max_segment_steps = max_segment_steps;
   QuasiStaticRun run(asmb, opt);
   CreepRun out;
   const int corner = nodes_on_plane(model.mesh, 0, 1.0).front();
@@ -55,6 +57,27 @@ CreepRun creep(double time_tol, double max_dt = 1.0) {
   });
   out.states = run.stats().states;
   return out;
+}
+
+// A history that needs more physical steps than the budget allows stops with a diagnosis (which
+// element, where in time, what to change) instead of grinding on: with time_tol = 1e-7 the creep
+// of the first 0.5 s segment needs hundreds of steps, the budget is 20.
+TEST(Creep, StalledTimeSteppingStopsWithElementAndHint) {
+  try {
+    creep(1e-7, 1.0, 20);
+    FAIL() << "expected a PhysicsError";
+  } catch (const PhysicsError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("physical time stepping stalled: 20 steps"), std::string::npos) << what;
+    // Homogeneous block: every element creeps alike, so any of them may be the "fastest".
+    EXPECT_NE(what.find("fastest at element " + std::to_string(e.element())), std::string::npos) << what;
+    EXPECT_NE(what.find("solver.max_segment_steps"), std::string::npos) << what;
+    EXPECT_GE(e.element(), 0);
+    EXPECT_GT(e.time_s(), 0.0);
+    EXPECT_LT(e.time_s(), 0.5);
+  }
+  // The same run with the default budget completes (the budget, not the physics, stopped it).
+  EXPECT_NO_THROW(creep(1e-7, 1.0, 5000));
 }
 
 double sls_creep(double t) {
