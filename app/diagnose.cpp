@@ -278,12 +278,6 @@ std::vector<double> interpolation_nodes(ParameterInterpolation how, const Candid
   }
   return v;
 }
-/// Rig-angle weights for a value in degrees.
-std::vector<double> interpolation_weights(ParameterInterpolation, const CandidateParameter&, double value_deg) {
-  const auto w = rig_angle_weights(value_deg * 3.14159265358979323846 / 180.0);
-  return {w.begin(), w.end()};
-}
-
 struct Calibration {
   std::vector<double> values;
   double rss = std::numeric_limits<double>::infinity();
@@ -619,7 +613,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       auto rss = [&](const std::vector<double>& v) {
         std::vector<double> w;
         if (!node_frames.empty() && c.interpolation == ParameterInterpolation::rig_angle) {
-          w = interpolation_weights(c.interpolation, c.params[0], v[0]);
+          const auto rw = rig_angle_weights(v[0] * 3.14159265358979323846 / 180.0);
+          w.assign(rw.begin(), rw.end());
         } else if (!node_frames.empty()) {
           const double x = scale(c.params[0], v[0]);
           if (x >= node_x.front() - 1e-12 && x <= node_x.back() + 1e-12) w = lagrange_weights(node_x, x);

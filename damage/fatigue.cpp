@@ -54,7 +54,7 @@ IntegrityUpdate integrity_update(double s_old, double a, double n) {
   }
   u.s = std::max(u.s, kMinIntegrity);
   // Implicit differentiation of s + a s^n = s_old: ds/da = -s^n / (1 + n a s^(n-1)).
-  const double sn1 = std::pow(u.s, n - 1.0);
+  const double sn1 = n == 1.0 ? 1.0 : std::pow(u.s, n - 1.0);
   u.ds_da = -sn1 * u.s / (1.0 + n * a * sn1);
   return u;
 }
