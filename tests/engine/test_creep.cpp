@@ -27,7 +27,7 @@ struct CreepRun {
   long states = 0;
 };
 
-CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 5000) {
+CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 5000, double min_dt = 1e-3) {
   Mesh mesh = box(1.0, 1.0, 1.0, 1, 1, 1, ElementType::Tet10);
   MaterialPtr base = neo_hookean(kMu, 1e3 * kMu);
   Model model = single_part_model(mesh, make_viscoelastic(base, ViscoParams{{kGamma}, {kTau}}));
@@ -48,6 +48,7 @@ CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 50
   opt.time_tol = time_tol;
   opt.max_dt_s = max_dt;
   opt.max_segment_steps = max_segment_steps;
+  opt.min_dt_s = min_dt;
   QuasiStaticRun run(asmb, opt);
   CreepRun out;
   const int corner = nodes_on_plane(model.mesh, 0, 1.0).front();
@@ -78,6 +79,17 @@ TEST(Creep, StalledTimeSteppingStopsWithElementAndHint) {
   }
   // The same run with the default budget completes (the budget, not the physics, stopped it).
   EXPECT_NO_THROW(creep(1e-7, 1.0, 5000));
+}
+
+// Regression: a step at min_dt_s that the no-sliver rule stretches to the segment end (0.45 s step,
+// 0.05 s left -> one 0.5 s step) was rejected for its history change, retried at min_dt_s,
+// stretched again, forever. Minimal steps are accepted: the run completes, one state per 0.5 s output
+// segment (plus the 1 us load ramp), 25 in all.
+TEST(Creep, MinimalStepStretchedToTheSegmentEndIsAccepted) {
+  const CreepRun r = creep(1e-7, 1.0, 100, 0.45);
+  EXPECT_EQ(r.states, 25);
+  ASSERT_FALSE(r.strain.empty());
+  EXPECT_GT(r.strain.back(), 0.0);
 }
 
 double sls_creep(double t) {
