@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 
 #include <nlopt.hpp>
 #include <tbb/global_control.h>
@@ -47,6 +48,29 @@ Scene elastic_reference(const Scene& scene) {
   sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
   if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
   return scene.with(sets);
+}
+
+/// Cache key of a scene's elastic FEM curve: its TOML without the lag (curves are lag-free) and
+/// without the tables of disabled effects, whose constants do not change the model (otherwise
+/// every calibration run of a history effect on top of gravity missed the cache of its elastic
+/// gravity offset, one FEM sweep per run).
+std::string curve_key(const Scene& s) {
+  std::istringstream in(s.with({"load.pressure_lag_s=0.0"}).to_toml());
+  std::string out, block, line;
+  bool disabled = false;
+  auto flush = [&] {
+    if (!disabled) out += block;
+    block.clear();
+    disabled = false;
+  };
+  while (std::getline(in, line)) {
+    const std::size_t first = line.find_first_not_of(' ');
+    if (first != std::string::npos && line[first] == '[') flush();
+    if (first != std::string::npos && line.compare(first, std::string::npos, "enabled = false") == 0) disabled = true;
+    block += line + '\n';
+  }
+  flush();
+  return out;
 }
 
 bool has_history(const Model& m) {
@@ -225,7 +249,7 @@ class RomEvaluator {
   /// Angles (deg) of the static FEM equilibria at p = hi i / n, i = 0..n (cached by scene; `bm`
   /// is the variant's built model, or null to build it on a cache miss).
   std::vector<double> elastic_curve(const Scene& variant, const BuiltModel* bm_in, double hi, int n) const {
-    const std::string key = variant.with({"load.pressure_lag_s=0.0"}).to_toml();
+    const std::string key = curve_key(variant);
     {
       std::lock_guard<std::mutex> lock(cache_mu_);
       const auto it = curves_.find(key);
@@ -576,6 +600,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       // with a declared interpolation is calibrated on the model interpolated between a few node
       // runs (app/elastic_curve.h): 5-7 sweeps instead of one per evaluation. The calibrated value
       // is then evaluated exactly (metrics() below), so the reported error is the FEM's.
+      const auto tc = std::chrono::steady_clock::now();  // calibration wall time, node sweeps included
       std::vector<std::vector<double>> node_frames;
       std::vector<double> node_x;  // calibration coordinate of each usable node (smooth)
       if (c.interpolation != ParameterInterpolation::none && c.params.size() == 1 &&
@@ -628,7 +653,6 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
         const Scene s = cur_scene.with(c.sets(cur_scene, v));
         return rss_of(rom.at_frames(s), frames);
       };
-      const auto tc = std::chrono::steady_clock::now();
       const Calibration cal = calibrate(c, rss, opt.max_evaluations);
       r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
       r.evaluations = cal.evaluations;
