@@ -58,6 +58,19 @@ TEST(SmoothWeights, ReproducePolynomialsUpToDegreeSixExactly) {
   EXPECT_NEAR(smooth_node(kSmoothNodes - 1), 1.0, 1e-15);
 }
 
+/// Largest |sum_j w_j node_j[i] - direct[i]| over the curve's samples i.
+template <class Weights>
+double max_interpolation_error(const Weights& w, const std::vector<std::vector<double>>& node,
+                               const std::vector<double>& direct) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < direct.size(); ++i) {
+    double v = 0.0;
+    for (std::size_t j = 0; j < node.size(); ++j) v += w[j] * node[j][i];
+    e = std::max(e, std::abs(v - direct[i]));
+  }
+  return e;
+}
+
 std::string gravity_at(double phi, double G) {
   char buf[128];
   std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[0.0, %.17g, %.17g]", G * std::cos(phi), -G * std::sin(phi));
@@ -84,14 +97,8 @@ TEST(RigAngleInterpolation, MatchesDirectFemSweepsBetweenNodes) {
   for (double deg : {22.5, 67.5, 157.5}) {
     const double phi = deg * kPi / 180.0;
     const std::vector<double> direct = curve({gravity_at(phi, G)});
-    const auto w = rig_angle_weights(phi);
-    double e = 0.0;
-    for (int i = 0; i <= n; ++i) {
-      double v = 0.0;
-      for (int j = 0; j < kRigAngleNodes; ++j) v += w[j] * node[j][i];
-      e = std::max(e, std::abs(v - direct[i]));
-      effect = std::max(effect, std::abs(direct[i] - none[i]));
-    }
+    const double e = max_interpolation_error(rig_angle_weights(phi), node, direct);
+    for (int i = 0; i <= n; ++i) effect = std::max(effect, std::abs(direct[i] - none[i]));
     err.push_back(e);
     std::printf("rig angle %.1f deg: interpolation error %.2e deg\n", deg, e);
   }
@@ -125,13 +132,7 @@ TEST(SmoothInterpolation, StiffnessUnderGravityMatchesDirectFemSweeps) {
   ASSERT_GT(range, 5.0);
   for (double x : {0.1, 0.37, 0.81}) {
     const std::vector<double> direct = curve(scale_at(x));
-    const auto w = smooth_weights(x);
-    double e = 0.0;
-    for (int i = 0; i <= n; ++i) {
-      double v = 0.0;
-      for (int j = 0; j < kSmoothNodes; ++j) v += w[j] * node[j][i];
-      e = std::max(e, std::abs(v - direct[i]));
-    }
+    const double e = max_interpolation_error(smooth_weights(x), node, direct);
     std::printf("stiffness scale %.3f: interpolation error %.2e deg (range %.2f deg)\n", scale_at(x), e, range);
     // 0.5 % of the angle's change over the bounds: well below what separates candidates (the
     // calibrated value is evaluated exactly afterwards; this bounds the calibration's bias).
