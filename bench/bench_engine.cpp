@@ -3,7 +3,7 @@
 //     default pneu-net mesh, 1 and N threads;
 //   * tangent assembly and one Newton iteration (assembly + CHOLMOD factorisation + solve);
 //   * one staircase trial (10 levels, 0-45 kPa) of the default scene, quasi-static Newton.
-// Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial]
+// Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -36,7 +36,7 @@ double median_seconds(int reps, F&& f) {
   return t[t.size() / 2];
 }
 
-void kernel_rates(const std::string& element, double h_mm, int threads) {
+void kernel_rates(const std::string& element, double h_mm, int threads, int reps) {
   const Scene scene = Scene::load("", {"mesh.element=\"" + element + "\"", "mesh.h_mm=" + std::to_string(h_mm)});
   auto bm = build_model(scene);
   const Assembler A(bm->model);
@@ -47,7 +47,7 @@ void kernel_rates(const std::string& element, double h_mm, int threads) {
   SparseMatrix K;
   for (int t : {1, threads}) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, t);
-    const double tf = median_seconds(7, [&] { A.internal(u, {}, {}, {}, &f, nullptr, nullptr); });
+    const double tf = median_seconds(reps, [&] { A.internal(u, {}, {}, {}, &f, nullptr, nullptr); });
     const double tk = median_seconds(3, [&] { A.internal(u, {}, {}, {}, &f, &K, nullptr); });
     std::printf("  %-5s h=%.2f mm  %6d elements  %7d dofs  threads=%d  force: %8.2f ms  %.3g element-updates/s"
                 "  (%.3g qp/s)   force+tangent: %8.2f ms\n",
@@ -105,16 +105,22 @@ void one_trial(double h_mm, int threads) {
 int main(int argc, char** argv) {
   double h = 2.0;
   int threads = tbb::info::default_concurrency();
-  bool skip_trial = false;
+  bool skip_trial = false, kernel_only = false;
+  int reps = 7;
+  std::string only_element;  // "" = both
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--skip-trial")) skip_trial = true;
+    else if (!std::strcmp(argv[i], "--kernel-only")) kernel_only = true;  // force kernel only (profiling)
+    else if (!std::strcmp(argv[i], "--element") && i + 1 < argc) only_element = argv[++i];
+    else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
   }
   std::printf("pneufem engine benchmark (threads available: %d)\n", tbb::info::default_concurrency());
   std::printf("force kernel:\n");
-  kernel_rates("tet4", h, threads);
-  kernel_rates("tet10", h, threads);
+  for (const char* el : {"tet4", "tet10"})
+    if (only_element.empty() || only_element == el) kernel_rates(el, h, threads, reps);
+  if (kernel_only) return 0;
   std::printf("implicit:\n");
   newton_iteration(h, threads);
   if (!skip_trial) one_trial(h, threads);

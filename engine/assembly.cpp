@@ -54,7 +54,27 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry(model.mesh)) {
   const Mesh& mesh = model.mesh;
   const int ne = mesh.num_elements(), nn = mesh.num_nodes(), npe = mesh.npe();
-  colours_ = colour_elements(mesh);
+  {
+    const std::vector<std::vector<int>> colours = colour_elements(mesh);
+    colour_ptr_.assign(1, 0);
+    kelem_.reserve(ne);
+    for (const auto& c : colours) {
+      kelem_.insert(kelem_.end(), c.begin(), c.end());
+      colour_ptr_.push_back(static_cast<int>(kelem_.size()));
+    }
+    const std::size_t gq = static_cast<std::size_t>(geom_.nqp) * npe * 3;
+    knodes_.resize(static_cast<std::size_t>(ne) * npe);
+    kgrad_.resize(static_cast<std::size_t>(ne) * gq);
+    kw_.resize(static_cast<std::size_t>(ne) * geom_.nqp);
+    kmat_.resize(ne);
+    for (int i = 0; i < ne; ++i) {
+      const int e = kelem_[i];
+      std::copy(mesh.element(e), mesh.element(e) + npe, knodes_.begin() + static_cast<std::ptrdiff_t>(i) * npe);
+      std::copy(geom_.grad(e, 0), geom_.grad(e, 0) + gq, kgrad_.begin() + static_cast<std::ptrdiff_t>(i * gq));
+      for (int q = 0; q < geom_.nqp; ++q) kw_[static_cast<std::size_t>(i) * geom_.nqp + q] = geom_.w(e, q);
+      kmat_[i] = &model.material_of(e);
+    }
+  }
 
   state_offset_.assign(ne + 1, 0);
   for (int e = 0; e < ne; ++e)
@@ -90,15 +110,15 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
   }
   adj_.reserve(adj_ptr_.back());
   for (auto& v : adj) adj_.insert(adj_.end(), v.begin(), v.end());
-  // Pair slots: position of node a in adj(b).
+  // Pair slots: position of node a in adj(b), per loop position.
   pair_slot_.resize(static_cast<std::size_t>(ne) * npe * npe);
-  for (int e = 0; e < ne; ++e) {
-    const int* n = mesh.element(e);
+  for (int i = 0; i < ne; ++i) {
+    const int* n = knodes_.data() + static_cast<std::size_t>(i) * npe;
     for (int a = 0; a < npe; ++a)
       for (int b = 0; b < npe; ++b) {
         const int* first = adj_.data() + adj_ptr_[n[b]];
         const int* last = adj_.data() + adj_ptr_[n[b] + 1];
-        pair_slot_[(static_cast<std::size_t>(e) * npe + a) * npe + b] =
+        pair_slot_[(static_cast<std::size_t>(i) * npe + a) * npe + b] =
             static_cast<std::uint16_t>(std::lower_bound(first, last, n[a]) - first);
       }
   }
@@ -191,15 +211,18 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
   const bool tangent = K != nullptr;
   const bool has_state = state_size() > 0;
 
-  auto kernel = [&](int e) {
-    const int* n = mesh.element(e);
+  auto kernel = [&](int pos) {  // loop position (colour order), see assembly.h
+    const int e = kelem_[pos];
+    const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
+    const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
+    const double* wq = kw_.data() + static_cast<std::size_t>(pos) * NQP;
     // F = I + grad u (not x grad N): at small strain the displacement gradient is computed to full
     // relative precision, so stresses of a stiff layer (E = 6.5 GPa) carry no round-off floor.
     Eigen::Matrix<double, 3, NPE> ue;
     for (int a = 0; a < NPE; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
     std::array<Mat3, NQP> F;
     for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));  // column a = dN_a/dX
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);  // column a = dN_a/dX
       F[q] = Mat3::Identity() + ue * g.transpose();
       const double J = F[q].determinant();
       if (!(J > 0.0) || !std::isfinite(J)) {
@@ -208,15 +231,15 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
       }
     }
     std::array<PointResponse, NQP> resp;
-    const Material& mat = model_.material_of(e);
+    const Material& mat = *kmat_[pos];
     const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
     mat.evaluate(F, ts, has_state ? state_old.subspan(o0, o1 - o0) : std::span<const double>{},
                  has_state && !state_new.empty() ? state_new.subspan(o0, o1 - o0) : std::span<double>{}, resp, tangent);
     Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
     double psi = 0.0;
     for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));
-      const double w = geom_.w(e, q);
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+      const double w = wq[q];
       const Mat3 P = resp[q].P();
       if (!P.allFinite()) {
         atomic_min(bad, e);
@@ -234,8 +257,8 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
     Eigen::Matrix<double, 3 * NPE, 3 * NPE> Ke;
     Ke.setZero();
     for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(geom_.grad(e, q));
-      const Mat9 A = geom_.w(e, q) * resp[q].A();
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+      const Mat9 A = wq[q] * resp[q].A();
       for (int b = 0; b < NPE; ++b) {
         // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
         Eigen::Matrix<double, 9, 3> T;
@@ -251,7 +274,7 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
     double* val = K->valuePtr();
     for (int b = 0; b < NPE; ++b)
       for (int a = 0; a < NPE; ++a) {
-        const int slot = pair_slot_[(static_cast<std::size_t>(e) * NPE + a) * NPE + b];
+        const int slot = pair_slot_[(static_cast<std::size_t>(pos) * NPE + a) * NPE + b];
         for (int k = 0; k < 3; ++k) {
           double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
           for (int i = 0; i < 3; ++i) col[i] += a <= b ? Ke(3 * a + i, 3 * b + k) : Ke(3 * b + k, 3 * a + i);
@@ -259,9 +282,9 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
       }
   };
 
-  for (const auto& colour : colours_) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, colour.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i < r.end(); ++i) kernel(colour[i]);
+  for (std::size_t c = 0; c + 1 < colour_ptr_.size(); ++c) {
+    tbb::parallel_for(tbb::blocked_range<int>(colour_ptr_[c], colour_ptr_[c + 1], 64), [&](const tbb::blocked_range<int>& r) {
+      for (int i = r.begin(); i < r.end(); ++i) kernel(i);
     });
   }
   if (bad.load() != INT_MAX) {

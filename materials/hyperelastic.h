@@ -54,8 +54,8 @@ class InvariantMaterial final : public Material {
   void evaluate(std::span<const Mat3> F, const TimeStep&, std::span<const double>, std::span<double>,
                 std::span<PointResponse> out, bool tangent) const override {
     for (std::size_t q = 0; q < F.size(); ++q) {
-      InvariantDerivatives d = law_.derivatives(isochoric_invariants(F[q]));
-      invariant_response(F[q], d, tangent, out[q]);
+      const Invariants v = isochoric_invariants(F[q]);
+      invariant_response(F[q], v, law_.derivatives(v), tangent, out[q]);
     }
   }
   double initial_shear_modulus() const override { return law_.mu0(); }

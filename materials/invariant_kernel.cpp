@@ -1,37 +1,65 @@
 #include "materials/invariant_kernel.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace pneufem {
 
+double inverse_cbrt(double x) {
+  std::uint64_t i;
+  std::memcpy(&i, &x, sizeof i);
+  i = 0x553ef0ff289dd796ULL - i / 3;  // exponent / -3 with a tuned mantissa: within 3.4 %
+  double y;
+  std::memcpy(&y, &i, sizeof y);
+  for (int k = 0; k < 4; ++k) y = y * (4.0 - x * y * y * y) * (1.0 / 3.0);
+  return y;
+}
+
 Invariants isochoric_invariants(const Mat3& F) {
-  const double J = F.determinant();
+  Invariants v;
+  // Cofactor matrix by columns: cof.col(J) = F.col(J+1) x F.col(J+2); then J = F.col(0) . cof.col(0).
+  v.cof.col(0) = F.col(1).cross(F.col(2));
+  v.cof.col(1) = F.col(2).cross(F.col(0));
+  v.cof.col(2) = F.col(0).cross(F.col(1));
+  v.J = F.col(0).dot(v.cof.col(0));
   const Mat3 C = F.transpose() * F;
-  const double I1 = C.trace();
-  const double I2 = 0.5 * (I1 * I1 - (C * C).trace());
-  const double Jm23 = std::cbrt(1.0 / (J * J));
-  return {J, Jm23 * I1, Jm23 * Jm23 * I2};
+  v.I1 = C.trace();
+  v.I2 = 0.5 * (v.I1 * v.I1 - C.squaredNorm());  // tr(C^2) = |C|^2, C symmetric
+  const double r = inverse_cbrt(v.J);
+  v.Jm23 = r * r;
+  v.I1b = v.Jm23 * v.I1;
+  v.I2b = v.Jm23 * v.Jm23 * v.I2;
+  return v;
 }
 
 void invariant_response(const Mat3& F, const InvariantDerivatives& d, bool tangent, PointResponse& out) {
-  const double J = F.determinant();
-  const Mat3 H = F.inverse().transpose();
+  invariant_response(F, isochoric_invariants(F), d, tangent, out);
+}
+
+void invariant_response(const Mat3& F, const Invariants& v, const InvariantDerivatives& d, bool tangent,
+                        PointResponse& out) {
+  const double J = v.J, I1 = v.I1, I2 = v.I2;
+  const Mat3 H = v.cof / J;  // F^{-T}
+  const double a = v.Jm23;   // J^{-2/3}
+  const double b = a * a;    // J^{-4/3}
+
+  const Mat3 g1 = a * (2.0 * F - (2.0 / 3.0) * I1 * H);  // dI1b/dF
+  out.psi_iso = d.W;
+  out.psi_vol = d.U;
+  out.P_vol = d.dU * v.cof;  // U'(J) dJ/dF = U' J H
+  // Laws of I1b alone (Yeoh, neo-Hookean) skip the I2b terms: that is the common case.
+  const bool has_i2 = d.W2 != 0.0 || d.W12 != 0.0 || d.W22 != 0.0;
+  if (!has_i2 && !tangent) {
+    out.P_iso = d.W1 * g1;
+    return;
+  }
   const Mat3 C = F.transpose() * F;
   const Mat3 B = F * F.transpose();
   const Mat3 FC = F * C;
-  const double I1 = C.trace();
-  const double I2 = 0.5 * (I1 * I1 - (C * C).trace());
-  const double a = std::cbrt(1.0 / (J * J));  // J^{-2/3}
-  const double b = a * a;                     // J^{-4/3}
-
-  const Mat3 G2 = 2.0 * (I1 * F - FC);                   // dI2/dF
-  const Mat3 g1 = a * (2.0 * F - (2.0 / 3.0) * I1 * H);  // dI1b/dF
-  const Mat3 g2 = b * (G2 - (4.0 / 3.0) * I2 * H);       // dI2b/dF
-
-  out.psi_iso = d.W;
-  out.psi_vol = d.U;
+  const Mat3 G2 = 2.0 * (I1 * F - FC);              // dI2/dF
+  const Mat3 g2 = b * (G2 - (4.0 / 3.0) * I2 * H);  // dI2b/dF
   out.P_iso = d.W1 * g1 + d.W2 * g2;
-  out.P_vol = d.dU * J * H;
   if (!tangent) return;
 
   const Vec9 v1 = flatten(g1), v2 = flatten(g2), vH = flatten(H);

@@ -118,7 +118,13 @@ TEST(YeohStability, LimitIsFirstSignChangeOfW1) {
     const Yeoh law(c.C10, c.C20, c.C30, 1e3 * c.C10);
     SCOPED_TRACE("C10, C20, C30 = " + std::to_string(c.C10) + ", " + std::to_string(c.C20) + ", " +
                  std::to_string(c.C30));
-    const auto W1 = [&](double x) { return law.derivatives({1.0, 3.0 + x, 3.0}).W1; };
+    const auto W1 = [&](double x) {
+      Invariants v;
+      v.J = 1.0;
+      v.I1b = 3.0 + x;
+      v.I2b = 3.0;
+      return law.derivatives(v).W1;
+    };
     const double xs = law.stability_limit_I1b_minus_3();
     const double x_scan = std::isfinite(xs) ? xs : 1e4;
     for (int k = 0; k < 1000; ++k) EXPECT_GT(W1(x_scan * k / 1000.0), 0.0) << "x = " << x_scan * k / 1000.0;
@@ -148,6 +154,27 @@ TEST(OgdenSpecialCases, MatchNeoHookeanAndMooneyRivlin) {
       EXPECT_LE(max_abs(a.A_iso - b.A_iso), 1e-10 * M);
       EXPECT_LE(max_abs(a.A_vol - b.A_vol), 1e-10 * M);
     }
+}
+
+}  // namespace
+}  // namespace pneufem
+
+namespace pneufem {
+namespace {
+
+// inverse_cbrt replaces libm's cbrt in the invariant kernel (materials/invariant_kernel.h). Over
+// 16 decades of J (far beyond any admissible deformation) it must agree with 1 / cbrt(x) to a few
+// ulp: the analysis of the four Newton steps gives ~1e-16 relative, and both sides round, so
+// 2e-15 (~9 ulp) is a bound that still fails for three steps (~3e-10).
+TEST(InverseCbrt, AgreesWithLibmToAFewUlp) {
+  double worst = 0.0;
+  for (double x = 1e-8; x < 1e8; x *= 1.001) {
+    const double ref = 1.0 / std::cbrt(x);
+    worst = std::max(worst, std::abs(inverse_cbrt(x) - ref) / ref);
+  }
+  EXPECT_LT(worst, 2e-15);
+  EXPECT_EQ(inverse_cbrt(1.0), 1.0);  // exactly: the reference state has zero stress
+  EXPECT_EQ(inverse_cbrt(8.0), 0.5);
 }
 
 }  // namespace
