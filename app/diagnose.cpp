@@ -621,18 +621,13 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
         } else {
           // Keep the longest run of consecutive reachable nodes (>= 4: a cubic at least); values
           // outside it are run one by one (and fail there like the nodes did).
-          std::size_t best_lo = 0, best_len = 0;
-          for (std::size_t lo = 0; lo < nf.size();) {
-            std::size_t hi = lo;
-            while (hi < nf.size() && !nf[hi].empty()) ++hi;
-            if (hi - lo > best_len) best_lo = lo, best_len = hi - lo;
-            lo = hi + 1;
+          std::vector<bool> reachable;
+          for (const auto& f : nf) reachable.push_back(!f.empty());
+          const NodeRun run = longest_reachable_run(reachable, 4);
+          for (std::size_t node = run.first; node < run.first + run.count; ++node) {
+            node_frames.push_back(std::move(nf[node]));
+            node_x.push_back(scale(c.params[0], at[node]));
           }
-          if (best_len >= 4)
-            for (std::size_t node = best_lo; node < best_lo + best_len; ++node) {
-              node_frames.push_back(std::move(nf[node]));
-              node_x.push_back(scale(c.params[0], at[node]));
-            }
         }
       }
       auto rss = [&](const std::vector<double>& v) {
@@ -714,29 +709,54 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   // constants, adds its frame-by-frame difference from the reduced model as a fixed correction,
   // and re-calibrates each selected effect in turn from its current constants. At convergence the
   // corrected reduced model equals the FEM at the fitted constants, so the constants are the FEM's.
-  auto fem_at_frames = [&](const Scene& s) {
+  //
+  // When the FEM cannot follow the constants to the end (typically fatigue: the reduced model
+  // misses the feedback "a damaged wall stretches more, so it damages faster", so its constants
+  // are too aggressive and the FEM's walls fail or reach a limit point), the refinement uses the
+  // frames the FEM did solve: the correction is applied there and the reduced model alone is used
+  // after the failure. Re-calibrating against that moves the constants towards what the FEM can
+  // follow, and the next refinement's FEM gets further (an FEM-verified continuation).
+  auto fem_at_frames = [&](const Scene& s, std::string* failure, double* failure_time_s) {
     DriveOptions d;
     d.threads = opt.threads;
+    d.partial_on_failure = true;
     const DriveResult dr = simulate_recording(s, rec, d);
+    *failure = dr.failure;
+    *failure_time_s = dr.failure_time_s;
     std::vector<double> v(frames.size());
-    for (std::size_t i = 0; i < frames.size(); ++i) v[i] = value_at(dr.trials[frames[i].trial_index].angle_deg, frames[i].t_s);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const Series& a = dr.trials[frames[i].trial_index].angle_deg;
+      v[i] = value_at(a, frames[i].t_s);
+      // value_at interpolates: a frame between the last solved one and the first unsolved one has
+      // no FEM value either.
+      if (!dr.failure.empty()) {
+        const auto it = std::lower_bound(a.t_s.begin(), a.t_s.end(), frames[i].t_s);
+        const std::size_t j = static_cast<std::size_t>(it - a.t_s.begin());
+        if (j >= a.t_s.size() || !std::isfinite(a.value[j]) || (j > 0 && !std::isfinite(a.value[j - 1])))
+          v[i] = NAN;
+      }
+    }
     return v;
   };
   for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
     if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d with the full FEM ...\n", it + 1);
-    std::vector<double> fem;
-    try {
-      fem = fem_at_frames(scene.with(selected_sets));
-    } catch (const PhysicsError& e) {
-      // The FEM cannot follow the fitted constants (e.g. a softened actuator past its limit
-      // point): keep the constants of the last completed round and say so.
-      out.fem_error = "refinement " + std::to_string(it + 1) + " stopped, the full FEM failed at the current constants: " + e.what();
-      if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", out.fem_error.c_str());
-      break;
+    std::string failure;
+    double failure_time_s = -1.0;
+    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets), &failure, &failure_time_s);
+    std::size_t solved = 0;
+    for (double v : fem) solved += std::isfinite(v) ? 1 : 0;
+    if (!failure.empty()) {
+      std::ostringstream m;
+      m << "refinement " << it + 1 << ": the full FEM stopped at t = " << failure_time_s << " s of trial "
+        << frames[std::min(solved, frames.size() - 1)].trial_index + 1 << " (" << solved << " of " << frames.size()
+        << " frames solved; corrected there, reduced model alone after): " << failure;
+      out.fem_error += (out.fem_error.empty() ? "" : "; ") + m.str();
+      if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", m.str().c_str());
+      if (solved == 0) break;
     }
     const std::vector<double> romv = rom.at_frames(scene.with(selected_sets));
     std::vector<double> corr(fem.size());
-    for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = fem[i] - romv[i];
+    for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = std::isfinite(fem[i]) ? fem[i] - romv[i] : 0.0;
     for (std::size_t j = 0; j < chosen.size(); ++j) {
       std::vector<std::string> others;
       for (std::size_t o = 0; o < chosen.size(); ++o)

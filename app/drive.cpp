@@ -207,7 +207,18 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     if (static_cast<int>(worst.size()) > opt.vtu_worst) worst.pop_back();
   };
   QuasiStaticRun run(asmb, bm->solver.quasi_static);
-  run.run(load, observe);
+  std::size_t failed_trial = rec.trials.size();  // index of the trial that stopped early
+  try {
+    run.run(load, observe);
+  } catch (const PhysicsError& e) {
+    if (!opt.partial_on_failure) throw;
+    result.failure = e.what();
+    failed_trial = 0;
+    while (failed_trial + 1 < rec.trials.size() && !result.trials[failed_trial + 1].states_angle_deg.t_s.empty())
+      ++failed_trial;
+    const Series& solved = result.trials[failed_trial].states_angle_deg;
+    result.failure_time_s = solved.t_s.empty() ? 0.0 : solved.t_s.back();
+  }
   if (opt.progress) std::fprintf(stderr, "\n");
   result.states = run.stats().states;
   result.mesh = bm->stats;
@@ -217,8 +228,14 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     const Series& frames = rec.trials[k].angle_deg;
     tt.angle_deg.t_s = frames.t_s;
     tt.angle_deg.value.reserve(frames.t_s.size());
+    const Series& solved = tt.states_angle_deg;
+    // After an early stop, frames past the last solved state of the failed trial (and all frames
+    // of later trials) have no model value.
+    const double t_end = k < failed_trial    ? INFINITY
+                         : k == failed_trial ? (solved.t_s.empty() ? -INFINITY : solved.t_s.back())
+                                             : -INFINITY;
     for (double t : frames.t_s)
-      tt.angle_deg.value.push_back(interp_clamped(tt.states_angle_deg.t_s, tt.states_angle_deg.value, t));
+      tt.angle_deg.value.push_back(t <= t_end && !solved.t_s.empty() ? interp_clamped(solved.t_s, solved.value, t) : NAN);
   }
   if (want_vtu && !worst.empty()) {
     std::filesystem::create_directories(opt.vtu_dir);

@@ -48,6 +48,9 @@ struct DriveOptions {
   bool progress = false;                ///< progress line on stderr
   std::string vtu_dir;                  ///< "" = no files; else VTU of the `vtu_worst` worst states
   int vtu_worst = 3;                    ///< states with the largest |model - measured| angle
+  /// On a PhysicsError (e.g. the actuator past its limit point): false = rethrow; true = return
+  /// the frames solved so far (later frames NaN) with DriveResult::failure set.
+  bool partial_on_failure = false;
 };
 
 struct TrialTrace {
@@ -71,6 +74,8 @@ struct DriveResult {
   double tolerance_kPa = 0.0;      ///< the RDP tolerance used (auto or given)
   std::vector<WorstState> worst;   ///< VTU files written (empty without vtu_dir)
   MeshStats mesh;                  ///< statistics of the model's mesh (regions: elements_per_region)
+  std::string failure;             ///< why the run stopped early ("" = it completed; partial_on_failure)
+  double failure_time_s = -1.0;    ///< recording time of the last solved state of the failed trial
 };
 
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt);

@@ -44,6 +44,17 @@ std::array<double, kRigAngleNodes> rig_angle_weights(double phi_rad) {
 
 double smooth_node(int j) { return 0.5 * (1.0 - std::cos(j * 3.14159265358979323846 / (kSmoothNodes - 1))); }
 
+NodeRun longest_reachable_run(const std::vector<bool>& reachable, std::size_t min_count) {
+  NodeRun best;
+  for (std::size_t lo = 0; lo < reachable.size();) {
+    std::size_t hi = lo;
+    while (hi < reachable.size() && reachable[hi]) ++hi;
+    if (hi - lo > best.count) best = {lo, hi - lo};
+    lo = hi + 1;
+  }
+  return best.count >= min_count ? best : NodeRun{};
+}
+
 std::vector<double> lagrange_weights(const std::vector<double>& nodes, double x) {
   std::vector<double> w(nodes.size());
   for (std::size_t j = 0; j < nodes.size(); ++j) {

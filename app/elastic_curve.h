@@ -3,6 +3,7 @@
 // the chamber pressure, from static FEM equilibria, and its interpolation over the rig angle (the
 // direction of gravity), which lets diagnose calibrate the rig angle on five FEM sweeps.
 #include <array>
+#include <cstddef>
 #include <vector>
 
 namespace pneufem {
@@ -35,5 +36,15 @@ double smooth_node(int j);
 std::array<double, kSmoothNodes> smooth_weights(double x);
 /// Lagrange weights on any distinct nodes (diagnose drops nodes the FEM cannot reach).
 std::vector<double> lagrange_weights(const std::vector<double>& nodes, double x);
+
+/// The nodes diagnose interpolates between when some are unreachable for the FEM (a softened
+/// actuator past its limit point): the longest run of consecutive reachable nodes (the first on a
+/// tie), or none (count 0) when it is shorter than `min_count`. Values outside the run are then
+/// simulated one by one. Why consecutive: interpolating across a gap would bridge a parameter range
+/// where the model does not exist.
+struct NodeRun {
+  std::size_t first = 0, count = 0;
+};
+NodeRun longest_reachable_run(const std::vector<bool>& reachable, std::size_t min_count);
 
 }  // namespace pneufem

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 
@@ -170,6 +171,35 @@ TEST_F(DriveTest, ChamberPressureLagActsOnTheMeasuredInlet) {
   }
   EXPECT_GT(std::abs(lagged_pressure(bm->load.trials[0], tau_s, 4.5) - bm->load.trials[0].pressure(4.5)), 1e3)
       << "the lag must matter at the test times";
+}
+
+// A run the FEM cannot finish (trial 2 drives the actuator far past its ballooning limit): by
+// default the PhysicsError propagates (compare must not report half a run as a result); with
+// partial_on_failure the frames solved before the failure keep their values, identical to a run
+// that did not fail (same equilibria), and every later frame is NaN (diagnose --refine uses this).
+TEST_F(DriveTest, PartialRunOnFailureKeepsTheSolvedFrames) {
+  Recording rec = sampled_staircase(scene(), 0.0, 1);
+  for (double& p : rec.trials[1].pressure_kPa.value) p *= 10.0;  // 0 ... 300 kPa
+  const Scene s = scene().with({"solver.min_increment_kPa=0.5"});  // give up quickly at the limit
+  DriveOptions opt;
+  opt.threads = 2;
+  EXPECT_THROW(simulate_recording(s, rec, opt), PhysicsError);
+  opt.partial_on_failure = true;
+  const DriveResult r = simulate_recording(s, rec, opt);
+  EXPECT_FALSE(r.failure.empty());
+  std::printf("stopped at t = %.3f s of trial 2: %s\n", r.failure_time_s, r.failure.c_str());
+  ASSERT_EQ(r.trials.size(), 2u);
+  EXPECT_EQ(r.trials[0].angle_deg.value, clean().trials[0].angle_deg.value);  // trial 1 unaffected
+  const Series& a = r.trials[1].angle_deg;
+  std::size_t finite = 0, nan_after = 0, finite_after = 0;
+  for (std::size_t j = 0; j < a.t_s.size(); ++j) {
+    if (std::isfinite(a.value[j])) ++finite;
+    if (a.t_s[j] > r.failure_time_s) (std::isfinite(a.value[j]) ? finite_after : nan_after) += 1;
+  }
+  EXPECT_GT(finite, 30u) << "the 0 kPa hold and the first ramp of trial 2 were solved";
+  EXPECT_GT(nan_after, 0u) << "the run must have stopped before the end of trial 2";
+  EXPECT_EQ(finite_after, 0u) << "no model value after the last solved state";
+  EXPECT_GT(r.failure_time_s, 4.0);
 }
 
 TEST(Drive, CreepCarriesOverBetweenTrialsAsInADirectRun) {

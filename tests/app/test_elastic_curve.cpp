@@ -58,6 +58,34 @@ TEST(SmoothWeights, ReproducePolynomialsUpToDegreeSixExactly) {
   EXPECT_NEAR(smooth_node(kSmoothNodes - 1), 1.0, 1e-15);
 }
 
+// Nodes the FEM cannot reach (diagnose's smooth interpolation): the longest consecutive run of
+// reachable nodes is kept, the first one on a tie, none below the minimum count; interpolating on
+// the kept subset stays exact for polynomials of degree count - 1 inside it.
+TEST(SmoothWeights, UnreachableNodesAreDroppedAsALongestConsecutiveRun) {
+  const auto run = [](std::vector<bool> ok, std::size_t min_count) {
+    const NodeRun r = longest_reachable_run(ok, min_count);
+    return std::make_pair(r.first, r.count);
+  };
+  using P = std::pair<std::size_t, std::size_t>;
+  EXPECT_EQ(run({true, true, true, true, true, true, true}, 4), P(0, 7));
+  EXPECT_EQ(run({false, false, true, true, true, true, true}, 4), P(2, 5));  // soft end past the limit point
+  EXPECT_EQ(run({true, true, false, true, true, true, true}, 4), P(3, 4));   // a gap: never bridged
+  EXPECT_EQ(run({true, true, true, false, true, true, true}, 3), P(0, 3));   // tie: the first
+  EXPECT_EQ(run({true, true, true, false, true, true, true}, 4).second, 0u);  // too short: none
+  EXPECT_EQ(run({}, 4).second, 0u);
+
+  // Kept nodes 2..6 of the Chebyshev-Lobatto set: exact for quartics on [x_2, x_6].
+  std::vector<double> nodes;
+  for (int j = 2; j < kSmoothNodes; ++j) nodes.push_back(smooth_node(j));
+  auto f = [](double x) { return 0.3 - 1.1 * x + 0.7 * x * x + 2.0 * x * x * x - 0.9 * x * x * x * x; };
+  for (double x = nodes.front(); x <= nodes.back(); x += 0.05) {
+    const std::vector<double> w = lagrange_weights(nodes, x);
+    double v = 0.0;
+    for (std::size_t j = 0; j < w.size(); ++j) v += w[j] * f(nodes[j]);
+    EXPECT_NEAR(v, f(x), 1e-13) << "x = " << x;  // rounding only (|f| < 3, Lebesgue constant < 3)
+  }
+}
+
 /// Largest |sum_j w_j node_j[i] - direct[i]| over the curve's samples i.
 template <class Weights>
 double max_interpolation_error(const Weights& w, const std::vector<std::vector<double>>& node,
