@@ -367,6 +367,25 @@ double Assembler::max_history_change(std::span<const double> a, std::span<const 
   return worst;
 }
 
+Assembler::RegionFailures Assembler::failed_points(std::span<const double> state) const {
+  const Mesh& mesh = model_.mesh;
+  // A mesh without region tags counts as one region (index 0).
+  const bool tagged = !mesh.region_names.empty() && mesh.region.size() == static_cast<std::size_t>(mesh.num_elements());
+  RegionFailures r;
+  r.failed.assign(tagged ? mesh.region_names.size() : 1, 0);
+  r.points.assign(r.failed.size(), 0);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const Material& mat = model_.material_of(e);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    const std::size_t reg = tagged ? mesh.region[e] : 0;
+    r.points[reg] += geom_.nqp;
+    if (ss == 0) continue;
+    for (int q = 0; q < geom_.nqp; ++q)
+      if (mat.fields(state.subspan(state_offset_[e] + q * ss, ss)).failed) ++r.failed[reg];
+  }
+  return r;
+}
+
 void Assembler::point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
                                 std::span<PointResponse> out) const {
   const Mesh& mesh = model_.mesh;

@@ -77,6 +77,13 @@ class Assembler {
   double max_history_change(std::span<const double> before, std::span<const double> after,
                             int* worst_element = nullptr) const;
 
+  /// Material points whose law reports failure (PointFields::failed, e.g. fatigue damage >= d_fail)
+  /// and all material points, per region (index = mesh region id; one entry for an untagged mesh).
+  struct RegionFailures {
+    std::vector<int> failed, points;
+  };
+  RegionFailures failed_points(std::span<const double> state) const;
+
   /// Deformation gradients and responses at the element's quadrature points (for output).
   void point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
                        std::span<PointResponse> out) const;

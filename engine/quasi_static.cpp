@@ -211,6 +211,29 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   }
 }
 
+std::string QuasiStaticRun::failure_note() const {
+  // Points a damage law has declared failed explain most stalls of damaged runs: say where.
+  if (state_.empty()) return "";
+  const Assembler::RegionFailures f = asm_.failed_points(state_);
+  int total = 0, worst = -1;
+  for (std::size_t r = 0; r < f.failed.size(); ++r) {
+    total += f.failed[r];
+    if (f.failed[r] > 0 && (worst < 0 || f.failed[r] * f.points[worst] > f.failed[worst] * f.points[r]))
+      worst = static_cast<int>(r);
+  }
+  if (total == 0) return "";
+  std::ostringstream m;
+  const std::vector<std::string>& names = asm_.model().mesh.region_names;
+  m << " [" << total << " material points had failed (damage >= d_fail) by then";
+  if (!names.empty() && f.failed.size() == names.size())
+    m << "; the largest share in region '" << names[static_cast<std::size_t>(worst)] << "', " << f.failed[worst]
+      << " of its " << f.points[worst] << " points";
+  else
+    m << ", of " << f.points[0];
+  m << ": a damage law is destroying that part, so the structure gives way (check its constants)]";
+  return m.str();
+}
+
 void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, const CheckpointSink& sink,
                          const QuasiStaticCheckpoint* resume) {
   const auto wall0 = std::chrono::steady_clock::now();
@@ -229,7 +252,13 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
   }
   for (std::size_t i = first; i < segs.size(); ++i) {
     const Segment& s = segs[i];
-    solve_segment(s);
+    try {
+      solve_segment(s);
+    } catch (const PhysicsError& e) {
+      std::string msg = e.what();
+      msg += failure_note();
+      throw PhysicsError(msg, e.element(), e.time_s());
+    }
     if (s.report) {
       StateRecord rec;
       rec.trial = s.trial + 1;

@@ -100,6 +100,7 @@ class QuasiStaticRun {
     bool report;             ///< a report is due at t1
   };
   static std::vector<Segment> segments(const LoadHistory& load);
+  std::string failure_note() const;  ///< where damage laws report failed points ("" = none)
   void solve_segment(const Segment& s);
   void equilibrium(double p0, double p1, double t0, double t1);
 

@@ -7,6 +7,7 @@
 // term adds gamma E_inf with relaxation time tau. Under a constant stress sigma0 applied at t = 0:
 //   eps(t) = sigma0 / E_inf * (1 - gamma / (1 + gamma) * exp(-t / tau_c)),  tau_c = (1 + gamma) tau.
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
@@ -132,6 +133,55 @@ TEST(Creep, ResponseConvergesAsTheTimeToleranceTightens) {
   EXPECT_LT(err[1], err[0]);
   EXPECT_LT(err[2], err[1]);
   EXPECT_LT(err[2], 0.25 * err[0]);
+}
+
+}  // namespace
+}  // namespace pneufem
+
+namespace pneufem {
+namespace {
+
+using namespace testing;
+
+// A block under constant tension whose fatigue damage runs away (stretch driver above threshold,
+// first-order kinetics): its stiffness goes to zero under a fixed load, so the run must stop with
+// a PhysicsError — and, because damage laws declared points failed first (d >= d_fail = 0.5),
+// the message says how many and that a damage law is destroying the part.
+TEST(FatigueRunaway, StopsAndNamesTheFailedPoints) {
+  Mesh mesh = box(1.0, 1.0, 1.0, 1, 1, 1, ElementType::Tet4);
+  FatigueParams fp;
+  fp.driver = FatigueDriver::max_principal_stretch;
+  fp.lambda_th = 1.01;
+  fp.tau_s = 1.0;
+  fp.q = 1.0;
+  fp.d_fail = 0.5;
+  Model model = single_part_model(mesh, make_fatigue(neo_hookean(kMu, 1e3 * kMu), fp));
+  fix(model, nodes_on_plane(model.mesh, 0, 0.0), {true, false, false});
+  fix(model, nodes_on_plane(model.mesh, 1, 0.0), {false, true, false});
+  fix(model, nodes_on_plane(model.mesh, 2, 0.0), {false, false, true});
+  model.pressure_faces = faces_where(model.mesh, [](const Eigen::Vector3d& X) { return X.x() > 1 - 1e-12; });
+  model.angle.tip_nodes = nodes_on_plane(model.mesh, 0, 1.0);
+  Assembler asmb(model);
+  LoadHistory load;
+  TrialLoad tl;
+  tl.time_s = {0.0, 1e-3, 1000.0};
+  tl.pressure_Pa = {0.0, -0.3 * kMu, -0.3 * kMu};  // stretch ~1.1 undamaged, above lambda_th
+  tl.output_s = {1000.0};
+  load.trials.push_back(tl);
+  QuasiStaticOptions opt;
+  opt.max_segment_steps = 2000;
+  QuasiStaticRun run(asmb, opt);
+  try {
+    run.run(load, nullptr);
+    FAIL() << "a block losing all its stiffness under a fixed load cannot reach t = 1000 s";
+  } catch (const PhysicsError& e) {
+    const std::string what = e.what();
+    std::printf("%s\n", what.c_str());
+    EXPECT_NE(what.find("material points had failed (damage >= d_fail)"), std::string::npos) << what;
+    EXPECT_NE(what.find("a damage law is destroying that part"), std::string::npos) << what;
+    EXPECT_GT(e.time_s(), 0.0);
+    EXPECT_LT(e.time_s(), 1000.0);
+  }
 }
 
 }  // namespace
