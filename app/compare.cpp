@@ -190,7 +190,9 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
       .add("volume_m3", r.drive.mesh.volume_m3)
       .add("elements_per_region", mesh_regions.str(4));
   json::Object sim;
-  sim.add("states", static_cast<double>(r.drive.states))
+  sim.add_str("status", r.drive.failure.empty() ? "complete" : "incomplete")
+      .add_str("failure", r.drive.failure)
+      .add("states", static_cast<double>(r.drive.states))
       .add("pressure_tolerance_kPa", r.drive.tolerance_kPa)
       .add("wall_s", r.drive.wall_s);
   json::Object o;
@@ -346,11 +348,21 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
   dopt.vtu_dir = staging.string();
+  // A model the FEM cannot follow to the end (a limit point, failed walls) still gives the
+  // comparison of the frames solved before: hours of computation are not thrown away, and where it
+  // stopped is itself a finding. metrics.json says "incomplete" with the reason; the CLI exits 1.
+  dopt.partial_on_failure = true;
   try {
     r.drive = simulate_recording(scene, rec, dopt);
+    if (!r.drive.failure.empty()) {
+      std::ostringstream w;
+      w << "the model run stopped early (at t = " << r.drive.failure_time_s
+        << " s of its last trial): the metrics cover only the frames solved before. " << r.drive.failure;
+      r.warnings.push_back(w.str());
+    }
     r.comparison = compare_recording(rec, model_series(r.drive), opt.compare);
     r.warnings.insert(r.warnings.end(), r.comparison.warnings.begin(), r.comparison.warnings.end());
-    if (opt.regions) r.regions = region_sensitivities(scene, rec, r, opt, r.warnings);
+    if (opt.regions && r.drive.failure.empty()) r.regions = region_sensitivities(scene, rec, r, opt, r.warnings);
   } catch (...) {
     fs::remove_all(staging, ec);
     throw;
@@ -378,7 +390,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   h.nrmse = r.comparison.nrmse;
   for (const TrialComparison& t : r.comparison.trials) h.trial_nrmse.push_back(t.nrmse);
   std::vector<HistoryEntry> history = read_history(opt.out_dir);
-  history.push_back(h);
+  if (r.drive.failure.empty()) history.push_back(h);
 
   write_file_atomic((dir / "metrics.json").string(), metrics_json_text(scene, opt, r, label, hash));
   write_file_atomic((dir / "metrics.csv").string(), metrics_csv_text(r.comparison));
@@ -386,7 +398,9 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   const std::vector<ReportFigure> figs = compare_figures(rec, r, history);
   for (const ReportFigure& f : figs) write_file_atomic((dir / (f.name + ".svg")).string(), f.svg);
   write_file_atomic((dir / "report.html").string(), compare_report_html(rec, r, figs, history, label, opt.data_path));
-  append_history(opt.out_dir, h);
+  // The study history plots the error of each model variant; an incomplete run's error covers
+  // other frames than the others', so it is not added there.
+  if (r.drive.failure.empty()) append_history(opt.out_dir, h);
   return r;
 }
 

@@ -82,8 +82,10 @@ struct CompareRunResult {
   double wall_s = 0.0;
 };
 
-/// Runs the comparison and writes the directory (see above). InputError for bad data or scene,
-/// PhysicsError when the model fails (nothing is written then).
+/// Runs the comparison and writes the directory (see above). InputError for bad data or scene.
+/// When the model run stops early (PhysicsError), the frames solved before are compared and
+/// written, with drive.failure set and "status": "incomplete" in metrics.json; the run is not
+/// added to the study history.
 CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt);
 
 /// One line of history.jsonl: {"time_utc", "label", "scene_hash", "nrmse", "trial_nrmse", "source"}.

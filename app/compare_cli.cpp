@@ -44,6 +44,13 @@ int run_compare_command(CompareCommand& c, const std::string& command_line) {
   std::printf("compare: NRMSE %.4f (noise floor %.4f) over %zu trials, %ld states, %.1f s; report %s/report.html\n",
               r.comparison.nrmse, r.comparison.noise_floor_nrmse, r.comparison.trials.size(), r.drive.states, r.wall_s,
               c.options.out_dir.c_str());
+  if (!r.drive.failure.empty()) {
+    std::fprintf(stderr,
+                 "\nsimulation failed: %s\n(the frames solved before are compared and written to %s, with "
+                 "\"status\": \"incomplete\" in metrics.json)\n",
+                 r.drive.failure.c_str(), c.options.out_dir.c_str());
+    return 3;  // as every physical failure (README, exit codes)
+  }
   return 0;
 }
 

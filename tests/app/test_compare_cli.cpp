@@ -193,6 +193,32 @@ TEST_F(CompareCli, WritesEverythingAndMatchesTheLibrary) {
   EXPECT_FALSE(fs::exists(fresh));
 }
 
+// A model the FEM cannot follow to the end (trial 2's inlet driven 10x past the tiny actuator's
+// ballooning limit): compare still compares and writes the frames solved before, says so
+// ("status": "incomplete", the failure, exit code 3 as every physical failure), keeps trial 1's
+// numbers exactly, and leaves the study history alone.
+TEST_F(CompareCli, ModelThatStopsEarlyWritesTheSolvedPart) {
+  Recording rec = read_measurements_csv((*dir_ / "data.csv").string());
+  for (double& p : rec.trials[1].pressure_kPa.value) p *= 10.0;
+  write_measurements_csv((*dir_ / "data_fail.csv").string(), rec);
+  const fs::path out = *dir_ / "out_fail";
+  const Result r = run("compare " + (*dir_ / "tiny.toml").string() + " --data " + (*dir_ / "data_fail.csv").string() +
+                       " --out " + out.string() + " --threads 2 --set solver.min_increment_kPa=0.5");
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("simulation failed"), std::string::npos) << r.out;
+  const std::string m = slurp(out / "metrics.json");
+  EXPECT_NE(m.find("\"status\": \"incomplete\""), std::string::npos);
+  EXPECT_NE(m.find("stopped early"), std::string::npos);
+  EXPECT_EQ(m.find("nan"), std::string::npos) << "JSON has no NaN literal";
+  const std::size_t t1 = m.find("\"trials\"");
+  ASSERT_NE(t1, std::string::npos);
+  const std::size_t n1 = m.find("\"nrmse\": ", t1);  // trial 1's (after its "nrmse_mark")
+  ASSERT_NE(n1, std::string::npos);
+  EXPECT_DOUBLE_EQ(std::strtod(m.c_str() + n1 + 9, nullptr), expected_->trials[0].nrmse);  // trial 1 complete
+  EXPECT_EQ(html_problem(slurp(out / "report.html")), "");
+  EXPECT_FALSE(fs::exists(out / "history.jsonl"));
+}
+
 TEST_F(CompareCli, RegionSensitivityFindsAPerturbedRegion) {
   // Measured = the model with the roof 5 % softer. Linearised about scale 1 with the 0.9
   // sensitivity, the roof's best scale is 0.95 up to the curvature of angle(scale) over
