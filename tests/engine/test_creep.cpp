@@ -28,16 +28,21 @@ struct CreepRun {
   long states = 0;
 };
 
-CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 5000, double min_dt = 1e-3) {
-  Mesh mesh = box(1.0, 1.0, 1.0, 1, 1, 1, ElementType::Tet10);
-  MaterialPtr base = neo_hookean(kMu, 1e3 * kMu);
-  Model model = single_part_model(mesh, make_viscoelastic(base, ViscoParams{{kGamma}, {kTau}}));
+/// Unit cube on symmetry supports (x = 0, y = 0, z = 0 planes), loaded in tension on x = 1 by a
+/// negative pressure (a follower load; at strain 5e-4 the area change is 1e-3).
+Model tension_block(ElementType type, MaterialPtr material) {
+  Model model = single_part_model(box(1.0, 1.0, 1.0, 1, 1, 1, type), std::move(material));
   fix(model, nodes_on_plane(model.mesh, 0, 0.0), {true, false, false});
   fix(model, nodes_on_plane(model.mesh, 1, 0.0), {false, true, false});
   fix(model, nodes_on_plane(model.mesh, 2, 0.0), {false, false, true});
-  // Tension on x = 1 as a negative pressure (follower; at strain 5e-4 the area change is 1e-3).
   model.pressure_faces = faces_where(model.mesh, [](const Eigen::Vector3d& X) { return X.x() > 1 - 1e-12; });
   model.angle.tip_nodes = nodes_on_plane(model.mesh, 0, 1.0);
+  return model;
+}
+
+CreepRun creep(double time_tol, double max_dt = 1.0, long max_segment_steps = 5000, double min_dt = 1e-3) {
+  const Model model =
+      tension_block(ElementType::Tet10, make_viscoelastic(neo_hookean(kMu, 1e3 * kMu), ViscoParams{{kGamma}, {kTau}}));
   Assembler asmb(model);
   LoadHistory load;
   TrialLoad tl;
@@ -148,19 +153,13 @@ using namespace testing;
 // a PhysicsError — and, because damage laws declared points failed first (d >= d_fail = 0.5),
 // the message says how many and that a damage law is destroying the part.
 TEST(FatigueRunaway, StopsAndNamesTheFailedPoints) {
-  Mesh mesh = box(1.0, 1.0, 1.0, 1, 1, 1, ElementType::Tet4);
   FatigueParams fp;
   fp.driver = FatigueDriver::max_principal_stretch;
   fp.lambda_th = 1.01;
   fp.tau_s = 1.0;
   fp.q = 1.0;
   fp.d_fail = 0.5;
-  Model model = single_part_model(mesh, make_fatigue(neo_hookean(kMu, 1e3 * kMu), fp));
-  fix(model, nodes_on_plane(model.mesh, 0, 0.0), {true, false, false});
-  fix(model, nodes_on_plane(model.mesh, 1, 0.0), {false, true, false});
-  fix(model, nodes_on_plane(model.mesh, 2, 0.0), {false, false, true});
-  model.pressure_faces = faces_where(model.mesh, [](const Eigen::Vector3d& X) { return X.x() > 1 - 1e-12; });
-  model.angle.tip_nodes = nodes_on_plane(model.mesh, 0, 1.0);
+  const Model model = tension_block(ElementType::Tet4, make_fatigue(neo_hookean(kMu, 1e3 * kMu), fp));
   Assembler asmb(model);
   LoadHistory load;
   TrialLoad tl;
