@@ -258,7 +258,14 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
     Ke.setZero();
     for (int q = 0; q < NQP; ++q) {
       const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
-      const Mat9 A = wq[q] * resp[q].A();
+      // The symmetric part of the material tangent: K = sum G^T A G is then the symmetric part of
+      // the consistent tangent, which the symmetric solver (Cholesky, upper blocks here) needs.
+      // Hyperelastic tangents have major symmetry (A = A^T, and 0.5 (a + a) == a exactly, so
+      // nothing changes for them); a rate law's consistent tangent need not (fatigue driven by the
+      // principal stretch: dP/dF gains P (x) dlambda/dF), and using its upper half only would be
+      // neither the tangent nor its symmetric part.
+      const Mat9 Aq = resp[q].A();
+      const Mat9 A = (0.5 * wq[q]) * (Aq + Aq.transpose());
       for (int b = 0; b < NPE; ++b) {
         // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
         Eigen::Matrix<double, 9, 3> T;
