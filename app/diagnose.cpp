@@ -738,6 +738,23 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     }
     return v;
   };
+  //
+  // Safeguard: the correction is frozen at the last FEM run, so when the FEM-vs-reduced difference
+  // changes quickly with the constants (damage that fails wall points) a re-calibration can jump
+  // too far (measured: fatigue W_th 4.8 -> 29 kPa, FEM error back to the baseline's). Every FEM run
+  // therefore also scores its constants; constants whose complete FEM run fits worse than the best
+  // so far are not used to build a correction — the next trial point is halfway (in each
+  // parameter's calibration scale) back towards the best, and the best constants are the result.
+  auto sets_of = [&](const std::vector<std::pair<const CandidateEffect*, std::vector<double>>>& ch) {
+    std::vector<std::string> v;
+    for (const auto& [c, vals] : ch) {
+      const std::vector<std::string> sc = c->sets(scene, vals);
+      v.insert(v.end(), sc.begin(), sc.end());
+    }
+    return v;
+  };
+  auto chosen_best = chosen;
+  double best_fem_rss = std::numeric_limits<double>::infinity();  // complete FEM runs only
   for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
     if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d with the full FEM ...\n", it + 1);
     std::string failure;
@@ -753,6 +770,24 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       out.fem_error += (out.fem_error.empty() ? "" : "; ") + m.str();
       if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", m.str().c_str());
       if (solved == 0) break;
+    } else {
+      const double fem_rss = rss_of(fem, frames);
+      if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d: FEM rss %.4g deg^2 (best %.4g)\n", it + 1, fem_rss, best_fem_rss);
+      if (!(fem_rss < best_fem_rss) && std::isfinite(best_fem_rss)) {
+        // Worse than the best complete run: step halfway back, no new correction.
+        for (std::size_t j = 0; j < chosen.size(); ++j) {
+          const std::vector<CandidateParameter>& ps = chosen[j].first->params;
+          for (std::size_t k = 0; k < ps.size(); ++k) {
+            double& v = chosen[j].second[k];
+            const double b = chosen_best[j].second[k];
+            v = ps[k].log ? std::sqrt(v * b) : 0.5 * (v + b);
+          }
+        }
+        selected_sets = sets_of(chosen);
+        continue;
+      }
+      best_fem_rss = fem_rss;
+      chosen_best = chosen;
     }
     const std::vector<double> romv = rom.at_frames(scene.with(selected_sets));
     std::vector<double> corr(fem.size());
@@ -775,10 +810,14 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       rom_runs += cal.evaluations;
       if (std::isfinite(cal.rss)) chosen[j].second = cal.values;
     }
-    selected_sets.clear();
-    for (const auto& [c, v] : chosen) {
-      const std::vector<std::string> sc = c->sets(scene, v);
-      selected_sets.insert(selected_sets.end(), sc.begin(), sc.end());
+    selected_sets = sets_of(chosen);
+  }
+  if (opt.refine > 0 && !chosen.empty()) {
+    // The result: the constants of the best complete FEM run (the last re-calibration is untested
+    // by the FEM unless it was the best), else the last ones (no FEM run completed).
+    if (std::isfinite(best_fem_rss)) {
+      chosen = chosen_best;
+      selected_sets = sets_of(chosen);
     }
     out.refined_params.clear();
     for (const auto& [c, v] : chosen) out.refined_params.push_back(v);

@@ -125,7 +125,11 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
     }
     const FatigueRate rate = fatigue_rate(X, p_);
     const double a = dt_over_tau * rate.g;
-    const IntegrityUpdate upd = integrity_update(s_old, a, p_.n);
+    IntegrityUpdate upd = integrity_update(s_old, a, p_.n);
+    // A failed point (d = d_fail) keeps its residual stiffness 1 - d_fail: the damage stops there
+    // (fatigue.h, "Failure"). min(): a state that was already below (an older checkpoint) stays.
+    const double s_floor = std::min(s_old, 1.0 - p_.d_fail);
+    if (upd.s < s_floor) upd = {s_floor, 0.0};
     const double s_new = upd.s;
     if (!ps.own_new.empty()) ps.own_new[0] = s_new;
     if (tangent) {
@@ -143,7 +147,7 @@ PointFields FatigueDamage::fields(std::span<const double> state) const {
   PointFields f = base_->fields(state.subspan(kOwnState));
   const double d = 1.0 - state[0];
   f.damage = detail::combine_damage(d, f.damage);
-  f.failed = f.failed || d >= p_.d_fail;
+  f.failed = f.failed || state[0] <= 1.0 - p_.d_fail;  // the integrity floor, bit for bit (evaluate)
   f.fatigue_damage = damage(state);
   return f;
 }

@@ -37,8 +37,12 @@
 //   dX/dF = F n (x) n / lambda (stretch; n the unit eigenvector of C of its largest eigenvalue).
 // With dt = 0 (a static solve in pseudo time) the law is the elastic base scaled by the committed 1 - d.
 //
-// Failure: fields().failed once d >= d_fail. The point keeps the residual stiffness fraction 1 - d > 0,
-// so stresses stay finite and nothing divides by zero; what failure means is the driver's decision.
+// Failure: at d = d_fail the point has failed (fields().failed) and its damage stops there: it keeps
+// the residual stiffness fraction 1 - d_fail, like the "maximum degradation" of Abaqus's damage
+// evolution. Why not let d -> 1: a failed wall with vanishing stiffness makes the structure singular,
+// the static solve stops at the first torn wall, and nothing after it (the angle of a torn actuator,
+// the FEM check of fitted constants in diagnose --refine) can be computed. Runs that stop for another
+// reason name the failed points (engine/quasi_static.h); the fields carry them for ParaView.
 //
 // psi_iso = (1 - d_new) W0 is the stored energy of the damaged solid. It is not a potential of P_iso
 // within an increment with dt > 0 (d_new depends on F), only at dt = 0.

@@ -109,7 +109,7 @@ const MullinsParams kMullins{2.0, 20e3, 0.3};
 const FatigueParams kFatigue{2e3, 100.0, 2.0, 0.5};
 const FatigueParams kFatigueStretch{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2};
 const ViscoParams kVisco{{0.5, 0.3}, {0.1, 2.0}};
-const FatigueParams kFatigueInStack{2e3, 50.0, 2.0, 0.5};
+const FatigueParams kFatigueInStack{2e3, 50.0, 2.0, 0.95};  // d_fail above the damage the cases reach
 // Saturating law (integrity exponent n = 3): the tangent goes through the scalar Newton's ds/da.
 const FatigueParams kFatigueSaturating{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2, 3.0};
 

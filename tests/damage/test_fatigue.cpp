@@ -33,10 +33,14 @@ double damage(const MaterialPoint& mp) { return FatigueDamage::damage(mp.committ
 
 // W_th = 5 kPa: uniaxial lambda = 1.3 (W0 ~ 3.5 kPa) is below, lambda = 2 (W0 ~ 42 kPa) well above.
 const FatigueParams kParams{5e3, 10.0, 2.0, 0.5};
+// The same law with its failure threshold above every damage the rate-law tests reach (0.86 at
+// most): those tests are about the integration of dd/dt, which stops at d_fail.
+const FatigueParams kRate{5e3, 10.0, 2.0, 0.99};
 
 TEST(Fatigue, DamageNeverDecreasesAndStaysBelowOne) {
-  // tau = 3000 s: the sequence ends near d = 0.9, crossing d_fail = 0.5 on the way.
-  const FatigueParams p{kParams.W_th_Pa, 3000.0, kParams.q, kParams.d_fail};
+  // tau = 3000 s: without a failure threshold the sequence ends near d = 0.79; it reaches d_fail = 0.7
+  // late, after which the damage stays exactly there (the point has failed).
+  const FatigueParams p{kParams.W_th_Pa, 3000.0, kParams.q, 0.7};
   MaterialPoint mp(make_fatigue(ecoflex(), p));
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> stretch(0.7, 2.2), dt(0.0, 2.0);
@@ -49,6 +53,7 @@ TEST(Fatigue, DamageNeverDecreasesAndStaysBelowOne) {
     const double d = damage(mp);
     ASSERT_GE(d, d_prev) << "step " << n;
     ASSERT_LT(d, 1.0) << "step " << n;
+    ASSERT_LE(1.0 - mp.committed_state()[0], p.d_fail) << "step " << n;  // capped at d_fail
     ASSERT_TRUE(r.P().allFinite()) << "step " << n;
     EXPECT_EQ(mp.fields().failed, d >= p.d_fail) << "step " << n;
     (d > d_prev ? grew : held)++;
@@ -66,20 +71,20 @@ TEST(Fatigue, DamageNeverDecreasesAndStaysBelowOne) {
 TEST(Fatigue, ConstantDriverMatchesExactSolutionAtFirstOrder) {
   const Mat3 F = uniaxial(1.6);
   const double W0 = base_energy(F);
-  const double g = std::pow(W0 / kParams.W_th_Pa - 1.0, kParams.q);
+  const double g = std::pow(W0 / kRate.W_th_Pa - 1.0, kRate.q);
   ASSERT_GT(g, 0.5);
-  const double T = 2.0 * kParams.tau_s / g;  // g T / tau = 2: d(T) = 1 - exp(-2) = 0.86
-  const double s_exact = std::exp(-g * T / kParams.tau_s);
+  const double T = 2.0 * kRate.tau_s / g;  // g T / tau = 2: d(T) = 1 - exp(-2) = 0.86
+  const double s_exact = std::exp(-g * T / kRate.tau_s);
   std::vector<double> err;
   for (int N : {10, 20, 40, 80, 160, 320}) {
-    MaterialPoint mp(make_fatigue(ecoflex(), kParams));
+    MaterialPoint mp(make_fatigue(ecoflex(), kRate));
     for (int n = 0; n < N; ++n) mp.advance(F, T / N);
     const double s = 1.0 - damage(mp);
     // The update is exactly backward Euler: equal to the closed form up to rounding of N divisions.
-    const double z = g * T / (kParams.tau_s * N);
+    const double z = g * T / (kRate.tau_s * N);
     EXPECT_NEAR(s, std::pow(1.0 + z, -N), 1e-13 * N * s) << "N = " << N;
     // Backward-Euler error, leading term within 10 % once N is large (the next term is O(1/N^2)).
-    const double leading = s_exact * std::pow(g * T / kParams.tau_s, 2) / (2.0 * N);
+    const double leading = s_exact * std::pow(g * T / kRate.tau_s, 2) / (2.0 * N);
     err.push_back(s - s_exact);
     if (N >= 80) {
       EXPECT_NEAR(err.back(), leading, 0.1 * leading) << "N = " << N;
@@ -99,7 +104,7 @@ TEST(Fatigue, ConstantDriverMatchesExactSolutionAtFirstOrder) {
 // equation s_new + a s_new^n = s_old to rounding, and N increments must converge to the exact solution
 // at first order (the error halves when N doubles: observed order in [0.9, 1.1] once N >= 40).
 TEST(Fatigue, SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution) {
-  FatigueParams p = kParams;
+  FatigueParams p = kRate;
   p.n = 3.0;
   const Mat3 F = uniaxial(1.6);
   const double g = std::pow(base_energy(F) / p.W_th_Pa - 1.0, p.q);
@@ -132,17 +137,17 @@ TEST(Fatigue, SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution) {
 // short increment from the same committed damage d0 gives Delta d ratio -> (1 - d0)^(n-1) as dt -> 0.
 TEST(Fatigue, SaturatingRateScalesWithIntegrityPower) {
   const Mat3 F = uniaxial(2.0);
-  FatigueParams p1 = kParams, p3 = kParams;
+  FatigueParams p1 = kRate, p3 = kRate;
   p3.n = 3.0;
-  const double g = std::pow(base_energy(F) / kParams.W_th_Pa - 1.0, kParams.q);
+  const double g = std::pow(base_energy(F) / kRate.W_th_Pa - 1.0, kRate.q);
   MaterialPoint m1(make_fatigue(ecoflex(), p1));
-  m1.advance(F, kParams.tau_s / g);  // a = 1: d0 = 0.5 with n = 1
+  m1.advance(F, kRate.tau_s / g);  // a = 1: d0 = 0.5 with n = 1
   const double s0 = 1.0 - damage(m1);
   ASSERT_NEAR(s0, 0.5, 1e-12);
   // The n = 3 point with the same committed integrity, reached in one increment of its own update.
   MaterialPoint m3(make_fatigue(ecoflex(), p3));
   // Backward Euler in one increment: s0 + a s0^3 = 1 -> a = (1 - s0) / s0^3, dt = a tau / g.
-  m3.advance(F, (1.0 - s0) / std::pow(s0, 3.0) * kParams.tau_s / g);
+  m3.advance(F, (1.0 - s0) / std::pow(s0, 3.0) * kRate.tau_s / g);
   ASSERT_NEAR(1.0 - damage(m3), s0, 1e-12);
   const double dt = 1e-5;  // a = g dt / tau ~ 5e-5
   const double d1 = damage(m1), d3 = damage(m3);
@@ -185,17 +190,25 @@ TEST(Fatigue, FailureFlagAndResidualStiffness) {
     ++steps;
   }
   ASSERT_TRUE(mp.fields().failed);
-  EXPECT_GE(damage(mp), kParams.d_fail);
+  EXPECT_NEAR(damage(mp), kParams.d_fail, 1e-15);  // the increment that crosses it stops there
   EXPECT_GT(steps, 1);  // it took several increments, not one
-  // Absurd overload for very long increments (a ~ 1e30 per step): d approaches 1 so closely that
-  // 1 - (1 - d) rounds to 1 in double, but the stored integrity 1 - d stays > 0 (it is what is kept),
-  // so the point keeps a positive stiffness fraction and the stresses stay finite.
+  // A failed point keeps the residual stiffness 1 - d_fail however long it stays loaded: damage and
+  // stress stop changing, and the stress is exactly that fraction of the base's isochoric stress.
+  for (int n = 0; n < 10; ++n) {
+    const PointResponse r = mp.advance(uniaxial(2.5), 10.0);
+    EXPECT_EQ(mp.committed_state()[0], 1.0 - kParams.d_fail) << "step " << n;
+    EXPECT_TRUE(mp.fields().failed);
+    const PointResponse r0 = MaterialPoint(ecoflex()).advance(uniaxial(2.5), 10.0);
+    EXPECT_NEAR((r.P_iso - (1.0 - kParams.d_fail) * r0.P_iso).norm(), 0.0, 1e-12 * r0.P_iso.norm());
+  }
+  // Absurd overload for very long increments (a ~ 1e30 per step): the integrity still stops at
+  // 1 - d_fail, the stresses and tangents stay finite, the volumetric response is never degraded.
   MaterialPoint hard(make_fatigue(ecoflex(), {1.0, 1e-3, 4.0, 0.9}));
   for (int n = 0; n < 20; ++n) {
     const PointResponse r = hard.advance(1.05 * uniaxial(3.0), 1e6, true);  // J = 1.16
     ASSERT_TRUE(r.P().allFinite() && r.A().allFinite()) << "step " << n;
-    ASSERT_GT(hard.committed_state()[0], 0.0) << "step " << n;
-    ASSERT_GT(r.P_vol.norm(), 0.0);  // the volumetric response is never degraded
+    ASSERT_EQ(hard.committed_state()[0], 1.0 - 0.9) << "step " << n;
+    ASSERT_GT(r.P_vol.norm(), 0.0);
   }
   EXPECT_TRUE(hard.fields().failed);
 }
