@@ -325,7 +325,18 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
   // Largest finite RSS seen (deg^2), for the failure score; starts at 1e6 deg^2 (tens of degrees
   // RMS over a recording) so that a failure before any large RSS never scores like a good fit.
   double worst = 1e6;
+  // Optimisers re-evaluate points (BOBYQA starts at the point the grid already scored): each costs a
+  // model run (a full FEM run for --fem-calibrate), so repeats are answered from memory.
+  std::map<std::vector<double>, double> seen;
+  std::function<double(const std::vector<double>&)> eval_new;
   auto eval = [&](const std::vector<double>& x) {
+    const auto hit = seen.find(x);
+    if (hit != seen.end()) return hit->second;
+    const double f = eval_new(x);
+    seen.emplace(x, f);
+    return f;
+  };
+  eval_new = [&](const std::vector<double>& x) {
     std::vector<double> v(k);
     for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
     double r = std::numeric_limits<double>::infinity();
@@ -812,7 +823,43 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     }
     selected_sets = sets_of(chosen);
   }
-  if (opt.refine > 0 && !chosen.empty()) {
+  if (opt.fem_calibration_runs > 0 && !chosen.empty()) {
+    // Local calibration on the FEM itself (each effect in turn, the others at their constants). A
+    // run that does not complete scores as failed (the calibrator then avoids the region).
+    if (std::isfinite(best_fem_rss)) chosen = chosen_best;
+    for (std::size_t j = 0; j < chosen.size(); ++j) {
+      std::vector<std::string> others;
+      for (std::size_t o = 0; o < chosen.size(); ++o)
+        if (o != j) {
+          const std::vector<std::string> so = chosen[o].first->sets(scene, chosen[o].second);
+          others.insert(others.end(), so.begin(), so.end());
+        }
+      const Scene base_j = scene.with(others);
+      const CandidateEffect& c = *chosen[j].first;
+      int run = 0;
+      auto rss = [&](const std::vector<double>& v) {
+        std::string failure;
+        double t_fail = -1.0;
+        const std::vector<double> fem = fem_at_frames(base_j.with(c.sets(base_j, v)), &failure, &t_fail);
+        if (!failure.empty()) throw PhysicsError("the FEM stopped early: " + failure);
+        const double r = rss_of(fem, frames);
+        if (opt.progress) {
+          std::fprintf(stderr, "diagnose: FEM calibration of %s, run %d:", c.name.c_str(), ++run);
+          for (double x : v) std::fprintf(stderr, " %.4g", x);
+          std::fprintf(stderr, " -> rss %.4g deg^2\n", r);
+        }
+        return r;
+      };
+      const Calibration cal = calibrate(c, rss, opt.fem_calibration_runs, &chosen[j].second);
+      if (std::isfinite(cal.rss)) {
+        chosen[j].second = cal.values;
+        best_fem_rss = cal.rss;
+        chosen_best = chosen;
+      }
+    }
+    selected_sets = sets_of(chosen);
+  }
+  if ((opt.refine > 0 || opt.fem_calibration_runs > 0) && !chosen.empty()) {
     // The result: the constants of the best complete FEM run (the last re-calibration is untested
     // by the FEM unless it was the best), else the last ones (no FEM run completed).
     if (std::isfinite(best_fem_rss)) {
@@ -830,7 +877,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
                     (out.selected.size() > 1 ? " + " + out.selected[1] : std::string()) + ") with calibrated constants.\n" +
                     "# Data: " + opt.data_path + "\n" + fitted.to_toml();
 
-  if (opt.verify || opt.refine > 0) {
+  if (opt.verify || opt.refine > 0 || opt.fem_calibration_runs > 0) {
     DriveOptions d;
     d.threads = opt.threads;
     auto fem_nrmse = [&](const Scene& s, const char* which) {

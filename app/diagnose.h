@@ -53,6 +53,9 @@ struct DiagnoseOptions {
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
   int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
+  /// Full-FEM runs for a final local calibration of each selected effect's constants directly on the
+  /// FEM (bounded derivative-free search from the reduced-model or refined constants); 0 = none.
+  int fem_calibration_runs = 0;
   int threads = 0;
   bool progress = false;
   std::string command_line;

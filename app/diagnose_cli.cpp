@@ -45,6 +45,12 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
                      "plus a verification); recommended for damage effects (mullins, fatigue)")
       ->check(CLI::Range(0, 5))
       ->capture_default_str();
+  c->cmd->add_option("--fem-calibrate", c->options.fem_calibration_runs,
+                     "Then calibrate the selected effects' constants directly on the full FEM, locally from the "
+                     "reduced-model (or refined) ones, with at most this many FEM runs per effect (~20 for two "
+                     "constants); for effects the reduced model misjudges (fatigue)")
+      ->check(CLI::Range(0, 200))
+      ->capture_default_str();
   c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
   c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));
