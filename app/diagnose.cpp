@@ -764,6 +764,13 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     }
     return v;
   };
+  // The selected effects other than the j-th, at their current constants (each effect is
+  // re-calibrated in turn with the others fixed).
+  auto sets_except = [&](std::size_t j) {
+    auto others = chosen;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(j));
+    return sets_of(others);
+  };
   auto chosen_best = chosen;
   double best_fem_rss = std::numeric_limits<double>::infinity();  // complete FEM runs only
   for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
@@ -804,13 +811,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     std::vector<double> corr(fem.size());
     for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = std::isfinite(fem[i]) ? fem[i] - romv[i] : 0.0;
     for (std::size_t j = 0; j < chosen.size(); ++j) {
-      std::vector<std::string> others;
-      for (std::size_t o = 0; o < chosen.size(); ++o)
-        if (o != j) {
-          const std::vector<std::string> so = chosen[o].first->sets(scene, chosen[o].second);
-          others.insert(others.end(), so.begin(), so.end());
-        }
-      const Scene base_j = scene.with(others);
+      const Scene base_j = scene.with(sets_except(j));
       const CandidateEffect& c = *chosen[j].first;
       auto rss = [&](const std::vector<double>& v) {
         std::vector<double> m = rom.at_frames(base_j.with(c.sets(base_j, v)));
@@ -828,13 +829,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     // run that does not complete scores as failed (the calibrator then avoids the region).
     if (std::isfinite(best_fem_rss)) chosen = chosen_best;
     for (std::size_t j = 0; j < chosen.size(); ++j) {
-      std::vector<std::string> others;
-      for (std::size_t o = 0; o < chosen.size(); ++o)
-        if (o != j) {
-          const std::vector<std::string> so = chosen[o].first->sets(scene, chosen[o].second);
-          others.insert(others.end(), so.begin(), so.end());
-        }
-      const Scene base_j = scene.with(others);
+      const Scene base_j = scene.with(sets_except(j));
       const CandidateEffect& c = *chosen[j].first;
       int run = 0;
       auto rss = [&](const std::vector<double>& v) {

@@ -21,6 +21,7 @@
 #include "materials/errors.h"
 #include "scenes/build_model.h"
 #include "tests/app/cli_helpers.h"
+#include "tests/app/recording_helpers.h"
 
 namespace pneufem {
 namespace {
@@ -90,22 +91,7 @@ class CompareCli : public ::testing::Test {
     std::ofstream(*dir_ / "tiny.toml") << kScene;
     const Scene scene = Scene::load((*dir_ / "tiny.toml").string());
     const std::unique_ptr<BuiltModel> bm = build_model(scene);
-    Recording rec;
-    rec.source = "model";
-    for (std::size_t k = 0; k < bm->load.trials.size(); ++k) {
-      const TrialLoad& tl = bm->load.trials[k];
-      TrialRecording tr;
-      tr.trial = static_cast<int>(k + 1);
-      for (long i = 0; i <= std::lround(tl.duration() * 400); ++i) {
-        tr.pressure_kPa.t_s.push_back(i / 400.0);
-        tr.pressure_kPa.value.push_back(tl.pressure(i / 400.0) * 1e-3);
-      }
-      for (long j = 0; j / 30.0 <= tl.duration(); ++j) {
-        tr.angle_deg.t_s.push_back(j / 30.0);
-        tr.angle_deg.value.push_back(0.0);
-      }
-      rec.trials.push_back(tr);
-    }
+    Recording rec = test::rig_sampled(bm->load);
     const DriveResult model = simulate_recording(scene, rec, DriveOptions{});
     // Known perturbation: trial 1 = model + a slow wobble, trial 2 = a 5 % stiffer-looking
     // actuator (model / 1.05) lagging by a constant 0.2 deg.

@@ -21,6 +21,7 @@
 #include "scenes/build_model.h"
 #include "app/effect_catalog.h"
 #include "scenes/scene.h"
+#include "tests/app/recording_helpers.h"
 
 namespace fs = std::filesystem;
 
@@ -91,21 +92,7 @@ TEST(EffectiveSampleSize, WhiteAndCorrelatedResiduals) {
 TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
   const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
                                        "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
-  const std::unique_ptr<BuiltModel> bm = build_model(scene);
-  Recording rec;
-  rec.source = "fem";
-  const TrialLoad& tl = bm->load.trials[0];
-  TrialRecording tr;
-  tr.trial = 1;
-  for (long i = 0; i <= std::lround(tl.duration() * 400); ++i) {
-    tr.pressure_kPa.t_s.push_back(i / 400.0);
-    tr.pressure_kPa.value.push_back(tl.pressure(i / 400.0) * 1e-3);
-  }
-  for (long j = 0; j / 30.0 <= tl.duration(); ++j) {
-    tr.angle_deg.t_s.push_back(j / 30.0);
-    tr.angle_deg.value.push_back(0.0);
-  }
-  rec.trials.push_back(tr);
+  Recording rec = test::rig_sampled(build_model(scene)->load, "fem");
   const DriveResult truth = simulate_recording(scene.with({"materials.silicone.stiffness_scale=0.8"}), rec, DriveOptions{});
   rec.trials[0].angle_deg.value = truth.trials[0].angle_deg.value;
   const fs::path dir = fs::temp_directory_path() / "pneufem_diag_femcal";
