@@ -162,7 +162,14 @@ int main(int argc, char** argv) {
   std::unique_ptr<CompareCommand> cmp = add_compare_command(app);
   std::unique_ptr<DiagnoseCommand> dia = add_diagnose_command(app);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help / --version print and exit 0; a malformed command line is bad input: exit 2 like every
+    // other input error (README, exit codes), not CLI11's own codes (105, 106, ...).
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
   try {
     if (sim->parsed()) {
       RunOptions opt;

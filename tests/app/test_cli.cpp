@@ -62,6 +62,17 @@ TEST(Cli, BadInputGivesExitCode2AndAMessage) {
   r = run("mesh --out /tmp/pneufem_cli_x.stl");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find(".vtu"), std::string::npos) << r.out;
+
+  // Malformed command lines (an option out of range, an unknown option) are bad input too.
+  r = run("simulate --threads 0 --out " + d.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--threads"), std::string::npos) << r.out;
+  r = run("diagnose --data " + std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/none.csv --out " + d.string() + " --fem-calibrate -1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--fem-calibrate"), std::string::npos) << r.out;
+  r = run("simulate --no-such-option");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_FALSE(fs::exists(d / "angles.csv"));
 }
 
 TEST(Cli, HelpListsTheSubcommands) {
