@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 namespace pneufem {
 
@@ -26,7 +27,9 @@ Invariants isochoric_invariants(const Mat3& F) {
   const Mat3 C = F.transpose() * F;
   v.I1 = C.trace();
   v.I2 = 0.5 * (v.I1 * v.I1 - C.squaredNorm());  // tr(C^2) = |C|^2, C symmetric
-  const double r = inverse_cbrt(v.J);
+  // J <= 0 (an inverted point) has no isochoric part: NaN, which every caller reports as a
+  // non-finite stress naming the element (the bit-level guess would return garbage for J < 0).
+  const double r = v.J > 0.0 ? inverse_cbrt(v.J) : std::numeric_limits<double>::quiet_NaN();
   v.Jm23 = r * r;
   v.I1b = v.Jm23 * v.I1;
   v.I2b = v.Jm23 * v.Jm23 * v.I2;
