@@ -93,8 +93,11 @@ class PaperStory : public ::testing::Test {
       metrics_->push_back(paper_metrics(sample(run_->bm->load.trials[k], k + 1, run_->records), ref));
     for (const TrialMetrics& m : *metrics_) {
       std::string line = "trial " + std::to_string(m.trial) + ": NRMSE " + std::to_string(100 * m.nrmse) + " %, error/spread:";
-      for (std::size_t i = 0; i < m.abs_error_deg.size(); ++i)
-        line += " " + std::to_string(m.mark_deg[i] - m.reference_deg[i]) + "/" + std::to_string(m.spread_deg[i]);
+      for (std::size_t i = 0; i < m.abs_error_deg.size(); ++i) {
+        char buf[64];  // snprintf rather than string sums: GCC 12 -O3 warns falsely (-Wrestrict) on "x" + string
+        std::snprintf(buf, sizeof buf, " %f/%f", m.mark_deg[i] - m.reference_deg[i], m.spread_deg[i]);
+        line += buf;
+      }
       std::printf("%s\n", line.c_str());
     }
   }
