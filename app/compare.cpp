@@ -350,7 +350,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   dopt.vtu_dir = staging.string();
   // A model the FEM cannot follow to the end (a limit point, failed walls) still gives the
   // comparison of the frames solved before: hours of computation are not thrown away, and where it
-  // stopped is itself a finding. metrics.json says "incomplete" with the reason; the CLI exits 1.
+  // stopped is itself a finding. metrics.json says "incomplete" with the reason; the CLI exits 3.
   dopt.partial_on_failure = true;
   try {
     r.drive = simulate_recording(scene, rec, dopt);

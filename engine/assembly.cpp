@@ -297,8 +297,7 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
   if (bad.load() != INT_MAX) {
     const int e = bad.load();
     std::ostringstream s;
-    s << "element " << mesh.element_ids[e] << " (region '" << mesh.region_names[mesh.region[e]]
-      << "') inverted or produced a non-finite stress (det F <= 0) at t = " << ts.time_s
+    s << mesh.element_label(e) << " inverted or produced a non-finite stress (det F <= 0) at t = " << ts.time_s
       << " s. Hint: the load step is too large or the actuator is past its ballooning limit; "
          "reduce the step (explicit: smaller dt_safety; static: smaller max_increment), refine the "
          "mesh near this element, or check its material constants.";

@@ -36,6 +36,13 @@ int Mesh::find_region(const std::string& name) const {
   return -1;
 }
 
+std::string Mesh::element_label(int e) const {
+  const std::size_t i = static_cast<std::size_t>(e);
+  std::string s = "element " + std::to_string(i < element_ids.size() ? element_ids[i] : static_cast<long>(e) + 1);
+  if (i < region.size() && region[i] < region_names.size()) s += " (region '" + region_names[region[i]] + "')";
+  return s;
+}
+
 void Mesh::ensure_ids() {
   if (node_ids.size() != X.size()) {
     node_ids.resize(X.size());

@@ -64,6 +64,10 @@ struct Mesh {
 
   /// Fills node_ids / element_ids with 1..n when they are empty.
   void ensure_ids();
+
+  /// "element <external id> (region '<tag>')" for messages: the id the user's mesh file uses
+  /// (1-based index when the mesh has none), the region when the mesh is tagged.
+  std::string element_label(int e) const;
 };
 
 /// Local node indices (0-based, in the element) of face `local_face`: corners first, then the

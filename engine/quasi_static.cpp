@@ -165,7 +165,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
         << s.g0 << " -> " << s.g1 << " s (global time; pressure " << s.p0 * 1e-3 << " -> " << s.p1 * 1e-3
         << " kPa) reached only t = " << t << " s; last step " << last_h << " s with a history change of "
         << last_change << " (time_tol " << opt_.time_tol << ")";
-      if (last_element >= 0) m << ", fastest at element " << last_element;
+      if (last_element >= 0) m << ", fastest at " << asm_.model().mesh.element_label(last_element);
       m << ". Hint: "
         << "damage or viscous strain there changes faster than time_tol per min_dt_s (a point running away: "
            "check the damage constants, e.g. a smaller fatigue rate or a saturating law, fatigue.n > 1), or "

@@ -30,9 +30,9 @@ struct Invariants {
 Invariants isochoric_invariants(const Mat3& F);
 
 /// x^{-1/3} for x > 0 to ~4 ulp: a bit-level first guess refined by four Newton steps
-/// y <- y (4 - x y^3) / 3 (relative error 3.4 % -> 2e-3 -> 1e-5 -> 3e-10 -> 1e-16). Plain IEEE
-/// multiplies, so the result is the same on every x86-64/ARM machine, and ~3x cheaper than
-/// libm's cbrt, which was 15 % of a force evaluation.
+/// y <- y (4 - x y^3) / 3 (relative error 3.4 % -> 2e-3 -> 1e-5 -> 3e-10 -> 1e-16). No libm
+/// call (whose last bit may differ between libm versions), and ~2x cheaper than cbrt, which was
+/// 15 % of a force evaluation.
 double inverse_cbrt(double x);
 
 /// Fills `out` (psi, P and, when `tangent`, A) from the scalar derivatives, at the invariants `v`
