@@ -15,6 +15,7 @@
 #include <nlopt.hpp>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "analysis/compare.h"
 #include "analysis/steps.h"
@@ -80,29 +81,83 @@ bool has_history(const Model& m) {
 }
 
 /// Reduced-model replay of a recording for any variant of the base scene (same mesh).
+///
+/// Calibration mesh. With `mesh_scene` (the user's scene: the same model on a finer mesh) the
+/// reduced model runs on `base` (a coarser mesh of the same geometry) driven by a mapped chamber
+/// pressure phi(p) = p_c(theta_f(p)): the pressure at which the calibration mesh's elastic path
+/// reaches the angle the scene's mesh reaches at p (theta_f from one static sweep of the scene's
+/// mesh, p_c from the traced path). Why map the pressure and not add an angle offset: a coarse
+/// mesh is too stiff (~7-10 % in angle from h = 2 to 4 mm on the default actuator, ~19 % from 2 to
+/// 8 mm on a 3-chamber one), i.e. its error acts like a stiffness error, and a pressure map makes
+/// the elastic baseline exact (up to interpolation) AND keeps a stiffness scale s exact when
+/// p_c(theta) / p_f(theta) is constant: s p_c(theta) = p_c(theta_f(p)) gives p_f(theta) = p / s. An
+/// additive angle offset theta_f(p) - theta_c(p) would not: on the 3-chamber case of
+/// tests/app/test_diagnose.cpp (CalibrationMesh; theta ~ p^1.4, coarse 19 % stiffer) it biases a
+/// calibrated scale by ~4 % (power-law estimate), the map by 1.9 % (measured). History effects see the deformation the scene's
+/// mesh would have (same angle), so their strain-driven evolution is alike. Without any
+/// correction the coarse mesh's stiffness is itself "a missing stiffness effect".
 class RomEvaluator {
  public:
-  RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points)
+  RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points,
+               const Scene* mesh_scene = nullptr)
       : rec_(rec), frames_(frames) {
     ref_ = build_model(elastic_reference(base));
     double p_max = 0.0;
     for (const TrialRecording& t : rec.trials)
       for (double p : t.pressure_kPa.value) p_max = std::max(p_max, p);
     p_max_Pa_ = std::max(1e3, p_max * 1e3);
-    PathModelOptions po;
-    po.p_top_Pa = 1.8 * p_max_Pa_;  // softened models reach angles the elastic one reaches only above p_max
-    po.dp_Pa = p_max_Pa_ / 40.0;
-    po.max_points = rom_points;
-    po.max_dt_s = 0.5;
-    po.newton = ref_->solver.quasi_static.newton;
-    path_ = std::make_unique<PathModel>(ref_->model, po);
     DriveOptions d;
     d.max_report_gap_s = 0.5;  // creep and damage inside holds: 0.5 s states, linear in between
     inlet_ = measured_load(rec, d, base.number("load.rest_s"), true, offset_);
     rest_s_ = base.number("load.rest_s");
     for (const TrialLoad& tr : inlet_.trials)
       for (double p : tr.pressure_Pa) inlet_max_Pa_ = std::max(inlet_max_Pa_, p);
+    PathModelOptions po;
+    po.p_top_Pa = 1.8 * p_max_Pa_;  // softened models reach angles the elastic one reaches only above p_max
+    po.dp_Pa = p_max_Pa_ / 40.0;
+    po.max_points = rom_points;
+    po.max_dt_s = 0.5;
+    po.newton = ref_->solver.quasi_static.newton;
+    if (!mesh_scene) {
+      path_ = std::make_unique<PathModel>(ref_->model, po);
+      return;
+    }
+    // The scene mesh's sweep (the expensive part) runs beside the coarse path trace.
+    std::string fine_error;
+    tbb::parallel_invoke([&] { path_ = std::make_unique<PathModel>(ref_->model, po); },
+                         [&] {
+                           try {
+                             const std::unique_ptr<BuiltModel> fine = build_model(elastic_reference(*mesh_scene));
+                             fine_dofs_ = fine->model.num_dofs();
+                             fine_curve_ = static_angle_curve(*fine, inlet_max_Pa_, kMeshCurvePoints);
+                           } catch (const PhysicsError& e) {
+                             fine_error = e.what();
+                           }
+                         });
+    if (!fine_error.empty())
+      throw PhysicsError("diagnose: the static sweep of the scene's own mesh (for the calibration mesh's pressure map) to " +
+                         fmt_kPa(inlet_max_Pa_) + " failed: " + fine_error);
+    const std::vector<double>& th = path_->path_angle_deg();
+    const std::vector<double>& pc = path_->path_pressure_Pa();
+    for (std::size_t i = 0; i < fine_curve_.size(); ++i) {
+      const double p = inlet_max_Pa_ * static_cast<double>(i) / kMeshCurvePoints;
+      if (fine_curve_[i] > th.back() + 1e-9)
+        throw PhysicsError("diagnose: the calibration mesh's elastic path ends at " + fmt_kPa(pc.back()) + " (" +
+                           std::to_string(th.back()) + " deg, a limit point) before the angle the scene's mesh reaches at " +
+                           fmt_kPa(p) + " (" + std::to_string(fine_curve_[i]) + " deg): use a finer --calibration-h");
+      map_Pa_.push_back(interpolate_quadratic(th, pc, fine_curve_[i]));
+      coarse_curve_.push_back(interpolate_quadratic(pc, th, p));
+    }
   }
+
+  /// The calibration mesh's pressure map (empty without one): static angles (deg) of the scene's
+  /// mesh and of the calibration mesh at p = inlet_max_Pa() i / n, and phi(p) there (Pa).
+  const std::vector<double>& fine_curve() const { return fine_curve_; }
+  const std::vector<double>& coarse_curve() const { return coarse_curve_; }
+  const std::vector<double>& pressure_map_Pa() const { return map_Pa_; }
+  long fine_dofs() const { return fine_dofs_; }
+  long dofs() const { return ref_->model.num_dofs(); }
+  double inlet_max_Pa() const { return inlet_max_Pa_; }
 
   const PathModel& path() const { return *path_; }
 
@@ -157,7 +212,7 @@ class RomEvaluator {
       // points, quadratic interpolation; cached by scene without the lag).
       // Curves span the inlet's peak pressure, which a lagged chamber pressure never exceeds, so
       // every lag shares one curve per scene (the cache key leaves the lag out).
-      const double hi = inlet_max_Pa_;
+      const double hi = chamber(inlet_max_Pa_);
       const bool fem = bm->model.gravity_m_s2.norm() > 0.0;
       const int n = fem ? kFemCurvePoints : 120;
       std::vector<double> th;
@@ -174,7 +229,7 @@ class RomEvaluator {
       for (std::size_t k = 0; k < nt; ++k) {
         const TrialLoad& tr = load.trials[k];
         for (double t : times[k]) {
-          out[k].push_back(curve_at(th, hi, tr.pressure(std::clamp(t, 0.0, tr.duration()))));
+          out[k].push_back(curve_at(th, hi, chamber(tr.pressure(std::clamp(t, 0.0, tr.duration())))));
         }
       }
       return out;
@@ -190,7 +245,7 @@ class RomEvaluator {
         const double t = g + tr.time_s[i];
         if (!pl.t_s.empty() && t <= pl.t_s.back()) continue;
         pl.t_s.push_back(t);
-        pl.p_Pa.push_back(tr.pressure_Pa[i]);
+        pl.p_Pa.push_back(chamber(tr.pressure_Pa[i]));
       }
       g += tr.duration();
       // Between trials the actuator is vented to 0 and rests for load.rest_s (as the FEM drive
@@ -214,7 +269,7 @@ class RomEvaluator {
       const Vec3 gv = bm->model.gravity_m_s2;
       char buf[160];
       std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
-      const double hi = inlet_max_Pa_;
+      const double hi = chamber(inlet_max_Pa_);  // pl holds mapped pressures
       const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
       const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
       std::vector<double> off(cg.size());
@@ -235,6 +290,35 @@ class RomEvaluator {
   }
 
   static constexpr int kFemCurvePoints = 16;
+  /// Sweep points of the scene mesh for the pressure map (one static continuation of that mesh;
+  /// its cost dominates diagnose with --calibration-h). The map phi(p) is close to linear (a
+  /// stiffness-like mesh error), so quadratic interpolation on 24 points is far below the reduced
+  /// model's own error: the calibration-mesh baseline equals the scene mesh's to 4 digits in
+  /// tests/app/test_diagnose.cpp (CalibrationMesh).
+  static constexpr int kMeshCurvePoints = 24;
+
+  /// The pressure that drives the reduced model: p itself, or phi(p) with a calibration mesh
+  /// (interpolated between the sweep's points; identity above the sweep's top is never needed:
+  /// the sweep spans the inlet's peak).
+  double chamber(double p) const { return map_Pa_.empty() ? p : curve_at(map_Pa_, inlet_max_Pa_, p); }
+
+  static std::string fmt_kPa(double p_Pa) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.2f kPa", p_Pa * 1e-3);
+    return b;
+  }
+
+  /// y(x) on samples (xs, ys) with xs increasing (not uniform): quadratic Lagrange interpolation on
+  /// the three samples nearest x (linear extrapolation is not needed: callers stay inside).
+  static double interpolate_quadratic(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
+    const std::size_t n = xs.size();
+    if (n < 3) return n ? ys.front() : 0.0;
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(xs.begin(), xs.end(), x) - xs.begin());
+    const std::size_t c = std::clamp<std::size_t>(k, 1, n - 2);  // centre: samples c-1, c, c+1
+    const double x0 = xs[c - 1], x1 = xs[c], x2 = xs[c + 1];
+    return ys[c - 1] * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2)) + ys[c] * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2)) +
+           ys[c + 1] * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1));
+  }
 
   /// A curve sampled at p = hi i / n (n = th.size() - 1) at pressure p (quadratic 3-point Lagrange
   /// interpolation on the nearest samples; p clamped to [0, hi]).
@@ -270,6 +354,8 @@ class RomEvaluator {
   const std::vector<ComparedFrame>& frames_;
   std::unique_ptr<BuiltModel> ref_;
   std::unique_ptr<PathModel> path_;
+  std::vector<double> fine_curve_, coarse_curve_, map_Pa_;
+  long fine_dofs_ = 0;
   LoadHistory inlet_;
   std::vector<double> offset_;
   double rest_s_ = 0.0, p_max_Pa_ = 0.0, inlet_max_Pa_ = 0.0;
@@ -571,18 +657,37 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   std::vector<int> segment;
   for (const ComparedFrame& f : frames) segment.push_back(f.trial_index);
 
-  if (opt.progress) std::fprintf(stderr, "diagnose: tracing the elastic path ...\n");
-  const RomEvaluator rom(scene, rec, frames, opt.rom_points);
+  // Calibration scene: the user's scene, or the same scene on a coarser built-in mesh (the reduced
+  // model then carries the mesh correction; FEM runs of --verify/--refine/--fem-calibrate and
+  // fitted.toml keep the user's mesh).
+  Scene cal_scene = scene;
+  if (opt.calibration_h_mm > 0.0) {
+    if (scene.string("mesh.source") != "pneunet")
+      throw InputError("diagnose: --calibration-h needs the built-in mesher (mesh.source = \"pneunet\"); this scene's mesh "
+                       "comes from a deck (" + scene.string("mesh.file") + "): coarsen the deck itself, or omit --calibration-h");
+    cal_scene = scene.with({"mesh.h_mm=" + fmt("%.17g", opt.calibration_h_mm)});
+  }
   if (opt.progress)
+    std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
+                 opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");
+  const RomEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr);
+  if (opt.progress) {
     std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s)\n",
                  rom.path().path_pressure_Pa().back() * 1e-3, rom.path().num_points(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (!rom.fine_curve().empty())
+      std::fprintf(stderr,
+                   "diagnose: calibration mesh %ld dof, scene mesh %ld dof: angle at %.1f kPa %.3f vs %.3f deg "
+                   "(the calibration mesh is driven at %.2f kPa there)\n",
+                   rom.dofs(), rom.fine_dofs(), rom.inlet_max_Pa() * 1e-3, rom.coarse_curve().back(), rom.fine_curve().back(),
+                   rom.pressure_map_Pa().back() * 1e-3);
+  }
   long rom_runs = 0;
   std::mutex mu;
 
   DiagnosisResult out;
   auto metrics = [&](const Scene& s) { return compare_recording(rec, rom.series(s)); };
-  const Comparison base = metrics(scene);
+  const Comparison base = metrics(cal_scene);
   ++rom_runs;
   out.baseline_nrmse = base.nrmse;
   for (const TrialComparison& t : base.trials) out.baseline_nrmse_per_trial.push_back(t.nrmse);
@@ -600,7 +705,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     for (std::size_t i = 0; i < cands.size(); ++i)
       if (!used[i]) todo.push_back(i);
     if (todo.empty()) break;
-    const Scene cur_scene = scene.with(selected_sets);
+    const Scene cur_scene = cal_scene.with(selected_sets);
     tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t j) {
       const CandidateEffect& c = *cands[todo[j]];
       CandidateResult& r = results[todo[j]];
@@ -709,7 +814,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     out.selected.push_back(best.effect);
     if (round == 1) out.missing_effect = best.effect;
     selected_sets.insert(selected_sets.end(), best.sets.begin(), best.sets.end());
-    current = metrics(scene.with(selected_sets));
+    current = metrics(cal_scene.with(selected_sets));
     current_rss = current.rss_deg2;
   }
   out.final_nrmse = current.nrmse;
@@ -807,11 +912,11 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       best_fem_rss = fem_rss;
       chosen_best = chosen;
     }
-    const std::vector<double> romv = rom.at_frames(scene.with(selected_sets));
+    const std::vector<double> romv = rom.at_frames(cal_scene.with(selected_sets));
     std::vector<double> corr(fem.size());
     for (std::size_t i = 0; i < fem.size(); ++i) corr[i] = std::isfinite(fem[i]) ? fem[i] - romv[i] : 0.0;
     for (std::size_t j = 0; j < chosen.size(); ++j) {
-      const Scene base_j = scene.with(sets_except(j));
+      const Scene base_j = cal_scene.with(sets_except(j));
       const CandidateEffect& c = *chosen[j].first;
       auto rss = [&](const std::vector<double>& v) {
         std::vector<double> m = rom.at_frames(base_j.with(c.sets(base_j, v)));
@@ -941,6 +1046,20 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
                                   " material points, elastic path to " +
                                   fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  if (opt.calibration_h_mm > 0.0) {
+    // The calibration mesh and its correction, so a reader can judge its size against the effects'.
+    json::Object cm;
+    const std::vector<double>& f = rom.fine_curve();
+    const std::vector<double>& c = rom.coarse_curve();
+    std::vector<double> p;
+    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.inlet_max_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
+    cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
+    std::vector<double> m;
+    for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
+    cm.add("pressure_kPa", json::array(p)).add("scene_mesh_angle_deg", json::array(f)).add("calibration_mesh_angle_deg", json::array(c));
+    cm.add("mapped_pressure_kPa", json::array(m));
+    method.add("calibration_mesh", cm.str(4));
+  }
   method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);
   method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
   root.add("method", method.str(2));
