@@ -32,9 +32,13 @@ const std::string kStoryScene = std::string(PNEUFEM_TEST_DATA_DIR) + "/../../sce
 // CI model: the example's h = 6 mm mesh of a 3-chamber pneu-net (same chamber, wall, roof and base
 // cross-section; 1.8k instead of 7.4k nodes). The story is per chamber and the metrics are relative
 // to the ideal model's angle range, so the 3-chamber actuator tells the same story (ideal angle per
-// chamber at 45 kPa 3.1 deg vs 3.5 deg for 15 chambers; the 15-chamber story was not run to the end);
+// chamber at 45 kPa 3.1 deg vs 3.5 deg for 15 chambers; the 15-chamber story with its own fatigue rate: story.md r13);
 // three trials instead of ten (202 s CPU for the whole suite, story.md): ten trials do not fit in CI.
-const std::vector<std::string> kReducedModel = {"geometry.chambers=3", "mesh.h_mm=6.0", "output.vtu=\"none\""};
+// The fatigue rate is the 3-chamber calibration (tau = 80 s: 2.8 % -> 20.5 % over ten trials, story.md
+// r10); the file's tau = 160 s is the 15-chamber one (r12-r13), whose top steps sit closer to the
+// limit point and so soften faster for the same damage.
+const std::vector<std::string> kReducedModel = {"geometry.chambers=3", "mesh.h_mm=6.0", "output.vtu=\"none\"",
+                                                "materials.silicone.fatigue.tau_s=80.0"};
 constexpr int kTrials = 3;
 
 struct StoryRun {
