@@ -10,6 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "app/elastic_curve.h"
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/static_solver.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -135,6 +138,36 @@ TEST(RigAngleInterpolation, MatchesDirectFemSweepsBetweenNodes) {
   // 1 % of the gravity effect: the truncated third harmonic (the weight's response at third order
   // in its direction) is expected well below the second harmonic the basis keeps. Measured: ~1e-4.
   for (double e : err) EXPECT_LT(e, 0.01 * effect);
+}
+
+// The default 15-chamber actuator lying on its side (rig angle 90 deg) sags too far for one Newton
+// solve of the full weight from the straight state (diagnose's gravity candidate failed at p = 0 for
+// every rig angle on it, 2026-11-23). The curve ramps gravity in; its equilibrium must be the one a
+// continuation in the weight gives, checked against 16 equal steps done by hand: the sag angle
+// (measured 18.3 deg) agrees within 0.1 %, loose against the Newton tolerance (relative residual
+// 1e-6), tight against any other equilibrium branch.
+TEST(StaticAngleCurve, RampsInTheWeightOfALongActuator) {
+  const std::vector<std::string> base = {"mesh.h_mm=6.0", "output.vtu=\"none\""};
+  std::vector<std::string> s = base;
+  s.push_back(gravity_at(kPi / 2, 9.81));
+  const std::unique_ptr<BuiltModel> bm = build_model(Scene::load("", s));
+  const std::vector<double> th = static_angle_curve(*bm, 1e3, 1);  // threw "no convergence" before the ramp
+  ASSERT_EQ(th.size(), 2u);
+  std::printf("default actuator on its side: angle %.4f deg at 0 kPa, %.4f deg at 1 kPa\n", th[0], th[1]);
+  EXPECT_GT(std::abs(th[0]), 1.0) << "the weight must bend the 126 mm actuator noticeably, or the test says nothing";
+  // Reference: a continuation in the weight by hand, 16 equal steps (the curve's ramp is adaptive).
+  StaticOptions o = bm->solver.quasi_static.newton;
+  o.max_iterations = 40;
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  std::vector<double> state;
+  for (int k = 1; k <= 16; ++k) {
+    Model m = bm->model;
+    m.gravity_m_s2 *= k / 16.0;
+    const Assembler A(m);
+    StaticSolver solver(A, o);
+    solver.advance(0.0, 0.0, 0.0, 0.0, state, u);
+  }
+  EXPECT_NEAR(th[0], bending_angle(bm->model, u).angle_deg, 1e-3 * std::abs(th[0]));
 }
 
 // The stiffness candidate on top of gravity (diagnose's second round after a rig angle): the
