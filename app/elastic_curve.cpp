@@ -6,7 +6,6 @@
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/static_solver.h"
-#include "materials/errors.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -16,40 +15,9 @@ std::vector<double> static_angle_curve(const BuiltModel& bm, double hi_Pa, int n
   StaticSolver solver(A, bm.solver.quasi_static.newton);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(bm.model.num_dofs());
   std::vector<double> state;
-  try {
-    solver.advance(0.0, 0.0, 0.0, 0.0, state, u);  // gravity alone
-  } catch (const PhysicsError&) {
-    if (bm.model.gravity_m_s2.norm() == 0.0) throw;
-    // Gravity switched on in one Newton solve fails for a long soft actuator lying on its side
-    // (the default 126 mm pneu-net sags too far from the straight state: "no convergence at p = 0"
-    // for every rig angle of diagnose's gravity candidate). Ramp it in, then solve the full load
-    // from there (same equilibrium: the elastic problem has no history).
-    // Adaptive: the fraction grows by df, halved after a failed solve (from the last equilibrium),
-    // doubled after a success; a weight the actuator cannot carry fails below 1/1024 of a step.
-    u.setZero();
-    double f = 0.0, df = 0.125;
-    while (f < 1.0) {
-      const double f1 = std::min(1.0, f + df);
-      Model scaled = bm.model;
-      scaled.gravity_m_s2 *= f1;
-      const Assembler Ak(scaled);
-      StaticSolver sk(Ak, bm.solver.quasi_static.newton);
-      Eigen::VectorXd u1 = u;
-      std::vector<double> s1 = state;
-      try {
-        sk.advance(0.0, 0.0, 0.0, 0.0, s1, u1);
-      } catch (const PhysicsError&) {
-        df *= 0.5;
-        if (df < 1.0 / 1024.0) throw;
-        continue;
-      }
-      u = u1;
-      state = s1;
-      f = f1;
-      df = std::min(0.5, 2.0 * df);
-    }
-    solver.advance(0.0, 0.0, 0.0, 0.0, state, u);
-  }
+  // Gravity alone (a long actuator on its side sags far: StaticSolver ramps the weight in when the
+  // first solve fails).
+  solver.advance(0.0, 0.0, 0.0, 0.0, state, u);
   std::vector<double> th = {bending_angle(bm.model, u).angle_deg};
   for (int i = 1; i <= n; ++i) {
     solver.advance(hi_Pa * (i - 1) / n, hi_Pa * i / n, 0.0, 0.0, state, u);

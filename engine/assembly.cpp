@@ -480,8 +480,8 @@ double Assembler::cavity_volume(const Eigen::VectorXd& u) const {
   return V;
 }
 
-void Assembler::add_gravity(Eigen::VectorXd& f_ext) const {
-  const Eigen::Vector3d& g = model_.gravity_m_s2;
+void Assembler::add_gravity(Eigen::VectorXd& f_ext, double scale) const {
+  const Eigen::Vector3d g = scale * model_.gravity_m_s2;
   if (g.isZero()) return;
   const Mesh& mesh = model_.mesh;
   const auto rule = tet_rule(mesh.type);

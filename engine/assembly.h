@@ -55,7 +55,7 @@ class Assembler {
   /// stiffness d f_ext / du from K.
   void add_pressure(const Eigen::VectorXd& u, double p_Pa, Eigen::VectorXd& f_ext, SparseMatrix* K) const;
   /// Adds the consistent gravity load int rho N_a g dV (and rho t int N_a g dA of the membranes).
-  void add_gravity(Eigen::VectorXd& f_ext) const;
+  void add_gravity(Eigen::VectorXd& f_ext, double scale = 1.0) const;  ///< scale: fraction of the weight (ramps)
   /// Volume enclosed by the pressure faces in the deformed configuration (m^3); exact for a
   /// closed cavity (or one closed by symmetry planes through the origin).
   double cavity_volume(const Eigen::VectorXd& u) const;

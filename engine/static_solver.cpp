@@ -38,7 +38,7 @@ Eigen::VectorXd StaticSolver::residual(double p, const TimeStep& ts, std::span<c
   Eigen::VectorXd f_int, f_ext = Eigen::VectorXd::Zero(asm_.num_dofs());
   asm_.internal(u, ts, s_old, s_new, &f_int, nullptr, nullptr);
   asm_.add_pressure(u, p, f_ext, nullptr);
-  asm_.add_gravity(f_ext);
+  asm_.add_gravity(f_ext, gravity_scale_);
   ++stats_.residual_evaluations;
   Eigen::VectorXd R = f_int - f_ext;
   asm_.zero_fixed(R);
@@ -63,7 +63,7 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
       return rep;
     }
     asm_.add_pressure(u, p, f_ext, &K_);
-    asm_.add_gravity(f_ext);
+    asm_.add_gravity(f_ext, gravity_scale_);
     stats_.assembly_s += seconds_since(t0);
     R = f_int - f_ext;
     // Force scale of the criterion: the applied load, or the reactions when the loading is by
@@ -222,6 +222,43 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
   return true;
 }
 
+NewtonReport StaticSolver::solve_first_with_weight(double p, const TimeStep& ts, std::span<const double> s_old,
+                                                   std::span<double> s_new, Eigen::VectorXd& u) {
+  const Eigen::VectorXd u0 = u;
+  NewtonReport r = solve(p, ts, s_old, s_new, u);
+  if (r.converged || has_equilibrium_ || asm_.model().gravity_m_s2.isZero()) return r;
+  // The full weight in one Newton solve from the unloaded state fails for a long soft actuator
+  // lying on its side (the default 126 mm pneu-net sags ~18 deg). Ramp it in: the fraction grows by
+  // df, halved after a failed solve (restarting from the last equilibrium), doubled after a
+  // success; a weight the structure cannot carry fails below 1/1024 of a step with the original
+  // report. Same equilibrium as one solve would find (the ramp only supplies the start).
+  u = u0;
+  double f = 0.0, df = 0.125;
+  while (f < 1.0) {
+    const double f1 = std::min(1.0, f + df);
+    gravity_scale_ = f1;
+    Eigen::VectorXd u1 = u;
+    const NewtonReport r1 = solve(p, ts, s_old, s_new, u1);
+    if (!r1.converged) {
+      df *= 0.5;
+      if (df < 1.0 / 1024.0) {
+        gravity_scale_ = 1.0;
+        return r;
+      }
+      continue;
+    }
+    u = u1;
+    f = f1;
+    df = std::min(0.5, 2.0 * df);
+    if (f1 == 1.0) {
+      gravity_scale_ = 1.0;
+      return r1;
+    }
+  }
+  gravity_scale_ = 1.0;
+  return r;
+}
+
 void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vector<double>& state,
                            Eigen::VectorXd& u) {
   const double span = p1 - p0;
@@ -231,7 +268,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
     // from one time step to the next, so the last factorisation preconditions CG well.
     TimeStep ts{t1, t1 - t0};
     krylov_allowed_ = true;
-    NewtonReport r = solve(p1, ts, state, trial, u);
+    NewtonReport r = solve_first_with_weight(p1, ts, state, trial, u);
     krylov_allowed_ = false;
     ++stats_.increments;
     if (!r.converged) {
@@ -239,6 +276,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
       s << "static solve failed at p = " << p1 * 1e-3 << " kPa, t = " << t1 << " s: " << r.failure;
       throw PhysicsError(s.str(), -1, t1);
     }
+    has_equilibrium_ = true;
     state.swap(trial);
     return;
   }
@@ -298,6 +336,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
       continue;
     }
     ++stats_.increments;
+    has_equilibrium_ = true;
     if (path_p_.empty() || path_p_.back() != pa) {
       path_p_.assign(1, pa);
       path_u_.assign(1, u);

@@ -92,6 +92,10 @@ class StaticSolver {
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
   bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
   bool factorize_current(NewtonReport& rep);
+  /// solve() at constant pressure; when the very first equilibrium of this solver fails with
+  /// gravity on, retries with the weight ramped in (see static_solver.cpp).
+  NewtonReport solve_first_with_weight(double p_Pa, const TimeStep& ts, std::span<const double> s_old,
+                                       std::span<double> s_new, Eigen::VectorXd& u);
 
   const Assembler& asm_;
   StaticOptions opt_;
@@ -102,6 +106,8 @@ class StaticSolver {
   std::vector<double> path_p_;           ///< pressures of the last (<= 3) equilibria on this path
   std::vector<Eigen::VectorXd> path_u_;  ///< their displacements (for the predictor)
   double force_floor_ = 0.0;        ///< lower bound of the reference force (N)
+  double gravity_scale_ = 1.0;      ///< fraction of the weight applied (< 1 only while ramping it in)
+  bool has_equilibrium_ = false;    ///< an advance() has converged (the weight is then carried)
 };
 
 /// Force scale below which residuals count as zero relative to the structure's stiffness (N).

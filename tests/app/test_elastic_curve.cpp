@@ -142,7 +142,8 @@ TEST(RigAngleInterpolation, MatchesDirectFemSweepsBetweenNodes) {
 
 // The default 15-chamber actuator lying on its side (rig angle 90 deg) sags too far for one Newton
 // solve of the full weight from the straight state (diagnose's gravity candidate failed at p = 0 for
-// every rig angle on it, 2026-11-23). The curve ramps gravity in; its equilibrium must be the one a
+// every rig angle on it, and `simulate` of it at t = 0, 2026-11-23). StaticSolver now ramps the
+// weight in when its first equilibrium fails; the curve's equilibrium must be the one a
 // continuation in the weight gives, checked against 16 equal steps done by hand: the sag angle
 // (measured 18.3 deg) agrees within 0.1 %, loose against the Newton tolerance (relative residual
 // 1e-6), tight against any other equilibrium branch.
