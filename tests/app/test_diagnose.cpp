@@ -56,6 +56,19 @@ DiagnosisResult diagnose(const std::string& name, int refine = 0) {
   return r;
 }
 
+/// Noise-free data from the scene's own FEM with the silicone 20 % softer, rig-sampled, written
+/// to <tmp>/<name>/data.csv (the directory is returned, emptied first).
+fs::path softer_silicone_recording(const Scene& scene, const std::string& name) {
+  Recording rec = test::rig_sampled(build_model(scene)->load, "fem");
+  const DriveResult truth = simulate_recording(scene.with({"materials.silicone.stiffness_scale=0.8"}), rec, DriveOptions{});
+  rec.trials[0].angle_deg.value = truth.trials[0].angle_deg.value;
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_measurements_csv((dir / "data.csv").string(), rec);
+  return dir;
+}
+
 double param(const DiagnosisResult& r, const std::string& name) {
   const CandidateResult& c = r.candidates.front();
   for (std::size_t i = 0; i < c.param_names.size(); ++i)
@@ -93,13 +106,7 @@ TEST(EffectiveSampleSize, WhiteAndCorrelatedResiduals) {
 TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
   const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
                                        "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
-  Recording rec = test::rig_sampled(build_model(scene)->load, "fem");
-  const DriveResult truth = simulate_recording(scene.with({"materials.silicone.stiffness_scale=0.8"}), rec, DriveOptions{});
-  rec.trials[0].angle_deg.value = truth.trials[0].angle_deg.value;
-  const fs::path dir = fs::temp_directory_path() / "pneufem_diag_femcal";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  write_measurements_csv((dir / "data.csv").string(), rec);
+  const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_femcal");
 
   DiagnoseOptions o;
   o.data_path = (dir / "data.csv").string();
@@ -133,13 +140,7 @@ TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
 TEST(CalibrationMesh, GivesTheSceneMeshsBaselineRankingAndConstants) {
   const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=3", "load.max_kPa=20", "load.step_kPa=10",
                                        "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
-  Recording rec = test::rig_sampled(build_model(scene)->load, "fem");
-  const DriveResult truth = simulate_recording(scene.with({"materials.silicone.stiffness_scale=0.8"}), rec, DriveOptions{});
-  rec.trials[0].angle_deg.value = truth.trials[0].angle_deg.value;
-  const fs::path dir = fs::temp_directory_path() / "pneufem_diag_calmesh";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  write_measurements_csv((dir / "data.csv").string(), rec);
+  const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_calmesh");
   auto run = [&](const Scene& s, double cal_h, const std::vector<std::string>& cands, const std::string& out) {
     DiagnoseOptions o;
     o.data_path = (dir / "data.csv").string();
