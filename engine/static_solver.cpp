@@ -19,6 +19,65 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 StaticSolver::StaticSolver(const Assembler& assembler, StaticOptions options)
     : asm_(assembler), opt_(options), K_(assembler.tangent_pattern()) {
   force_floor_ = reference_force_floor(assembler);
+  if (opt_.stiff_relaxation_steps <= 0) return;
+  // The stiff layer: every node of an element whose material is stiff_modulus_ratio times stiffer
+  // (initial shear modulus) than the softest part. Nodes it shares with the soft body belong to it
+  // too: they carry its stretch.
+  const Model& m = assembler.model();
+  double mu_min = std::numeric_limits<double>::infinity();
+  for (const Part& part : m.parts) mu_min = std::min(mu_min, part.material->initial_shear_modulus());
+  std::vector<unsigned char> stiff_node(m.mesh.num_nodes(), 0);
+  for (int e = 0; e < m.mesh.num_elements(); ++e)
+    if (m.material_of(e).initial_shear_modulus() > opt_.stiff_modulus_ratio * mu_min)
+      for (int a = 0; a < m.mesh.npe(); ++a) stiff_node[m.mesh.element(e)[a]] = 1;
+  stiff_index_.assign(m.num_dofs(), -1);
+  for (int i = 0; i < m.num_dofs(); ++i)
+    if (stiff_node[i / 3] && !m.fixed[i]) {
+      stiff_index_[i] = static_cast<int>(stiff_dofs_.size());
+      stiff_dofs_.push_back(i);
+    }
+  if (stiff_dofs_.empty()) stiff_index_.clear();
+}
+
+void StaticSolver::relax_stiff_layer(double p, const TimeStep& ts, std::span<const double> s_old,
+                                     std::span<double> s_new, Eigen::VectorXd& u, Eigen::VectorXd& R) {
+  const int ns = static_cast<int>(stiff_dofs_.size());
+  if (!stiff_factor_current_) {
+    // The layer's block of the current tangent (its own stiffness plus the soft elements on its
+    // nodes): a thin-layer matrix, far cheaper to factorise than the whole tangent. It is the
+    // tangent at the start of this Newton iteration, so the relaxation is a chord method; the
+    // layer is linear elastic in its own frame, which is why that suffices.
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int c : stiff_dofs_)
+      for (SparseMatrix::InnerIterator it(K_, c); it; ++it)
+        if (const int r = stiff_index_[it.row()]; r >= 0) entries.emplace_back(r, stiff_index_[c], it.value());
+    SparseMatrix Kss(ns, ns);
+    Kss.setFromTriplets(entries.begin(), entries.end());
+    ++stats_.stiff_factorizations;
+    if (!stiff_linear_.factorize(Kss)) return;  // not positive definite: no elimination this iteration
+    stiff_factor_current_ = true;
+  }
+  Eigen::VectorXd rs(ns), u1;
+  for (int k = 0; k < opt_.stiff_relaxation_steps; ++k) {
+    for (int i = 0; i < ns; ++i) rs[i] = R[stiff_dofs_[i]];
+    if (rs.norm() <= 0.1 * R.norm()) return;  // the layer is in equilibrium; the rest is the soft body's
+    const Eigen::VectorXd ds = stiff_linear_.solve(rs);
+    u1 = u;
+    for (int i = 0; i < ns; ++i) u1[stiff_dofs_[i]] -= ds[i];
+    Eigen::VectorXd R1;
+    try {
+      R1 = residual(p, ts, s_old, s_new, u1);
+    } catch (const PhysicsError&) {
+      return;  // the relaxed state inverts an element: keep u
+    }
+    if (opt_.verbose)
+      std::fprintf(stderr, "      stiff-layer relaxation %d: |R| %.3e -> %.3e (layer part %.3e)\n", k, R.norm(),
+                   R1.norm(), rs.norm());
+    if (!(R1.norm() < R.norm())) return;
+    u.swap(u1);
+    R.swap(R1);
+    ++stats_.stiff_relaxations;
+  }
 }
 
 double reference_force_floor(const Assembler& a) {
@@ -99,12 +158,16 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     for (int i = 0; i < n; ++i) mean_diag += std::abs(K_.coeff(i, i));
     mean_diag /= n;
     asm_.apply_constraints(K_, mean_diag);
+    stiff_factor_current_ = false;
     Eigen::VectorXd du;
     const bool ok = linear_step(R, du, rep);
     stats_.factor_s += seconds_since(t0);
     if (!ok) return rep;
 
     // Line search on s(alpha) = du . R(u + alpha du) (works for the non-potential follower load).
+    // With a stiff layer, R is taken at the state relaxed in the layer (stiff-layer elimination):
+    // s(alpha) is then the slope of the energy with the layer in equilibrium, so the step is not cut
+    // for the layer's spurious stretch.
     const double s0 = du.dot(R);
     if (opt_.verbose) std::fprintf(stderr, "      |du|=%.3e max|du|=%.3e decrement du.R=%.3e\n", du.norm(), du.lpNorm<Eigen::Infinity>(), s0);
     double alpha = 1.0;
@@ -119,6 +182,7 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
         ++rep.line_search_cuts;
         continue;
       }
+      if (!stiff_dofs_.empty()) relax_stiff_layer(p, ts, s_old, s_new, u_try, R1);
       const double s1 = du.dot(R1);
       if (!std::isfinite(s1)) {
         alpha *= 0.5;

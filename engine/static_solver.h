@@ -20,7 +20,7 @@ namespace pneufem {
 struct StaticOptions {
   double rel_tol = 1e-8;          ///< relative residual tolerance
   double abs_tol_N = 1e-12;       ///< absolute residual floor (N)
-  int max_iterations = 12;        ///< Newton iterations per increment (then cut back)
+  int max_iterations = 30;        ///< Newton iterations per increment (then cut back)
   double max_increment_Pa = 5e3;  ///< largest pressure sub-increment of a continuation
   double min_increment_Pa = 1.0;  ///< give up (limit point) below this sub-increment
   bool verbose = false;           ///< print every iteration to stderr
@@ -29,6 +29,10 @@ struct StaticOptions {
   int krylov_max_iterations = 10;
   double krylov_rel_tol = 1e-3;   ///< CG stopping criterion, relative to |R|
   int chord_steps = 3;            ///< back-substitutions with the current factor per iteration
+  /// Stiff-layer elimination (see StaticSolver): relaxation steps of the stiff dofs after every
+  /// trial update (0 = off), and the shear-modulus ratio above which a part counts as stiff.
+  int stiff_relaxation_steps = 3;
+  double stiff_modulus_ratio = 100.0;
 };
 
 struct NewtonReport {
@@ -50,10 +54,22 @@ struct StaticStats {
   long residual_evaluations = 0;
   long krylov_iterations = 0;
   long chord_steps = 0;
+  long stiff_relaxations = 0;     ///< accepted stiff-layer relaxation steps
+  long stiff_factorizations = 0;  ///< factorisations of the stiff-layer block
   double assembly_s = 0.0;
   double factor_s = 0.0;
 };
 
+/// Stiff-layer elimination. A thin layer ~10^5 times stiffer than the body it is bonded to (the
+/// fabric in the silicone) makes plain Newton wander: a linearised rotation is not isometric, so every
+/// step that bends the structure stretches the layer to second order, that spurious stress enters
+/// the geometric stiffness of the soft bending mode, and the next step overshoots (6-13 erratic
+/// iterations per increment on the default pneu-net, many increments cut back). The solver therefore
+/// eliminates the layer nonlinearly (in the spirit of Lanzkron, Rose & Wilkes 1996, "nonlinear
+/// elimination"): after every trial update, the dofs of the stiff parts' nodes are relaxed with the
+/// rest held (a few Newton steps on the layer's block of the tangent, a small factorisation), and the
+/// line search measures the step on that relaxed state. The equilibrium is unchanged (the full
+/// residual is still the criterion); only the path to it changes.
 class StaticSolver {
  public:
   StaticSolver(const Assembler& assembler, StaticOptions options = {});
@@ -92,6 +108,10 @@ class StaticSolver {
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
   bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
   bool factorize_current(NewtonReport& rep);
+  /// Relaxes the stiff dofs of u (the others held) given R = R(u); updates u and R in place.
+  /// Never throws: a relaxation step that fails or does not reduce |R| is not taken.
+  void relax_stiff_layer(double p_Pa, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,
+                         Eigen::VectorXd& u, Eigen::VectorXd& R);
   /// solve() at constant pressure; when the very first equilibrium of this solver fails with
   /// gravity on, retries with the weight ramped in (see static_solver.cpp).
   NewtonReport solve_first_with_weight(double p_Pa, const TimeStep& ts, std::span<const double> s_old,
@@ -101,6 +121,10 @@ class StaticSolver {
   StaticOptions opt_;
   bool krylov_allowed_ = false;  ///< CG with the old factor: only for pure time increments
   LinearSolver linear_;
+  std::vector<int> stiff_dofs_;   ///< free dofs of the nodes of stiff parts (stiff-layer elimination)
+  std::vector<int> stiff_index_;  ///< dof -> position in stiff_dofs_, or -1
+  LinearSolver stiff_linear_;     ///< factor of the stiff block of K_
+  bool stiff_factor_current_ = false;  ///< stiff_linear_ factors the current K_
   SparseMatrix K_;
   StaticStats stats_;
   std::vector<double> path_p_;           ///< pressures of the last (<= 3) equilibria on this path

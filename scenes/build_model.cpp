@@ -544,6 +544,8 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   sv.quasi_static.relaxation.rel_tol = sv.quasi_static.newton.rel_tol;
   sv.quasi_static.newton.max_iterations = s.integer("solver.max_iterations");
   if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
+  sv.quasi_static.newton.stiff_relaxation_steps = s.integer("solver.stiff_relaxation_steps");
+  if (sv.quasi_static.newton.stiff_relaxation_steps < 0) s.fail("solver.stiff_relaxation_steps", "must be >= 0 (0 = off)");
   sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
   sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");

@@ -127,6 +127,14 @@ TEST(SceneErrors, ElementWithoutPartIsReported) {
   EXPECT_NE(msg.find("belongs to no part"), std::string::npos) << msg;
 }
 
+TEST(SceneErrors, SolverCountsOutOfRangeNameTheKey) {
+  const std::string m1 = error_of([] { build_model(Scene::load("", {"solver.stiff_relaxation_steps=-1", "mesh.h_mm=8.0"})); });
+  EXPECT_NE(m1.find("solver.stiff_relaxation_steps"), std::string::npos) << m1;
+  EXPECT_NE(m1.find(">= 0"), std::string::npos) << m1;
+  const std::string m2 = error_of([] { build_model(Scene::load("", {"solver.max_iterations=0", "mesh.h_mm=8.0"})); });
+  EXPECT_NE(m2.find("solver.max_iterations"), std::string::npos) << m2;
+}
+
 TEST(SceneBuild, DefaultModelHasCavityTipFixedAndSymmetry) {
   const Scene s = Scene::load("", {"mesh.h_mm=4.0"});
   const auto bm = build_model(s);
