@@ -250,10 +250,10 @@ bool StaticSolver::factorize_current(NewtonReport& rep) {
     for (int i = 0; i < n; ++i) Ks.coeffRef(i, i) = K_.coeff(i, i) + beta * d[i];
     ok = linear_.factorize(Ks);
     ++stats_.factorizations;
-    if (opt_.verbose) std::fprintf(stderr, "      shift beta=%.0e: %s\n", beta, ok ? "ok" : "not PD");
+    if (opt_.verbose)
+      std::fprintf(stderr, "      tangent not positive definite; shift beta=%.0e: %s\n", beta, ok ? "ok" : "not PD");
   }
   ++rep.regularised;
-  if (opt_.verbose) std::fprintf(stderr, "      tangent not positive definite: %s\n", ok ? "factorised with a diagonal shift" : "no shift helped");
   if (!ok) rep.failure = "tangent could not be factorised even with a diagonal shift";
   return ok;
 }
