@@ -16,9 +16,39 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+namespace {
+// True when the follower-pressure load is conservative, f_p = p dV/du with V the cavity volume of
+// Assembler::cavity_volume: a closed cavity, or one closed by symmetry planes through the origin.
+// Checked once, at the reference state, along a fixed pseudo-random direction of the free dofs: an
+// open cavity (a deck's surface with a hole) differs by a boundary term of the order of f_p itself.
+// Tolerance 1e-6: the central difference of a cubic in the step is exact up to round-off (~1e-12
+// relative at the step used); a mismatch below 1e-6 would not mislead an Armijo test.
+bool pressure_is_conservative(const Assembler& a) {
+  const Model& m = a.model();
+  if (m.pressure_faces.empty()) return true;
+  const int n = a.num_dofs();
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n), d = Eigen::VectorXd::Zero(n);
+  a.add_pressure(zero, 1.0, f, nullptr);
+  for (int i = 0; i < n; ++i)
+    if (!m.fixed[i]) d[i] = std::sin(12.9898 * i + 78.233);
+  const MeshStats st = compute_stats(m.mesh);
+  const double eps = 1e-6 * (st.bbox_max - st.bbox_min).norm();  // step (m): small against the body
+  const double dV = (a.cavity_volume(eps * d) - a.cavity_volume(-eps * d)) / (2.0 * eps);
+  const double fd = f.dot(d);
+  double scale = 0.0;
+  for (int i = 0; i < n; ++i) scale += std::abs(f[i] * d[i]);
+  return std::abs(dV - fd) <= 1e-6 * scale;
+}
+}  // namespace
+
 StaticSolver::StaticSolver(const Assembler& assembler, StaticOptions options)
     : asm_(assembler), opt_(options), K_(assembler.tangent_pattern()) {
   force_floor_ = reference_force_floor(assembler);
+  gravity_load_ = Eigen::VectorXd::Zero(assembler.num_dofs());
+  assembler.add_gravity(gravity_load_);
+  // Material history (damage, viscosity) makes the incremental problem non-potential in general.
+  has_potential_ = assembler.state_size() == 0 && pressure_is_conservative(assembler);
   if (opt_.stiff_relaxation_steps <= 0) return;
   // The stiff layer: every node of an element whose material is stiff_modulus_ratio times stiffer
   // (initial shear modulus) than the softest part. Nodes it shares with the soft body belong to it
@@ -43,7 +73,8 @@ StaticSolver::StaticSolver(const Assembler& assembler, StaticOptions options)
 }
 
 void StaticSolver::relax_stiff_layer(double p, const TimeStep& ts, std::span<const double> s_old,
-                                     std::span<double> s_new, Eigen::VectorXd& u, Eigen::VectorXd& R) {
+                                     std::span<double> s_new, Eigen::VectorXd& u, Eigen::VectorXd& R,
+                                     double* potential) {
   const int ns = static_cast<int>(stiff_dofs_.size());
   if (!stiff_factor_current_) {
     // The layer's block of the current tangent (its own stiffness plus the soft elements on its
@@ -68,8 +99,9 @@ void StaticSolver::relax_stiff_layer(double p, const TimeStep& ts, std::span<con
     u1 = u;
     for (int i = 0; i < ns; ++i) u1[stiff_dofs_[i]] -= ds[i];
     Eigen::VectorXd R1;
+    double Pi1 = 0.0;
     try {
-      R1 = residual(p, ts, s_old, s_new, u1);
+      R1 = residual(p, ts, s_old, s_new, u1, potential ? &Pi1 : nullptr);
     } catch (const PhysicsError&) {
       return;  // the relaxed state inverts an element: keep u
     }
@@ -79,6 +111,7 @@ void StaticSolver::relax_stiff_layer(double p, const TimeStep& ts, std::span<con
     if (!(R1.norm() < R.norm())) return;
     u.swap(u1);
     R.swap(R1);
+    if (potential) *potential = Pi1;
     ++stats_.stiff_relaxations;
   }
 }
@@ -95,10 +128,16 @@ double reference_force_floor(const Assembler& a) {
   return 1e-6 * mu * L * L;
 }
 
+double StaticSolver::potential_from(double W, double p, const Eigen::VectorXd& u) const {
+  return W - p * asm_.cavity_volume(u) - gravity_scale_ * gravity_load_.dot(u);
+}
+
 Eigen::VectorXd StaticSolver::residual(double p, const TimeStep& ts, std::span<const double> s_old,
-                                       std::span<double> s_new, const Eigen::VectorXd& u) {
+                                       std::span<double> s_new, const Eigen::VectorXd& u, double* potential) {
   Eigen::VectorXd f_int, f_ext = Eigen::VectorXd::Zero(asm_.num_dofs());
-  asm_.internal(u, ts, s_old, s_new, &f_int, nullptr, nullptr);
+  double W = 0.0;
+  asm_.internal(u, ts, s_old, s_new, &f_int, nullptr, potential ? &W : nullptr);
+  if (potential) *potential = potential_from(W, p, u);
   asm_.add_pressure(u, p, f_ext, nullptr);
   asm_.add_gravity(f_ext, gravity_scale_);
   ++stats_.residual_evaluations;
@@ -114,12 +153,14 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
   Eigen::VectorXd f_int, f_ext;
   Eigen::VectorXd R;
   double previous_residual = std::numeric_limits<double>::infinity();
+  const bool energy_search = has_potential_ && opt_.energy_line_search;
   for (int it = 0; it <= opt_.max_iterations; ++it) {
     // Residual and tangent at u.
     auto t0 = std::chrono::steady_clock::now();
     f_ext.setZero(n);
+    double W0 = 0.0;
     try {
-      asm_.internal(u, ts, s_old, s_new, &f_int, &K_, nullptr);
+      asm_.internal(u, ts, s_old, s_new, &f_int, &K_, energy_search ? &W0 : nullptr);
     } catch (const PhysicsError& e) {
       rep.failure = e.what();
       return rep;
@@ -170,26 +211,44 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     // Line search on s(alpha) = du . R(u + alpha du) (works for the non-potential follower load).
     // With a stiff layer, R is taken at the state relaxed in the layer (stiff-layer elimination):
     // s(alpha) is then the slope of the energy with the layer in equilibrium, so the step is not cut
-    // for the layer's spurious stretch.
+    // for the layer's spurious stretch. With a potential, the step must first lower it (Armijo,
+    // sufficient-decrease constant 1e-4, the usual choice); not in the last iterations (within 100x
+    // the tolerance), where Pi changes by less than its round-off.
     const double s0 = du.dot(R);
     if (opt_.verbose) std::fprintf(stderr, "      |du|=%.3e max|du|=%.3e decrement du.R=%.3e\n", du.norm(), du.lpNorm<Eigen::Infinity>(), s0);
+    const bool armijo = energy_search && s0 < 0.0 && rep.residual_N > 100.0 * tol;
+    const double Pi0 = armijo ? potential_from(W0, p, u) : 0.0;
     double alpha = 1.0;
     Eigen::VectorXd u_try;
     for (int ls = 0; ls < 8; ++ls) {
       u_try = u + alpha * du;
       Eigen::VectorXd R1;
+      double Pi1 = 0.0;
       try {
-        R1 = residual(p, ts, s_old, s_new, u_try);
+        R1 = residual(p, ts, s_old, s_new, u_try, armijo ? &Pi1 : nullptr);
       } catch (const PhysicsError&) {
         alpha *= 0.5;
         ++rep.line_search_cuts;
         continue;
       }
-      if (!stiff_dofs_.empty()) relax_stiff_layer(p, ts, s_old, s_new, u_try, R1);
+      if (!stiff_dofs_.empty()) relax_stiff_layer(p, ts, s_old, s_new, u_try, R1, armijo ? &Pi1 : nullptr);
       const double s1 = du.dot(R1);
       if (!std::isfinite(s1)) {
         alpha *= 0.5;
         ++rep.line_search_cuts;
+        continue;
+      }
+      if (armijo && !(Pi1 <= Pi0 + 1e-4 * alpha * s0)) {
+        // The energy rose: go to the minimum of the parabola through Pi0, slope s0 and Pi1, kept
+        // within [0.1, 0.5] of alpha (a rise means the minimum lies well inside the step).
+        const double c = (Pi1 - Pi0 - s0 * alpha) / (alpha * alpha);
+        const double a_min = c > 0.0 ? -s0 / (2.0 * c) : 0.5 * alpha;
+        if (opt_.verbose)
+          std::fprintf(stderr, "      alpha=%.3g: potential %+.3e J (Armijo bound %+.3e J), |R| %.3e\n", alpha, Pi1 - Pi0,
+                       1e-4 * alpha * s0, R1.norm());
+        alpha = std::clamp(a_min, 0.1 * alpha, 0.5 * alpha);
+        ++rep.line_search_cuts;
+        ++stats_.energy_cuts;
         continue;
       }
       if (s0 >= 0.0 || std::abs(s1) <= 0.8 * std::abs(s0) || s1 < 0.0) break;
@@ -206,7 +265,7 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     // rotation increment, which shows as a large but "stiff" residual; one back-substitution with
     // the same factor removes it at a fraction of a new factorisation's cost. Steps continue while
     // they at least halve the residual.
-    if (linear_.has_factor()) {
+    if (linear_->has_factor()) {
       Eigen::VectorXd Rc;
       try {
         Rc = residual(p, ts, s_old, s_new, u);
@@ -216,7 +275,7 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
       for (int c = 0; c < opt_.chord_steps; ++c) {
         const double r0 = Rc.norm();
         if (r0 <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) break;
-        const Eigen::VectorXd dc = -linear_.solve(Rc);
+        const Eigen::VectorXd dc = -linear_->solve(Rc);
         Eigen::VectorXd R2;
         try {
           R2 = residual(p, ts, s_old, s_new, u + dc);
@@ -238,22 +297,33 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
 }
 
 bool StaticSolver::factorize_current(NewtonReport& rep) {
-  bool ok = linear_.factorize(K_);
+  bool ok = spare_->factorize(K_);
   ++stats_.factorizations;
-  if (ok) return true;
-  // Not positive definite (past a limit point, or a poor trial state): shift the diagonal
-  // (Levenberg-style) until the factorisation succeeds.
+  if (ok) {
+    std::swap(linear_, spare_);
+    return true;
+  }
+  // Not positive definite (past a limit point, or a poor trial state).
+  ++rep.regularised;
+  if (opt_.indefinite == StaticOptions::Indefinite::LastFactor && linear_->has_factor()) {
+    // Modified-Newton step with the last positive-definite tangent (see the class comment).
+    ++stats_.last_factor_steps;
+    if (opt_.verbose) std::fprintf(stderr, "      tangent not positive definite: step with the last factor\n");
+    return true;
+  }
+  // No factor yet (or Indefinite::Shift): shift the diagonal (Levenberg-style) until the
+  // factorisation succeeds.
   const int n = asm_.num_dofs();
   SparseMatrix Ks = K_;
   const Eigen::VectorXd d = K_.diagonal().cwiseAbs();
   for (double beta = 1e-6; beta <= 10.0 && !ok; beta *= 10.0) {
     for (int i = 0; i < n; ++i) Ks.coeffRef(i, i) = K_.coeff(i, i) + beta * d[i];
-    ok = linear_.factorize(Ks);
+    ok = spare_->factorize(Ks);
     ++stats_.factorizations;
     if (opt_.verbose)
       std::fprintf(stderr, "      tangent not positive definite; shift beta=%.0e: %s\n", beta, ok ? "ok" : "not PD");
   }
-  ++rep.regularised;
+  if (ok) std::swap(linear_, spare_);
   if (!ok) rep.failure = "tangent could not be factorised even with a diagonal shift";
   return ok;
 }
@@ -265,10 +335,10 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
   // (each one sparse product and two triangular solves) replace a new factorisation, which costs
   // ~40 triangular solves. CG stops at a relative residual of krylov_rel_tol, enough for
   // superlinear Newton convergence; on breakdown or slow convergence we re-factorise.
-  if (krylov_allowed_ && opt_.krylov_max_iterations > 0 && linear_.has_factor()) {
+  if (krylov_allowed_ && opt_.krylov_max_iterations > 0 && linear_->has_factor()) {
     const Eigen::VectorXd b = -R;
     du = Eigen::VectorXd::Zero(b.size());
-    Eigen::VectorXd r = b, z = linear_.solve(r), pdir = z, Kp;
+    Eigen::VectorXd r = b, z = linear_->solve(r), pdir = z, Kp;
     double rz = r.dot(z);
     const double target = opt_.krylov_rel_tol * b.norm();
     for (int k = 0; k < opt_.krylov_max_iterations; ++k) {
@@ -280,14 +350,14 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
       r -= alpha * Kp;
       ++stats_.krylov_iterations;
       if (r.norm() <= target) return true;
-      z = linear_.solve(r);
+      z = linear_->solve(r);
       const double rz_new = r.dot(z);
       pdir = z + (rz_new / rz) * pdir;
       rz = rz_new;
     }
   }
   if (!factorize_current(rep)) return false;
-  du = -linear_.solve(R);
+  du = -linear_->solve(R);
   return true;
 }
 

@@ -6,6 +6,7 @@
 //
 // Equilibrium: R(u) = f_int(u) - f_ext(u; p) = 0 on the free dofs, with p the cavity pressure.
 // Convergence: ||R_free||_2 <= rel_tol * max(||f_ext||_2, ||reactions||_2, floor) (+ abs_tol_N).
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,6 +34,15 @@ struct StaticOptions {
   /// trial update (0 = off), and the shear-modulus ratio above which a part counts as stiff.
   int stiff_relaxation_steps = 3;
   double stiff_modulus_ratio = 100.0;
+  /// A tangent that is not positive definite (a trial state off the equilibrium path, or near a
+  /// limit point): take the step with the last positive-definite factorisation (a modified-Newton
+  /// step, one back-substitution), or shift the diagonal until Cholesky succeeds (a new
+  /// factorisation per try). See StaticSolver.
+  enum class Indefinite { LastFactor, Shift };
+  Indefinite indefinite = Indefinite::LastFactor;
+  /// Line search on the total potential energy when the model has one (elastic materials, a
+  /// conservative pressure load); otherwise, and when false, on the directional derivative only.
+  bool energy_line_search = true;
 };
 
 struct NewtonReport {
@@ -56,6 +66,8 @@ struct StaticStats {
   long chord_steps = 0;
   long stiff_relaxations = 0;     ///< accepted stiff-layer relaxation steps
   long stiff_factorizations = 0;  ///< factorisations of the stiff-layer block
+  long last_factor_steps = 0;     ///< iterations stepped with the last PD factor (tangent not PD)
+  long energy_cuts = 0;           ///< line-search cuts because the potential energy rose
   double assembly_s = 0.0;
   double factor_s = 0.0;
 };
@@ -70,6 +82,20 @@ struct StaticStats {
 /// rest held (a few Newton steps on the layer's block of the tangent, a small factorisation), and the
 /// line search measures the step on that relaxed state. The equilibrium is unchanged (the full
 /// residual is still the criterion); only the path to it changes.
+///
+/// Globalisation (measured in BENCHMARKS.md section 3). Near the top of the staircase and on trial
+/// states off the path (a linearised bending step stretches the fabric), the tangent is often not
+/// positive definite. Shifting its diagonal until Cholesky succeeds cost one to seven extra
+/// factorisations per such iteration (half of all factorisations), and the heavily shifted steps
+/// were tiny. Instead the solver keeps the last positive-definite factor (two buffers) and takes a
+/// modified-Newton step with it: a descent direction of the potential energy, for the price of a
+/// back-substitution. When the model has a potential Pi(u) = W(u) - p V(u) - f_g . u (elastic
+/// materials; the follower pressure on a closed cavity is conservative: p dV), the line search
+/// also requires Pi to fall (Armijo), which rejects the steps that bend the actuator by a
+/// linearised rotation and thereby stretch the stiff fabric (an energy rise the directional
+/// derivative alone does not see). Whether the load is conservative is checked once, numerically
+/// (the pressure load must be p times the gradient of the cavity volume), so an open cavity of a
+/// user's deck falls back to the derivative-only search.
 class StaticSolver {
  public:
   StaticSolver(const Assembler& assembler, StaticOptions options = {});
@@ -85,9 +111,13 @@ class StaticSolver {
   void advance(double p0_Pa, double p1_Pa, double t0_s, double t1_s, std::vector<double>& state,
                Eigen::VectorXd& u);
 
-  /// Residual R(u) on the free dofs (fixed entries zeroed).
+  /// Residual R(u) on the free dofs (fixed entries zeroed); with `potential`, also the total
+  /// potential energy Pi(u) (J; meaningful only when has_potential()).
   Eigen::VectorXd residual(double p_Pa, const TimeStep& ts, std::span<const double> state_committed,
-                           std::span<double> state_trial, const Eigen::VectorXd& u);
+                           std::span<double> state_trial, const Eigen::VectorXd& u, double* potential = nullptr);
+  /// True when R = dPi/du for the potential of residual(): no material history and a pressure load
+  /// that is p times the gradient of the cavity volume (checked numerically at construction).
+  bool has_potential() const { return has_potential_; }
 
   const StaticStats& stats() const { return stats_; }
   const StaticOptions& options() const { return opt_; }
@@ -111,7 +141,9 @@ class StaticSolver {
   /// Relaxes the stiff dofs of u (the others held) given R = R(u); updates u and R in place.
   /// Never throws: a relaxation step that fails or does not reduce |R| is not taken.
   void relax_stiff_layer(double p_Pa, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,
-                         Eigen::VectorXd& u, Eigen::VectorXd& R);
+                         Eigen::VectorXd& u, Eigen::VectorXd& R, double* potential);
+  /// Pi(u) from the stored energy W (J) already computed at u.
+  double potential_from(double W_J, double p_Pa, const Eigen::VectorXd& u) const;
   /// solve() at constant pressure; when the very first equilibrium of this solver fails with
   /// gravity on, retries with the weight ramped in (see static_solver.cpp).
   NewtonReport solve_first_with_weight(double p_Pa, const TimeStep& ts, std::span<const double> s_old,
@@ -120,7 +152,12 @@ class StaticSolver {
   const Assembler& asm_;
   StaticOptions opt_;
   bool krylov_allowed_ = false;  ///< CG with the old factor: only for pure time increments
-  LinearSolver linear_;
+  // Two factorisation buffers: a new factorisation goes into spare_ and becomes linear_ only when
+  // it succeeds, so linear_ always holds the last positive-definite factor (Indefinite::LastFactor).
+  std::unique_ptr<LinearSolver> linear_ = std::make_unique<LinearSolver>();
+  std::unique_ptr<LinearSolver> spare_ = std::make_unique<LinearSolver>();
+  bool has_potential_ = false;
+  Eigen::VectorXd gravity_load_;  ///< f_g at full weight (N), for the potential
   std::vector<int> stiff_dofs_;   ///< free dofs of the nodes of stiff parts (stiff-layer elimination)
   std::vector<int> stiff_index_;  ///< dof -> position in stiff_dofs_, or -1
   LinearSolver stiff_linear_;     ///< factor of the stiff block of K_

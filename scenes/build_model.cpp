@@ -546,6 +546,17 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
   sv.quasi_static.newton.stiff_relaxation_steps = s.integer("solver.stiff_relaxation_steps");
   if (sv.quasi_static.newton.stiff_relaxation_steps < 0) s.fail("solver.stiff_relaxation_steps", "must be >= 0 (0 = off)");
+  const std::string indefinite = s.string("solver.indefinite_tangent");
+  if (indefinite == "last_factor")
+    sv.quasi_static.newton.indefinite = StaticOptions::Indefinite::LastFactor;
+  else if (indefinite == "shift")
+    sv.quasi_static.newton.indefinite = StaticOptions::Indefinite::Shift;
+  else
+    s.fail("solver.indefinite_tangent", "must be \"last_factor\" or \"shift\", got \"" + indefinite + "\"");
+  const std::string line_search = s.string("solver.line_search");
+  if (line_search != "energy" && line_search != "slope")
+    s.fail("solver.line_search", "must be \"energy\" or \"slope\", got \"" + line_search + "\"");
+  sv.quasi_static.newton.energy_line_search = line_search == "energy";
   sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
   sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");

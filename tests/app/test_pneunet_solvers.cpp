@@ -4,6 +4,7 @@
 // Relaxation is slow here (the 6.5 GPa fabric makes the pseudo-dynamic system stiff: ~10^4-10^5
 // iterations per state), which is why Newton is the default; BENCHMARKS.md has the numbers.
 #include <cmath>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include "materials/errors.h"
 #include "engine/static_solver.h"
 #include "scenes/build_model.h"
+#include "tests/engine/test_meshes.h"
 
 namespace pneufem {
 namespace {
@@ -76,12 +78,13 @@ struct PathRun {
 };
 
 PathRun run_path(const std::vector<std::string>& sets, double top_kPa, int relaxation_steps,
-                 double max_increment_Pa) {
+                 double max_increment_Pa, const std::function<void(StaticOptions&)>& tweak = nullptr) {
   auto bm = build_model(Scene::load("", sets));
   Assembler A(bm->model);
   StaticOptions opt = bm->solver.quasi_static.newton;
   opt.stiff_relaxation_steps = relaxation_steps;
   opt.max_increment_Pa = max_increment_Pa;
+  if (tweak) tweak(opt);
   StaticSolver solver(A, opt);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
   std::vector<double> state(A.state_size(), 0.0);
@@ -109,6 +112,90 @@ TEST(StiffLayerElimination, FollowsTheLoadPathOfSmallIncrements) {
   EXPECT_GT(on.stats.stiff_relaxations, 0);
   std::printf("  Newton iterations: reference %ld, defaults %ld\n", ref.stats.iterations,
               on.stats.iterations);
+}
+
+// Globalisation of Newton (StaticSolver class comment): steps with the last positive-definite
+// factor when the tangent is not positive definite, and an Armijo line search on the potential
+// energy. The potential must be the one whose gradient is the residual, or the line search would
+// reject good steps; central differences along a generic direction check it at a deformed state
+// with pressure and gravity.
+TEST(Globalisation, PotentialGradientIsTheResidual) {
+  // A heavy rig (10 g) so that the weight's work is a sizeable part of the potential.
+  std::vector<std::string> sets = kSmall;
+  sets.push_back("gravity.g_m_s2=[0.0, 30.0, -98.1]");
+  auto bm = build_model(Scene::load("", sets));
+  Assembler A(bm->model);
+  StaticSolver solver(A, bm->solver.quasi_static.newton);
+  ASSERT_TRUE(solver.has_potential());
+  Eigen::VectorXd u_eq = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  std::vector<double> state;
+  const double p = 8e3;
+  solver.advance(0.0, p, 0.0, 0.0, state, u_eq);
+  // Direction: the deformation itself (bending and sagging, a soft mode), from a state 5 % beyond
+  // the equilibrium. There R . d is small next to each of its parts (internal work, pressure work
+  // p dV, weight), so dropping or mis-signing any one of them in Pi would be an O(1) error.
+  const Eigen::VectorXd d = u_eq, u = 1.05 * u_eq;
+  const double h = 1e-4;
+  double Pp = 0.0, Pm = 0.0;
+  const Eigen::VectorXd R = solver.residual(p, {}, state, state, u);
+  solver.residual(p, {}, state, state, u + h * d, &Pp);
+  solver.residual(p, {}, state, state, u - h * d, &Pm);
+  Eigen::VectorXd fg = Eigen::VectorXd::Zero(u.size()), fp = Eigen::VectorXd::Zero(u.size());
+  A.add_gravity(fg);
+  A.add_pressure(u, p, fp, nullptr);
+  const double fd = (Pp - Pm) / (2.0 * h), exact = R.dot(d);
+  std::printf("  dPi/dt: central difference %.9e, R.d %.9e (weight term %.3e, pressure term %.3e)\n", fd, exact,
+              fg.dot(d), fp.dot(d));
+  ASSERT_GT(std::abs(exact), 0.0);
+  ASSERT_GT(std::abs(fg.dot(d)), 0.1 * std::abs(exact));  // the weight is not negligible here
+  // Central difference error O(h^2) ~1e-8 relative; round-off of Pi ~1e-16 |Pi| / h. 1e-5 leaves
+  // room for both and is far below the size of any one term.
+  EXPECT_NEAR(fd, exact, 1e-5 * std::abs(exact));
+}
+
+// The energy line search needs a conservative load and no material history; otherwise the solver
+// must fall back to the derivative-only search rather than use a wrong "energy".
+TEST(Globalisation, NoPotentialForAnOpenCavityOrMaterialHistory) {
+  using namespace testing;
+  Model open = single_part_model(box(0.01, 0.01, 0.01, 2, 2, 2, ElementType::Tet10), ecoflex());
+  fix(open, nodes_on_plane(open.mesh, 2, 0.0), {true, true, true});
+  // Pressure on the top face alone: an open surface, whose load is not p times a volume gradient.
+  open.pressure_faces = faces_where(open.mesh, [](const Eigen::Vector3d& x) { return x.z() > 0.01 - 1e-12; });
+  ASSERT_FALSE(open.pressure_faces.empty());
+  const Assembler A_open(open);
+  EXPECT_FALSE(StaticSolver(A_open).has_potential());
+
+  // The built-in actuator (a closed cavity, closed by the symmetry plane in the half model) has one...
+  auto bm = build_model(Scene::load("", kSmall));
+  const Assembler A(bm->model);
+  EXPECT_TRUE(StaticSolver(A).has_potential());
+  // ...but not with a history-dependent silicone.
+  std::vector<std::string> sets = kSmall;
+  sets.push_back("materials.silicone.mullins.enabled=true");
+  auto bm_h = build_model(Scene::load("", sets));
+  const Assembler A_h(bm_h->model);
+  EXPECT_FALSE(StaticSolver(A_h).has_potential());
+}
+
+// Same equilibria as the previous strategy (diagonal shift, derivative-only search) at every level
+// up to 40 kPa on the 5-chamber actuator, with fewer factorisations (the point of the change;
+// BENCHMARKS.md section 3 has the default actuator's numbers).
+TEST(Globalisation, LastFactorAndEnergySearchGiveTheSameEquilibriaWithFewerFactorisations) {
+  const std::vector<std::string> sets = {"geometry.chambers=5", "mesh.h_mm=6.0"};
+  const PathRun old = run_path(sets, 40.0, 3, 5e3, [](StaticOptions& o) {
+    o.indefinite = StaticOptions::Indefinite::Shift;
+    o.energy_line_search = false;
+  });
+  const PathRun now = run_path(sets, 40.0, 3, 5e3);
+  ASSERT_EQ(now.angles_deg.size(), old.angles_deg.size());
+  for (size_t i = 0; i < old.angles_deg.size(); ++i)
+    // Both converge to rel_tol 1e-8 (see FollowsTheLoadPathOfSmallIncrements for the 1e-6 bound).
+    EXPECT_NEAR(now.angles_deg[i], old.angles_deg[i], 1e-6 * std::abs(old.angles_deg[i])) << 5.0 * (i + 1) << " kPa";
+  std::printf("  factorisations: shift %ld, last factor %ld (%ld last-factor steps, %ld energy cuts); iterations %ld vs %ld\n",
+              old.stats.factorizations, now.stats.factorizations, now.stats.last_factor_steps, now.stats.energy_cuts,
+              old.stats.iterations, now.stats.iterations);
+  EXPECT_LT(now.stats.factorizations, old.stats.factorizations);
+  EXPECT_GT(now.stats.energy_cuts, 0);
 }
 
 }  // namespace
