@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <istream>
 #include <ostream>
 #include <sstream>
@@ -197,6 +198,11 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     const double change = asm_.max_history_change(state_saved, state_, &last_element);
     last_change = change;
     last_h = h;
+    if (opt_.newton.verbose)
+      std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history change %.3g (tol %.3g) at %s%s\n",
+                   t + h, h, p_at(t + h) * 1e-3, change, opt_.time_tol,
+                   last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-",
+                   change > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9) ? " (rejected)" : "");
     if (change > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9)) {
       u_ = u_saved;
       state_ = state_saved;
