@@ -4,8 +4,12 @@
 //   * tangent assembly and one Newton iteration (assembly + CHOLMOD factorisation + solve);
 //   * one staircase trial (10 levels, 0-45 kPa) of the default scene, quasi-static Newton.
 // Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
+//                     [--checksum]
+// --checksum prints a hash of the bits of f_int, of K's values and of the energy (1 and N threads),
+// so two builds of the kernel can be compared bit for bit (A/B of an optimisation).
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -34,6 +38,34 @@ double median_seconds(int reps, F&& f) {
   }
   std::sort(t.begin(), t.end());
   return t[t.size() / 2];
+}
+
+/// FNV-1a over the bytes of n doubles.
+std::uint64_t hash_bits(const double* v, std::size_t n, std::uint64_t h = 0xcbf29ce484222325ULL) {
+  const auto* b = reinterpret_cast<const unsigned char*>(v);
+  for (std::size_t i = 0; i < n * sizeof(double); ++i) h = (h ^ b[i]) * 0x100000001b3ULL;
+  return h;
+}
+
+void kernel_checksum(const std::string& element, double h_mm, int threads) {
+  const Scene scene = Scene::load("", {"mesh.element=\"" + element + "\"", "mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  for (int i = 0; i < u.size(); ++i) u[i] = 2e-5 * std::sin(0.37 * i);  // a generic small deformation (the fabric is 0.4 mm thin)
+  for (int t : {1, threads}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, t);
+    Eigen::VectorXd f, fk;
+    SparseMatrix K;
+    double W = 0.0, Wk = 0.0;
+    A.internal(u, {}, {}, {}, &f, nullptr, &W);
+    A.internal(u, {}, {}, {}, &fk, &K, &Wk);
+    std::printf("  %-5s threads=%d  force %016llx  energy %016llx  force(tangent call) %016llx  K %016llx  energy %.17g\n",
+                element.c_str(), t, static_cast<unsigned long long>(hash_bits(f.data(), f.size())),
+                static_cast<unsigned long long>(hash_bits(&W, 1)),
+                static_cast<unsigned long long>(hash_bits(fk.data(), fk.size(), hash_bits(&Wk, 1))),
+                static_cast<unsigned long long>(hash_bits(K.valuePtr(), K.nonZeros())), W);
+  }
 }
 
 void kernel_rates(const std::string& element, double h_mm, int threads, int reps) {
@@ -105,7 +137,7 @@ void one_trial(double h_mm, int threads) {
 int main(int argc, char** argv) {
   double h = 2.0;
   int threads = tbb::info::default_concurrency();
-  bool skip_trial = false, kernel_only = false;
+  bool skip_trial = false, kernel_only = false, checksum = false;
   int reps = 7;
   std::string only_element;  // "" = both
   for (int i = 1; i < argc; ++i) {
@@ -115,6 +147,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--kernel-only")) kernel_only = true;  // force kernel only (profiling)
     else if (!std::strcmp(argv[i], "--element") && i + 1 < argc) only_element = argv[++i];
     else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--checksum")) checksum = true;
+  }
+  if (checksum) {
+    std::printf("kernel checksums (h=%.2f mm):\n", h);
+    for (const char* el : {"tet4", "tet10"})
+      if (only_element.empty() || only_element == el) kernel_checksum(el, h, threads);
+    return 0;
   }
   std::printf("pneufem engine benchmark (threads available: %d)\n", tbb::info::default_concurrency());
   std::printf("force kernel:\n");
