@@ -32,16 +32,6 @@ Yeoh::Yeoh(double c10, double c20, double c30, double k) : C10(c10), C20(c20), C
   require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa; set K0/mu0 (e.g. 100)");
 }
 
-InvariantDerivatives Yeoh::derivatives(const Invariants& v) const {
-  const double x = v.I1b - 3.0;
-  InvariantDerivatives d;
-  d.W = x * (C10 + x * (C20 + x * C30));
-  d.W1 = C10 + x * (2.0 * C20 + 3.0 * C30 * x);
-  d.W11 = 2.0 * C20 + 6.0 * C30 * x;
-  volumetric_abaqus(K, v.J, d);
-  return d;
-}
-
 double Yeoh::stability_limit_I1b_minus_3() const {
   // smallest positive root of C10 + 2 C20 x + 3 C30 x^2
   const double a = 3.0 * C30, b = 2.0 * C20, c = C10;
@@ -61,28 +51,11 @@ NeoHookean::NeoHookean(double c10, double k) : C10(c10), K(k) {
   require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa");
 }
 
-InvariantDerivatives NeoHookean::derivatives(const Invariants& v) const {
-  InvariantDerivatives d;
-  d.W = C10 * (v.I1b - 3.0);
-  d.W1 = C10;
-  volumetric_abaqus(K, v.J, d);
-  return d;
-}
-
 MooneyRivlin::MooneyRivlin(double c10, double c01, double k) : C10(c10), C01(c01), K(k) {
   require(std::isfinite(C10) && std::isfinite(C01) && std::isfinite(K), kName, "parameters must be finite numbers");
   require(C10 + C01 > 0.0, kName, "C10 + C01 must be > 0 (mu0 = 2 (C10 + C01)), got " + num(C10 + C01) + " Pa");
   require(C10 >= 0.0 || C01 >= 0.0, kName, "C10 and C01 cannot both be negative");
   require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa");
-}
-
-InvariantDerivatives MooneyRivlin::derivatives(const Invariants& v) const {
-  InvariantDerivatives d;
-  d.W = C10 * (v.I1b - 3.0) + C01 * (v.I2b - 3.0);
-  d.W1 = C10;
-  d.W2 = C01;
-  volumetric_abaqus(K, v.J, d);
-  return d;
 }
 
 SaintVenantKirchhoff::SaintVenantKirchhoff(double E, double nu) : E_(E), nu_(nu) {
@@ -91,6 +64,45 @@ SaintVenantKirchhoff::SaintVenantKirchhoff(double E, double nu) : E_(E), nu_(nu)
   require(nu > -1.0 && nu < 0.5, "linear_elastic", "Poisson ratio must lie in (-1, 0.5), got " + num(nu));
   lambda_ = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   mu_ = E / (2.0 * (1.0 + nu));
+}
+
+// Force only, batched (material.h: StressBatch): evaluate's arithmetic lane by lane, each sum in the
+// order Eigen evaluates it there (F^T F and rows 0-1 of F S left to right, row 2 of F S and the traces
+// right to left), so the results are evaluate's bit for bit. The (lambda tr E) * 0 of the off-diagonal
+// S entries is kept: it fixes the sign of a zero exactly as the scalar path does.
+void SaintVenantKirchhoff::stress(StressBatch& b, const TimeStep&, std::span<const double>, std::span<double>) const {
+  constexpr int N = StressBatch::kLanes;
+  const auto& F = b.F;
+  double E[9][N], S[9][N], trE[N];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double delta = i == j ? 1.0 : 0.0;
+      for (int l = 0; l < N; ++l) {  // E = (F^T F - I) / 2, F^T F(i,j) = F.col(i) . F.col(j)
+        const double C = (F[3 * i][l] * F[3 * j][l] + F[3 * i + 1][l] * F[3 * j + 1][l]) + F[3 * i + 2][l] * F[3 * j + 2][l];
+        E[i + 3 * j][l] = 0.5 * (C - delta);
+      }
+    }
+  for (int l = 0; l < N; ++l) {
+    trE[l] = E[0][l] + (E[4][l] + E[8][l]);
+    const double EE0 = E[0][l] * E[0][l] + (E[3][l] * E[1][l] + E[6][l] * E[2][l]);  // diagonal of E E
+    const double EE1 = E[1][l] * E[3][l] + (E[4][l] * E[4][l] + E[7][l] * E[5][l]);
+    const double EE2 = E[2][l] * E[6][l] + (E[5][l] * E[7][l] + E[8][l] * E[8][l]);
+    b.psi_iso[l] = 0.5 * lambda_ * trE[l] * trE[l] + mu_ * (EE0 + (EE1 + EE2));
+    b.psi_vol[l] = 0.0;
+  }
+  for (int k = 0; k < 9; ++k) {
+    const double delta = k % 4 == 0 ? 1.0 : 0.0;
+    for (int l = 0; l < N; ++l) S[k][l] = lambda_ * trE[l] * delta + 2.0 * mu_ * E[k][l];
+  }
+  for (int j = 0; j < 3; ++j) {  // P = F S: rows 0-1 left to right, row 2 right to left
+    for (int i = 0; i < 2; ++i)
+      for (int l = 0; l < N; ++l)
+        b.P_iso[i + 3 * j][l] = (F[i][l] * S[3 * j][l] + F[i + 3][l] * S[1 + 3 * j][l]) + F[i + 6][l] * S[2 + 3 * j][l];
+    for (int l = 0; l < N; ++l)
+      b.P_iso[2 + 3 * j][l] = F[2][l] * S[3 * j][l] + (F[5][l] * S[1 + 3 * j][l] + F[8][l] * S[2 + 3 * j][l]);
+  }
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < N; ++l) b.P_vol[k][l] = 0.0;
 }
 
 void SaintVenantKirchhoff::evaluate(std::span<const Mat3> Fs, const TimeStep&, std::span<const double>,

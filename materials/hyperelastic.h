@@ -24,6 +24,7 @@ struct Yeoh {
   /// I1b - 3 beyond which dW/dI1b <= 0 (loss of Drucker stability); +inf if never.
   double stability_limit_I1b_minus_3() const;
   static constexpr const char* kName = "yeoh";
+  static constexpr bool kUsesI2 = false;  ///< W depends on I1b alone (invariant_stress_batch)
 };
 
 /// Neo-Hookean: W = C10 (I1b - 3), mu0 = 2 C10.
@@ -33,6 +34,7 @@ struct NeoHookean {
   InvariantDerivatives derivatives(const Invariants& v) const;
   double mu0() const { return 2.0 * C10; }
   static constexpr const char* kName = "neo_hookean";
+  static constexpr bool kUsesI2 = false;
 };
 
 /// Mooney-Rivlin: W = C10 (I1b - 3) + C01 (I2b - 3), mu0 = 2 (C10 + C01).
@@ -42,7 +44,37 @@ struct MooneyRivlin {
   InvariantDerivatives derivatives(const Invariants& v) const;
   double mu0() const { return 2.0 * (C10 + C01); }
   static constexpr const char* kName = "mooney_rivlin";
+  static constexpr bool kUsesI2 = true;
 };
+
+// The laws' scalar derivatives are inline, so that the batched stress (invariant_stress_batch) is
+// compiled per law into loops without what the stress does not use (I2 and W11 for Yeoh).
+inline InvariantDerivatives Yeoh::derivatives(const Invariants& v) const {
+  const double x = v.I1b - 3.0;
+  InvariantDerivatives d;
+  d.W = x * (C10 + x * (C20 + x * C30));
+  d.W1 = C10 + x * (2.0 * C20 + 3.0 * C30 * x);
+  d.W11 = 2.0 * C20 + 6.0 * C30 * x;
+  volumetric_abaqus(K, v.J, d);
+  return d;
+}
+
+inline InvariantDerivatives NeoHookean::derivatives(const Invariants& v) const {
+  InvariantDerivatives d;
+  d.W = C10 * (v.I1b - 3.0);
+  d.W1 = C10;
+  volumetric_abaqus(K, v.J, d);
+  return d;
+}
+
+inline InvariantDerivatives MooneyRivlin::derivatives(const Invariants& v) const {
+  InvariantDerivatives d;
+  d.W = C10 * (v.I1b - 3.0) + C01 * (v.I2b - 3.0);
+  d.W1 = C10;
+  d.W2 = C01;
+  volumetric_abaqus(K, v.J, d);
+  return d;
+}
 
 /// Wraps an invariant law as a Material (no history).
 template <class Law>
@@ -57,6 +89,9 @@ class InvariantMaterial final : public Material {
       const Invariants v = isochoric_invariants(F[q]);
       invariant_response(F[q], v, law_.derivatives(v), tangent, out[q]);
     }
+  }
+  void stress(StressBatch& b, const TimeStep&, std::span<const double>, std::span<double>) const override {
+    invariant_stress_batch(law_, b);
   }
   double initial_shear_modulus() const override { return law_.mu0(); }
   double initial_bulk_modulus() const override { return law_.K; }
@@ -74,6 +109,7 @@ class SaintVenantKirchhoff final : public Material {
   std::string name() const override { return "linear_elastic"; }
   void evaluate(std::span<const Mat3> F, const TimeStep&, std::span<const double>, std::span<double>,
                 std::span<PointResponse> out, bool tangent) const override;
+  void stress(StressBatch& b, const TimeStep&, std::span<const double>, std::span<double>) const override;
   double initial_shear_modulus() const override { return mu_; }
   double initial_bulk_modulus() const override { return lambda_ + 2.0 * mu_ / 3.0; }
   bool is_split() const override { return false; }

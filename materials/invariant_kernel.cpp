@@ -1,19 +1,12 @@
 #include "materials/invariant_kernel.h"
 
 #include <cmath>
-#include <cstdint>
-#include <cstring>
-#include <limits>
 
 namespace pneufem {
 
 double inverse_cbrt(double x) {
-  std::uint64_t i;
-  std::memcpy(&i, &x, sizeof i);
-  i = 0x553ef0ff289dd796ULL - i / 3;  // exponent / -3 with a tuned mantissa: within 3.4 %
-  double y;
-  std::memcpy(&y, &i, sizeof y);
-  for (int k = 0; k < 4; ++k) y = y * (4.0 - x * y * y * y) * (1.0 / 3.0);
+  double y = inverse_cbrt_guess(x);
+  for (int k = 0; k < 4; ++k) y = inverse_cbrt_step(x, y);
   return y;
 }
 

@@ -39,6 +39,33 @@ struct PointResponse {
   Mat9 A() const { return A_iso + A_vol; }
 };
 
+/// Deformation gradients and force-only responses of up to kLanes points in structure-of-arrays
+/// layout: component k = i + 3J (tensor.h) of point l is at [k][l]. A law's loops over the lanes
+/// then have the same body for every lane, which the compiler vectorises at the baseline ISA (2
+/// doubles per SSE2 instruction); elementwise IEEE operations round as the scalar ones do. The
+/// engine's force kernel evaluates its elements this way (BENCHMARKS §4).
+struct StressBatch {
+  static constexpr int kLanes = 8;
+  int n = 0;  ///< points in use; lanes n..kLanes-1 are padding (see pad())
+  double F[9][kLanes];
+  double psi_iso[kLanes], psi_vol[kLanes];
+  double P_iso[9][kLanes], P_vol[9][kLanes];
+
+  void set_F(int l, const Mat3& Fl) {
+    for (int k = 0; k < 9; ++k) F[k][l] = Fl(k);
+  }
+  Mat3 F_of(int l) const {
+    Mat3 Fl;
+    for (int k = 0; k < 9; ++k) Fl(k) = F[k][l];
+    return Fl;
+  }
+  /// Copies point 0's F into the unused lanes, so that a law may compute every lane.
+  void pad() {
+    for (int k = 0; k < 9; ++k)
+      for (int l = n; l < kLanes; ++l) F[k][l] = F[k][0];
+  }
+};
+
 /// Physical-time information for rate-dependent laws. A purely elastic evaluation
 /// (e.g. the pseudo-time iterations of a static solve) keeps dt_s = 0 semantics: laws
 /// then return the state reached at the end of the increment dt_s.
@@ -76,6 +103,14 @@ class Material {
   virtual void evaluate(std::span<const Mat3> F, const TimeStep& step,
                         std::span<const double> state_old, std::span<double> state_new,
                         std::span<PointResponse> out, bool tangent) const = 0;
+
+  /// Force-only evaluation of the batch's points 0..b.n-1: psi and P exactly (bit for bit) as
+  /// evaluate(..., tangent = false) returns them, same state conventions (b.n * state_size() doubles).
+  /// F is padded (StressBatch::pad), so an override may compute all lanes; what it writes to the
+  /// padding lanes is ignored. The default converts to evaluate's layout, point by point; laws
+  /// override it with structure-of-arrays arithmetic (a linear tet's force is then ~2x faster).
+  virtual void stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                      std::span<double> state_new) const;
 
   /// Visualisation fields from a (committed) state of one point.
   virtual PointFields fields(std::span<const double> state) const {

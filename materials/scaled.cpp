@@ -37,6 +37,19 @@ void ScaledMaterial::evaluate(std::span<const Mat3> F, const TimeStep& step, std
   }
 }
 
+void ScaledMaterial::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                            std::span<double> state_new) const {
+  base_->stress(b, step, state_old, state_new);
+  for (int l = 0; l < b.n; ++l) {
+    b.psi_iso[l] *= scale_;
+    b.psi_vol[l] *= scale_;
+    for (int k = 0; k < 9; ++k) {
+      b.P_iso[k][l] *= scale_;
+      b.P_vol[k][l] *= scale_;
+    }
+  }
+}
+
 MaterialPtr scale_material(MaterialPtr base, double scale) {
   if (scale == 1.0 && base) return base;
   return std::make_shared<const ScaledMaterial>(std::move(base), scale);

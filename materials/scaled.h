@@ -25,6 +25,8 @@ class ScaledMaterial final : public Material {
   void init_state(std::span<double> state) const override { base_->init_state(state); }
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
+  void stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+              std::span<double> state_new) const override;
   PointFields fields(std::span<const double> state) const override { return base_->fields(state); }
   double initial_shear_modulus() const override { return scale_ * base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return scale_ * base_->initial_bulk_modulus(); }

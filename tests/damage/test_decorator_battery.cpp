@@ -352,6 +352,37 @@ TEST_P(DecoratorBattery, MultiPointCallMatchesSinglePoints) {
   }
 }
 
+// The force kernel's batched entry point (Material::stress) of a law with history: the engine
+// passes one element's points (4 for a quadratic tet) with their state blocks. psi, P and the
+// trial state must be evaluate()'s bit for bit (the default implementation calls evaluate).
+TEST_P(DecoratorBattery, StressBatchIsEvaluateBitForBit) {
+  const double dt = GetParam().dt;
+  const std::vector<State> states = battery_states();
+  const std::size_t n = 4, ss = static_cast<std::size_t>(material->state_size());
+  StressBatch b;
+  b.n = static_cast<int>(n);
+  std::vector<double> old_all, new_all(n * ss, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t q = 0; q < n; ++q) {
+    b.set_F(static_cast<int>(q), states[q + 1].F);
+    old_all.insert(old_all.end(), committed.begin(), committed.end());
+  }
+  b.pad();
+  material->stress(b, TimeStep{1.0 + dt, dt}, old_all, new_all);
+  for (std::size_t q = 0; q < n; ++q) {
+    const int l = static_cast<int>(q);
+    std::vector<double> trial;
+    const PointResponse r = eval(*material, states[q + 1].F, dt, committed, &trial, false);
+    EXPECT_EQ(b.psi_iso[l], r.psi_iso) << "point " << q;
+    EXPECT_EQ(b.psi_vol[l], r.psi_vol) << "point " << q;
+    EXPECT_EQ(b.F_of(l), states[q + 1].F);
+    for (int k = 0; k < 9; ++k) {
+      EXPECT_EQ(b.P_iso[k][l], r.P_iso(k)) << "point " << q << " component " << k;
+      EXPECT_EQ(b.P_vol[k][l], r.P_vol(k)) << "point " << q << " component " << k;
+    }
+    EXPECT_EQ(std::vector<double>(new_all.begin() + q * ss, new_all.begin() + (q + 1) * ss), trial) << "point " << q;
+  }
+}
+
 std::string case_name(const ::testing::TestParamInfo<Case>& i) { return i.param.name; }
 
 std::vector<Case> hyperelastic_cases() {
