@@ -81,9 +81,9 @@ void kernel_rates(const std::string& element, double h_mm, int threads, int reps
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, t);
     const double tf = median_seconds(reps, [&] { A.internal(u, {}, {}, {}, &f, nullptr, nullptr); });
     const double tk = median_seconds(3, [&] { A.internal(u, {}, {}, {}, &f, &K, nullptr); });
-    std::printf("  %-5s h=%.2f mm  %6d elements  %7d dofs  threads=%d  force: %8.2f ms  %.3g element-updates/s"
+    std::printf("  %-5s h=%.2f mm  %6d elements  %7d dofs  %3d colours  threads=%d  force: %8.2f ms  %.3g element-updates/s"
                 "  (%.3g qp/s)   force+tangent: %8.2f ms\n",
-                element.c_str(), h_mm, ne, bm->model.num_dofs(), t, tf * 1e3, ne / tf,
+                element.c_str(), h_mm, ne, bm->model.num_dofs(), A.num_colours(), t, tf * 1e3, ne / tf,
                 ne * double(A.geometry().nqp) / tf, tk * 1e3);
   }
 }

@@ -55,10 +55,14 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
   const Mesh& mesh = model.mesh;
   const int ne = mesh.num_elements(), nn = mesh.num_nodes(), npe = mesh.npe();
   {
-    const std::vector<std::vector<int>> colours = colour_elements(mesh);
+    std::vector<std::vector<int>> colours = colour_elements(mesh);
     colour_ptr_.assign(1, 0);
     kelem_.reserve(ne);
-    for (const auto& c : colours) {
+    for (auto& c : colours) {
+      // Within a colour the order is free (its elements share no node, so every sum sees the same
+      // terms in the same order): group the elements by part, hence by material, so that the
+      // force kernel's batches of one material are full (fabric and silicone interleave otherwise).
+      std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return model.element_part[a] < model.element_part[b]; });
       kelem_.insert(kelem_.end(), c.begin(), c.end());
       colour_ptr_.push_back(static_cast<int>(kelem_.size()));
     }
@@ -211,30 +215,134 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
   const bool tangent = K != nullptr;
   const bool has_state = state_size() > 0;
 
-  auto kernel = [&](int pos) {  // loop position (colour order), see assembly.h
-    const int e = kelem_[pos];
+  // F = I + grad u at the element's points (not x grad N): at small strain the displacement
+  // gradient is computed to full relative precision, so stresses of a stiff layer (E = 6.5 GPa)
+  // carry no round-off floor.
+  const auto deformation_gradients = [&](int pos, std::array<Mat3, NQP>& F) {
     const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
     const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
-    const double* wq = kw_.data() + static_cast<std::size_t>(pos) * NQP;
-    // F = I + grad u (not x grad N): at small strain the displacement gradient is computed to full
-    // relative precision, so stresses of a stiff layer (E = 6.5 GPa) carry no round-off floor.
     Eigen::Matrix<double, 3, NPE> ue;
     for (int a = 0; a < NPE; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
-    std::array<Mat3, NQP> F;
     for (int q = 0; q < NQP; ++q) {
       const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);  // column a = dN_a/dX
       F[q] = Mat3::Identity() + ue * g.transpose();
-      const double J = F[q].determinant();
-      if (!(J > 0.0) || !std::isfinite(J)) {
-        atomic_min(bad, e);
-        return;
+    }
+  };
+  const auto inverted = [](double J) { return !(J > 0.0) || !std::isfinite(J); };
+  // The element's slice of the material history (empty spans for a law without history).
+  const auto element_states = [&](int pos, std::span<const double>& s_old, std::span<double>& s_new) {
+    if (!has_state) return;
+    const int e = kelem_[pos];
+    const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
+    s_old = state_old.subspan(o0, o1 - o0);
+    if (!state_new.empty()) s_new = state_new.subspan(o0, o1 - o0);
+  };
+
+  // Force only (explicit steps, residuals): consecutive elements of one material share a batch of
+  // StressBatch::kLanes points, hence one virtual call, and the law computes them with
+  // structure-of-arrays arithmetic (materials/material.h); a law with history gets one element per
+  // batch, with its state. F and fe stay element by element, with the tangent path's Eigen
+  // expressions (same bits); det F, P = P_iso + P_vol and the finiteness checks run on the batch.
+  // The Tet4 force became 2x faster (BENCHMARKS §4); arranging F and fe by lanes too was slower.
+  constexpr int L = StressBatch::kLanes;
+  constexpr int kPerBatch = L / NQP;
+  static_assert(L % NQP == 0, "a batch holds whole elements");
+  const auto force_range = [&](int begin, int end) {
+    StressBatch b;
+    std::array<int, kPerBatch> bpos;  // loop positions of the batch's elements
+    std::array<Mat3, NQP> F;
+    for (int pos = begin; pos < end;) {
+      const Material& mat = *kmat_[pos];
+      const int cap = has_state && mat.state_size() > 0 ? 1 : kPerBatch;
+      int m = 0;
+      for (; pos < end && m < cap && kmat_[pos] == &mat; ++pos) {
+        deformation_gradients(pos, F);
+        for (int q = 0; q < NQP; ++q) b.set_F(m * NQP + q, F[q]);
+        bpos[m++] = pos;
+      }
+      b.n = m * NQP;
+      b.pad();
+      // det F of every point (Eigen's 3x3 formula); an inverted element is reported after the
+      // loop, and its points are replaced by F = I so that the law sees valid input.
+      const auto& Fb = b.F;
+      double J[L];
+      for (int l = 0; l < L; ++l)
+        J[l] = (Fb[0][l] * (Fb[4][l] * Fb[8][l] - Fb[7][l] * Fb[5][l]) -
+                Fb[3][l] * (Fb[1][l] * Fb[8][l] - Fb[7][l] * Fb[2][l])) +
+               Fb[6][l] * (Fb[1][l] * Fb[5][l] - Fb[4][l] * Fb[2][l]);
+      std::array<bool, kPerBatch> ok;
+      for (int j = 0; j < m; ++j) {
+        ok[j] = true;
+        for (int q = 0; q < NQP; ++q) ok[j] = ok[j] && !inverted(J[j * NQP + q]);
+        if (ok[j]) continue;
+        atomic_min(bad, kelem_[bpos[j]]);
+        for (int q = 0; q < NQP; ++q) b.set_F(j * NQP + q, Mat3::Identity());
+      }
+      if (std::none_of(ok.begin(), ok.begin() + m, [](bool v) { return v; })) continue;  // e.g. no trial state
+      std::span<const double> s_old;
+      std::span<double> s_new;
+      if (cap == 1) element_states(bpos[0], s_old, s_new);
+      mat.stress(b, ts, s_old, s_new);
+      double P[9][L], psi[L], nonfinite[L];
+      for (int l = 0; l < L; ++l) {
+        psi[l] = b.psi_iso[l] + b.psi_vol[l];
+        nonfinite[l] = 0.0;
+      }
+      for (int k = 0; k < 9; ++k)
+        for (int l = 0; l < L; ++l) {
+          P[k][l] = b.P_iso[k][l] + b.P_vol[k][l];
+          nonfinite[l] = nonfinite[l] + (P[k][l] - P[k][l]);  // 0 for a finite entry, NaN otherwise
+        }
+      for (int j = 0; j < m; ++j) {
+        if (!ok[j]) continue;
+        const int p = bpos[j], e = kelem_[p];
+        const double* grad = kgrad_.data() + static_cast<std::size_t>(p) * NQP * NPE * 3;
+        const double* wq = kw_.data() + static_cast<std::size_t>(p) * NQP;
+        Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
+        double psi_e = 0.0;
+        for (int q = 0; q < NQP; ++q) {
+          const int l = j * NQP + q;
+          if (!(nonfinite[l] == 0.0)) {
+            ok[j] = false;
+            break;
+          }
+          const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+          const Eigen::Map<const Mat3, 0, Eigen::InnerStride<L>> Pl(&P[0][l]);
+          const double w = wq[q];
+          fe.noalias() += w * Pl * g;
+          psi_e += w * psi[l];
+        }
+        if (!ok[j]) {
+          atomic_min(bad, e);
+          continue;
+        }
+        if (energy) elem_energy[e] = psi_e;
+        if (f_int) {
+          const int* n = knodes_.data() + static_cast<std::size_t>(p) * NPE;
+          for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
+        }
       }
     }
+  };
+
+  // Force and tangent, element by element.
+  const auto tangent_kernel = [&](int pos) {  // loop position (colour order), see assembly.h
+    const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
+    const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
+    const double* wq = kw_.data() + static_cast<std::size_t>(pos) * NQP;
+    std::array<Mat3, NQP> F;
+    deformation_gradients(pos, F);
+    for (int q = 0; q < NQP; ++q)
+      if (inverted(F[q].determinant())) {
+        atomic_min(bad, kelem_[pos]);
+        return;
+      }
     std::array<PointResponse, NQP> resp;
-    const Material& mat = *kmat_[pos];
-    const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
-    mat.evaluate(F, ts, has_state ? state_old.subspan(o0, o1 - o0) : std::span<const double>{},
-                 has_state && !state_new.empty() ? state_new.subspan(o0, o1 - o0) : std::span<double>{}, resp, tangent);
+    std::span<const double> s_old;
+    std::span<double> s_new;
+    element_states(pos, s_old, s_new);
+    kmat_[pos]->evaluate(F, ts, s_old, s_new, resp, true);
+    const int e = kelem_[pos];
     Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
     double psi = 0.0;
     for (int q = 0; q < NQP; ++q) {
@@ -251,7 +359,6 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
     if (energy) elem_energy[e] = psi;
     if (f_int)
       for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
-    if (!tangent) return;
     // Element stiffness K_ab(i,k) = sum_q w sum_JL g_a[J] A(iJ,kL) g_b[L], accumulated over the
     // points in a local matrix (upper blocks only, A has major symmetry) and scattered once.
     Eigen::Matrix<double, 3 * NPE, 3 * NPE> Ke;
@@ -289,9 +396,16 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
       }
   };
 
+  // Tasks of 10 us or more: one costs ~0.5 us to schedule, and a linear tet's force only ~50 ns
+  // (64-element tasks made the two-thread Tet4 force ~5 % slower than 256-element ones).
+  const int grain = !tangent && NQP == 1 ? 256 : 64;
   for (std::size_t c = 0; c + 1 < colour_ptr_.size(); ++c) {
-    tbb::parallel_for(tbb::blocked_range<int>(colour_ptr_[c], colour_ptr_[c + 1], 64), [&](const tbb::blocked_range<int>& r) {
-      for (int i = r.begin(); i < r.end(); ++i) kernel(i);
+    tbb::parallel_for(tbb::blocked_range<int>(colour_ptr_[c], colour_ptr_[c + 1], grain), [&](const tbb::blocked_range<int>& r) {
+      if (!tangent) {
+        force_range(r.begin(), r.end());
+        return;
+      }
+      for (int i = r.begin(); i < r.end(); ++i) tangent_kernel(i);
     });
   }
   if (bad.load() != INT_MAX) {

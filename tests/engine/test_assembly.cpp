@@ -1,5 +1,6 @@
 // Assembly-level checks: mass, tangent and pressure load stiffness against finite differences,
 // pressure resultants, cavity volume, thread-count independence, bending angle.
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -7,9 +8,11 @@
 
 #include <Eigen/Geometry>
 
+#include "damage/effects.h"
 #include "engine/angle.h"
 #include "materials/errors.h"
 #include "engine/assembly.h"
+#include "materials/hyperelastic.h"
 #include "tests/engine/test_meshes.h"
 
 namespace pneufem {
@@ -140,6 +143,43 @@ TEST_P(AssemblyTest, ResultsIndependentOfThreadCount) {
   EXPECT_TRUE((f1.array() == f2.array()).all());
   EXPECT_TRUE((k1.array() == k2.array()).all());
   EXPECT_EQ(w1, w2);
+}
+
+// The force-only path (batched stress, engine/assembly.cpp) and the force of the force + tangent
+// path are the same arithmetic: f_int, the energy and the trial state agree bit for bit, with 1 or
+// 2 threads, for a model mixing a law without history (batched), a stiff St Venant-Kirchhoff layer
+// and a decorated law with history (evaluated element by element).
+TEST_P(AssemblyTest, ForceOnlyPathMatchesTangentPathBitForBit) {
+  Model model = single_part_model(box(0.1, 0.1, 0.1, 4, 4, 4, GetParam()), ecoflex());
+  model.parts.push_back(Part{"fabric", std::make_shared<SaintVenantKirchhoff>(6.5e9, 0.2), 1000.0});
+  model.parts.push_back(Part{"mullins", make_mullins(ecoflex(), MullinsParams{2.0, 20e3, 0.3}), 1000.0});
+  for (int e = 0; e < model.mesh.num_elements(); ++e) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) c += model.mesh.X[model.mesh.element(e)[a]] / 4.0;
+    model.element_part[e] = c.z() < 0.025 ? 1 : c.x() < 0.05 ? 2 : 0;
+  }
+  Assembler A(model);
+  const Eigen::VectorXd u = random_displacement(model.mesh, 2e-4, 19);
+  const std::vector<double> state_old = A.initial_state();
+  ASSERT_GT(state_old.size(), 0u);
+  auto eval = [&](int threads, bool tangent) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    SparseMatrix K;
+    Eigen::VectorXd f;
+    double W = 0;
+    std::vector<double> state_new(state_old.size());
+    A.internal(u, TimeStep{1.0, 0.0}, state_old, state_new, &f, tangent ? &K : nullptr, &W);
+    return std::make_tuple(f, W, state_new);
+  };
+  const auto [f_t, w_t, s_t] = eval(1, true);
+  ASSERT_GT(f_t.norm(), 0.0);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    const auto [f, w, s] = eval(threads, false);
+    EXPECT_EQ(std::memcmp(f.data(), f_t.data(), sizeof(double) * f.size()), 0);  // bit for bit
+    EXPECT_EQ(w, w_t);
+    EXPECT_EQ(s, s_t);
+  }
 }
 
 TEST_P(AssemblyTest, InvertedElementIsReportedWithIdAndTime) {
