@@ -369,6 +369,12 @@ double rss_of(const std::vector<double>& model, const std::vector<ComparedFrame>
 }
 
 /// Value of a catalog parameter at the scaled coordinate x in [0, 1].
+std::vector<double> initial_values(const CandidateEffect& c) {
+  std::vector<double> v;
+  for (const CandidateParameter& p : c.params) v.push_back(p.initial);
+  return v;
+}
+
 double unscale(const CandidateParameter& p, double x) {
   x = std::clamp(x, 0.0, 1.0);
   return p.log ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + x * (p.hi - p.lo);
@@ -706,7 +712,25 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     for (std::size_t i = 0; i < cands.size(); ++i)
       if (!used[i]) todo.push_back(i);
     if (todo.empty()) break;
+    // Discrepancy principle (Morozov): once the residual is at the noise floor, no further effect
+    // can pass the third significance test (an NRMSE gain >= min_gain_of_floor x floor) without
+    // fitting below the noise floor, so the next round cannot select anything: stop.
+    if (round > 1 && opt.stop_at_noise_floor && current.nrmse < (1.0 + opt.min_gain_of_floor) * out.noise_floor_nrmse) {
+      out.stopped = "after round " + std::to_string(round - 1) + ": the residual (NRMSE " + fmt("%.4f", current.nrmse) +
+                    ") is within " + fmt("%.0f", 100.0 * opt.min_gain_of_floor) + " % of the noise floor (" +
+                    fmt("%.4f", out.noise_floor_nrmse) +
+                    "), so no further effect could be significant without fitting the noise (--all-rounds tries them anyway)";
+      if (opt.progress) std::fprintf(stderr, "diagnose: stopped %s\n", out.stopped.c_str());
+      break;
+    }
     const Scene cur_scene = cal_scene.with(selected_sets);
+    // Longest first: a candidate whose runs are static FEM sweeps (gravity) costs ~10x the others,
+    // so it starts at once and the cheap ones fill the other cores (the order changes no result).
+    std::vector<char> costly(cands.size(), 0);
+    for (std::size_t i : todo)
+      costly[i] = cands[i]->params.empty() ? 0 : rom.uses_fem_sweeps(cur_scene.with(cands[i]->sets(cur_scene, initial_values(*cands[i]))));
+    std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return costly[a] > costly[b]; });
+    const auto t_round = std::chrono::steady_clock::now();
     tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t j) {
       const CandidateEffect& c = *cands[todo[j]];
       CandidateResult& r = results[todo[j]];
@@ -805,7 +829,12 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
               " with " + std::to_string(c.params.size()) + " parameter(s)). Residual signature: " + evidence(c.name, sig) +
               ". " + c.signature;
     });
+    if (opt.progress)
+      std::fprintf(stderr, "diagnose: round %d done (%.1f s; %.1f s since the start)\n", round,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_round).count(),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     std::vector<std::size_t> order = todo;
+    std::sort(order.begin(), order.end());  // catalog order among equals, whatever the run order was
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return results[a].nrmse < results[b].nrmse; });
     for (std::size_t i : order) out.candidates.push_back(results[i]);
     const CandidateResult& best = results[order.front()];
@@ -1027,6 +1056,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   }
   root.add("candidates", cs + "\n  ]");
   root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
+  if (!out.stopped.empty()) root.add("stopped", json::quote(out.stopped));
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
   root.add("selected", sel + "]");

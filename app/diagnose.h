@@ -18,7 +18,9 @@
 //    and its NRMSE gain must be at least min_gain_of_floor x the noise floor (near the floor the
 //    excess is tiny and fitting noise can remove much of it).
 // 4. Greedy forward selection: the best significant candidate is added (with its calibrated
-//    constants) and the remaining candidates are tried again on top of it, up to max_effects.
+//    constants) and the remaining candidates are tried again on top of it, up to max_effects,
+//    unless the residual is already at the noise floor (within min_gain_of_floor: the third test
+//    of 3. could then only pass by fitting noise; the discrepancy principle of inverse problems).
 // 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
 //    trials, creep inside holds, first-trial vs later, lag after steps, offset at rest,
 //    proportional error) and the error it removes.
@@ -50,6 +52,9 @@ struct DiagnoseOptions {
   double aic_threshold = -10.0;
   double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
   double min_gain_of_floor = 0.1;       ///< ... and NRMSE gain of at least this times the noise floor
+  /// Skip later rounds once the residual is within min_gain_of_floor of the noise floor (no effect
+  /// could then be significant without fitting below the floor); false = run every round.
+  bool stop_at_noise_floor = true;
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
   int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
@@ -99,6 +104,7 @@ struct DiagnosisResult {
   std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
   std::vector<std::string> selected;
   std::string missing_effect;               ///< "" = none significant
+  std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
   double verified_baseline_nrmse = -1.0;    ///< full FEM (verify), -1 when not run
   double verified_fitted_nrmse = -1.0;

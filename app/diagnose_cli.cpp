@@ -36,6 +36,9 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
                      "... and remove at least this fraction of the squared error above the noise floor")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  c->cmd->add_flag_callback(
+      "--all-rounds", [o = &c->options] { o->stop_at_noise_floor = false; },
+      "Run every forward-selection round, even when the residual is already at the noise floor");
   c->cmd->add_option("--rom-points", c->options.rom_points, "Material points of the reduced model")
       ->check(CLI::Range(100, 10000000))
       ->capture_default_str();

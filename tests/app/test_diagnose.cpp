@@ -6,6 +6,7 @@
 //   * rank the hidden effect first and call it the missing effect (none for the control data),
 //   * bring the error down to near the noise floor,
 //   * recover constants near the truth.
+#include <fstream>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -41,7 +42,7 @@ DiagnosisResult diagnose(const std::string& name, int refine = 0) {
   o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_" + name)).string();
   fs::remove_all(o.out_dir);
   o.refine = refine;
-  o.max_effects = 1;  // one hidden effect: the second round is exercised in the CLI test below
+  o.max_effects = 1;  // one hidden effect: round 2 is exercised in GravityIsKeptUnderHistoryEffects and ForwardSelectionStopsAtTheNoiseFloor
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   std::printf("%s: baseline %.4f, floor %.4f, final %.4f (FEM %.4f); ranking:", name.c_str(), r.baseline_nrmse,
               r.noise_floor_nrmse, r.final_nrmse, r.verified_fitted_nrmse);
@@ -271,6 +272,7 @@ TEST(HiddenEffect, GravityIsKeptUnderHistoryEffects) {
   o.out_dir = (fs::temp_directory_path() / "pneufem_diag_gravity_visco").string();
   fs::remove_all(o.out_dir);
   o.max_effects = 2;
+  o.stop_at_noise_floor = false;  // round 1 reaches the floor; this test is about round 2
   o.candidates = {"gravity", "viscoelastic"};
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   ASSERT_EQ(r.missing_effect, "gravity");
@@ -281,6 +283,41 @@ TEST(HiddenEffect, GravityIsKeptUnderHistoryEffects) {
   }
   std::printf("round 1 gravity NRMSE %.4f, round 2 viscoelastic on top %.4f\n", g1, v2);
   EXPECT_LT(v2, 1.1 * g1);
+}
+
+// The forward selection stops once round 1 has brought the residual within min_gain_of_floor
+// (10 %) of the noise floor: a second effect could then pass the gain test only by fitting below
+// the floor. Hidden stiffness is explained to 0.0159 against a floor of 0.0156 (measured), so round
+// 2 is skipped and says why; hidden creep leaves 0.0232 against 0.0128 with the reduced model, so
+// round 2 still runs there.
+TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
+  auto run = [](const std::string& name, std::vector<std::string> cands) {
+    DiagnoseOptions o;
+    o.data_path = data(name);
+    o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_stop_" + name)).string();
+    fs::remove_all(o.out_dir);
+    o.max_effects = 2;
+    o.candidates = std::move(cands);
+    return run_diagnosis(Scene::load("", kScene), o);
+  };
+  auto rounds = [](const DiagnosisResult& r) {
+    int m = 0;
+    for (const CandidateResult& c : r.candidates) m = std::max(m, c.round);
+    return m;
+  };
+  const DiagnosisResult s = run("stiffness", {"stiffness", "pressure_lag"});
+  ASSERT_EQ(s.missing_effect, "stiffness");
+  ASSERT_LT(s.final_nrmse, 1.1 * s.noise_floor_nrmse);  // the premise of the stop
+  EXPECT_EQ(rounds(s), 1);
+  EXPECT_NE(s.stopped.find("noise floor"), std::string::npos) << s.stopped;
+  std::ifstream js(fs::temp_directory_path() / "pneufem_diag_stop_stiffness" / "diagnosis.json");
+  const std::string json((std::istreambuf_iterator<char>(js)), std::istreambuf_iterator<char>());
+  EXPECT_NE(json.find("\"stopped\": \"after round 1"), std::string::npos);
+  const DiagnosisResult v = run("viscoelastic", {"viscoelastic", "pressure_lag"});
+  ASSERT_EQ(v.missing_effect, "viscoelastic");
+  ASSERT_GE(v.final_nrmse, 1.1 * v.noise_floor_nrmse);
+  EXPECT_EQ(rounds(v), 2);
+  EXPECT_TRUE(v.stopped.empty()) << v.stopped;
 }
 
 TEST(HiddenEffect, Mullins) {
