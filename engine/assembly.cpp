@@ -487,6 +487,23 @@ double Assembler::max_history_change(std::span<const double> a, std::span<const 
   return worst;
 }
 
+std::vector<double> Assembler::history_scalars(std::span<const double> state) const {
+  const int ne = model_.mesh.num_elements();
+  std::vector<double> out(static_cast<std::size_t>(ne) * geom_.nqp * 2, 0.0);
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = model_.material_of(e);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    if (ss == 0) continue;
+    for (int q = 0; q < geom_.nqp; ++q) {
+      const PointFields f = mat.fields(state.subspan(state_offset_[e] + q * ss, ss));
+      const std::size_t i = 2 * (static_cast<std::size_t>(e) * geom_.nqp + q);
+      out[i] = f.fatigue_damage;
+      out[i + 1] = f.viscous_strain;
+    }
+  }
+  return out;
+}
+
 Assembler::RegionFailures Assembler::failed_points(std::span<const double> state) const {
   const Mesh& mesh = model_.mesh;
   // A mesh without region tags counts as one region (index 0).

@@ -77,6 +77,13 @@ class Assembler {
   double max_history_change(std::span<const double> before, std::span<const double> after,
                             int* worst_element = nullptr) const;
 
+  /// Per material point (element-major, geom nqp points each, every element): its fatigue damage
+  /// and viscous strain (Material::fields), 2 values per point; zeros where a law has no history.
+  /// The error-controlled physical time step compares three of these (engine/quasi_static.h).
+  std::vector<double> history_scalars(std::span<const double> state) const;
+  /// Element of point i of history_scalars.
+  int element_of_point(int i) const { return i / geom_.nqp; }
+
   /// Material points whose law reports failure (PointFields::failed, e.g. fatigue damage >= d_fail)
   /// and all material points, per region (index = mesh region id; one entry for an untagged mesh).
   struct RegionFailures {

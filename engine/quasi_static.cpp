@@ -16,7 +16,8 @@ namespace pneufem {
 
 // ------------------------------------------------------------------ checkpoint (binary)
 namespace {
-constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;  // "PNEFCKP1"
+constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;   // "PNEFCKP1"
+constexpr std::uint64_t kMagic2 = 0x32504b4346454e50ULL;  // "PNEFCKP2": + error-control memory
 
 template <class T>
 void put(std::ostream& os, const T& v) {
@@ -43,7 +44,7 @@ std::vector<double> get_vec(std::istream& is) {
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
-  put(os, kMagic);
+  put(os, kMagic2);
   put(os, static_cast<std::uint64_t>(next_segment));
   put(os, dt_suggest_s);
   put(os, last_angle_deg);
@@ -55,13 +56,17 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put(os, stats.rejected_steps);
   put(os, stats.relaxation_iterations);
   put(os, stats.wall_s);
+  put_vec(os, hist_prev.data(), hist_prev.size());
+  put_vec(os, hist_cur.data(), hist_cur.size());
+  put(os, h_prev_s);
+  put(os, rate_prev_Pa_s);
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
   QuasiStaticCheckpoint c;
   std::uint64_t magic = 0, seg = 0;
   get(is, magic);
-  if (magic != kMagic) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  if (magic != kMagic && magic != kMagic2) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
   get(is, seg);
   c.next_segment = static_cast<std::size_t>(seg);
   get(is, c.dt_suggest_s);
@@ -78,6 +83,12 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   get(is, c.stats.rejected_steps);
   get(is, c.stats.relaxation_iterations);
   get(is, c.stats.wall_s);
+  if (magic == kMagic2) {
+    c.hist_prev = get_vec(is);
+    c.hist_cur = get_vec(is);
+    get(is, c.h_prev_s);
+    get(is, c.rate_prev_Pa_s);
+  }
   if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size)
     throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
                      "resume with the run's own scene.toml");
@@ -151,10 +162,19 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   const double span = s.g1 - s.g0;
   if (!rate_dependent_ || span <= 0.0) {
     if (span > 0.0 || s.p0 != s.p1) equilibrium(s.p0, s.p1, s.g0, s.g1);
+    hist_prev_.clear();  // a jump: the error control's last step is no longer the last state
+    hist_cur_.clear();
     return;
   }
   auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
   if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
+  const bool error_control = opt_.time_control == TimeControl::Error;
+  const double rate = (s.p1 - s.p0) / span;
+  // A kink of the load (its rate changes) starts afresh: the last step's rate says nothing here.
+  if (error_control && !hist_cur_.empty() && std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_))) {
+    hist_prev_.clear();
+    hist_cur_.clear();
+  }
   double t = s.g0;
   long steps = 0;
   double last_change = 0.0, last_h = 0.0;
@@ -195,24 +215,60 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       ++stats_.rejected_steps;
       continue;
     }
-    const double change = asm_.max_history_change(state_saved, state_, &last_element);
+    double change = 0.0;
+    std::vector<double> hist_new;
+    // Error control with a previous step of the same load rate: the local-error estimate;
+    // otherwise the change limit. `measure` is what is compared with time_tol, `order` how it
+    // scales with the step (error ~ h^2, change ~ h).
+    double measure = 0.0, order = 1.0;
+    if (error_control) {
+      hist_new = asm_.history_scalars(state_);
+      if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
+      int worst_change = -1, worst_err = -1;
+      double err = 0.0;
+      const bool have_prev = !hist_prev_.empty() && h_prev_ > 0.0;
+      const double r = have_prev ? h / h_prev_ : 0.0;
+      for (std::size_t i = 0; i < hist_new.size(); i += 2) {
+        const double c = std::abs(hist_new[i] - hist_cur_[i]) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
+        if (c > change) change = c, worst_change = static_cast<int>(i / 2);
+        if (!have_prev) continue;
+        double e = 0.0;
+        for (int k = 0; k < 2; ++k)
+          e += std::abs((hist_new[i + k] - hist_cur_[i + k]) - r * (hist_cur_[i + k] - hist_prev_[i + k]));
+        e *= r / (1.0 + r);
+        if (e > err) err = e, worst_err = static_cast<int>(i / 2);
+      }
+      const int worst_point = have_prev ? worst_err : worst_change;
+      last_element = worst_point >= 0 ? asm_.element_of_point(worst_point) : -1;
+      measure = have_prev ? err : change;
+      order = have_prev ? 2.0 : 1.0;
+    } else {
+      change = asm_.max_history_change(state_saved, state_, &last_element);
+      measure = change;
+    }
     last_change = change;
     last_h = h;
+    const bool reject = measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
     if (opt_.newton.verbose)
-      std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history change %.3g (tol %.3g) at %s%s\n",
-                   t + h, h, p_at(t + h) * 1e-3, change, opt_.time_tol,
-                   last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-",
-                   change > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9) ? " (rejected)" : "");
-    if (change > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9)) {
+      std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history %s %.3g (tol %.3g) at %s%s\n",
+                   t + h, h, p_at(t + h) * 1e-3, order > 1.0 ? "error estimate" : "change", measure, opt_.time_tol,
+                   last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-", reject ? " (rejected)" : "");
+    if (reject) {
       u_ = u_saved;
       state_ = state_saved;
       newton_.set_path(path_saved);
-      dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, 0.9 * opt_.time_tol / change));
+      dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, std::pow(0.9 * opt_.time_tol / measure, 1.0 / order)));
       ++stats_.rejected_steps;
       continue;
     }
-    const double grow = change > 0.0 ? std::clamp(0.9 * opt_.time_tol / change, 0.5, 2.0) : 2.0;
+    const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
     dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+    if (error_control) {
+      hist_prev_ = std::move(hist_cur_);
+      hist_cur_ = std::move(hist_new);
+      h_prev_ = h;
+      rate_prev_ = rate;
+    }
     t += h;
   }
 }
@@ -254,6 +310,10 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     state_ = resume->state;
     newton_.set_path({resume->path_p, resume->path_u});
     stats_ = resume->stats;
+    hist_prev_ = resume->hist_prev;
+    hist_cur_ = resume->hist_cur;
+    h_prev_ = resume->h_prev_s;
+    rate_prev_ = resume->rate_prev_Pa_s;
     wall_before = stats_.wall_s;
   }
   for (std::size_t i = first; i < segs.size(); ++i) {
@@ -290,6 +350,10 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.path_p = path.p;
       c.path_u = path.u;
       c.stats = stats_;
+      c.hist_prev = hist_prev_;
+      c.hist_cur = hist_cur_;
+      c.h_prev_s = h_prev_;
+      c.rate_prev_Pa_s = rate_prev_;
       sink(c);
     }
   }

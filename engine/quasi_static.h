@@ -10,6 +10,16 @@
 // 0.9 time_tol / change, within [0.5, 2] of the last. Tightening time_tol converges the angle
 // history (tested).
 //
+// time_control = Error bounds an estimate of each step's local error instead of its size. The
+// history update is first order in the step (backward Euler / exponential Prony update), so its
+// local error is ~ x'' h^2 / 2; comparing the step's change with the previous step's change
+// extrapolated at constant rate, e = |dx_n - r dx_(n-1)| r / (1 + r) with r = h_n / h_(n-1)
+// (Milne's device), estimates it per point; the step is accepted when max e <= time_tol (retried
+// shorter above 2 time_tol) and the next one scaled by 0.9 sqrt(time_tol / e) within [0.5, 2].
+// A relaxing or steadily damaging hold then takes steps of seconds where the change limit took
+// tenths. Where the load rate jumps (the first step after a kink) there is no valid previous
+// rate: that step falls back to the change limit.
+//
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
 // resuming from a checkpoint continues bit-for-bit as the uninterrupted run would.
@@ -27,12 +37,14 @@
 namespace pneufem {
 
 enum class EquilibriumMethod { Newton, Relaxation };
+enum class TimeControl { Change, Error };
 
 struct QuasiStaticOptions {
   EquilibriumMethod method = EquilibriumMethod::Newton;
   StaticOptions newton;
   RelaxationOptions relaxation;
-  double time_tol = 0.01;   ///< max change of damage / viscous strain per physical step
+  double time_tol = 0.01;   ///< max change (Change) or local-error estimate (Error) of damage / viscous strain per physical step
+  TimeControl time_control = TimeControl::Change;
   double min_dt_s = 1e-3;   ///< smallest physical step
   double max_dt_s = 4.0;    ///< largest physical step (rate-dependent materials only)
   /// Physical steps (accepted + rejected) allowed in one load segment (a ramp, a hold, a rest)
@@ -69,6 +81,10 @@ struct QuasiStaticCheckpoint {
   std::vector<double> path_p;
   std::vector<Eigen::VectorXd> path_u;
   QuasiStaticStats stats;
+  /// Error control's memory of the last accepted step (empty when it has none): per point
+  /// (damage, viscous strain) at that step's start and end, its length and load rate.
+  std::vector<double> hist_prev, hist_cur;
+  double h_prev_s = 0.0, rate_prev_Pa_s = 0.0;
 
   void write(std::ostream& os) const;
   /// Throws InputError when the stream is not a checkpoint of a model with `dofs` and `state_size`.
@@ -113,6 +129,9 @@ class QuasiStaticRun {
   double last_angle_ = 0.0;
   double dt_suggest_ = 0.0;
   bool rate_dependent_ = false;
+  // Error control (see TimeControl::Error): the last accepted step, as in the checkpoint.
+  std::vector<double> hist_prev_, hist_cur_;
+  double h_prev_ = 0.0, rate_prev_ = 0.0;
 };
 
 }  // namespace pneufem

@@ -562,6 +562,13 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
   sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
   sv.quasi_static.time_tol = positive(s, "solver.time_tol");
+  const std::string time_control = s.string("solver.time_control");
+  if (time_control == "change")
+    sv.quasi_static.time_control = TimeControl::Change;
+  else if (time_control == "error")
+    sv.quasi_static.time_control = TimeControl::Error;
+  else
+    s.fail("solver.time_control", "must be \"change\" or \"error\", got \"" + time_control + "\"");
   sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
   sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
   if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
