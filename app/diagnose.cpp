@@ -727,8 +727,13 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     // Longest first: a candidate whose runs are static FEM sweeps (gravity) costs ~10x the others,
     // so it starts at once and the cheap ones fill the other cores (the order changes no result).
     std::vector<char> costly(cands.size(), 0);
-    for (std::size_t i : todo)
-      costly[i] = cands[i]->params.empty() ? 0 : rom.uses_fem_sweeps(cur_scene.with(cands[i]->sets(cur_scene, initial_values(*cands[i]))));
+    for (std::size_t i : todo) {
+      try {
+        costly[i] = rom.uses_fem_sweeps(cur_scene.with(cands[i]->sets(cur_scene, initial_values(*cands[i]))));
+      } catch (const std::exception&) {
+        // only an ordering hint: a candidate whose scene does not build fails in its calibration below
+      }
+    }
     std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return costly[a] > costly[b]; });
     const auto t_round = std::chrono::steady_clock::now();
     tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t j) {
