@@ -726,6 +726,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     const Scene cur_scene = cal_scene.with(selected_sets);
     // Longest first: a candidate whose runs are static FEM sweeps (gravity) costs ~10x the others,
     // so it starts at once and the cheap ones fill the other cores (the order changes no result).
+    // The same flag picks the candidates calibrated on interpolated node runs below.
     std::vector<char> costly(cands.size(), 0);
     for (std::size_t i : todo) {
       try {
@@ -749,8 +750,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       const auto tc = std::chrono::steady_clock::now();  // calibration wall time, node sweeps included
       std::vector<std::vector<double>> node_frames;
       std::vector<double> node_x;  // calibration coordinate of each usable node (smooth)
-      if (c.interpolation != ParameterInterpolation::none && c.params.size() == 1 &&
-          rom.uses_fem_sweeps(cur_scene.with(c.sets(cur_scene, {c.params[0].initial})))) {
+      if (c.interpolation != ParameterInterpolation::none && c.params.size() == 1 && costly[todo[j]]) {
         const std::vector<double> at = interpolation_nodes(c.interpolation, c.params[0]);
         std::vector<std::vector<double>> nf(at.size());
         tbb::parallel_for(std::size_t{0}, at.size(), [&](std::size_t node) {

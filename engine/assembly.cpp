@@ -465,28 +465,6 @@ void Assembler::add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eige
   }
 }
 
-double Assembler::max_history_change(std::span<const double> a, std::span<const double> b, int* worst_element) const {
-  double worst = 0.0;
-  if (worst_element) *worst_element = -1;
-  const int ne = model_.mesh.num_elements();
-  for (int e = 0; e < ne; ++e) {
-    const Material& mat = model_.material_of(e);
-    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
-    if (ss == 0) continue;
-    for (int q = 0; q < geom_.nqp; ++q) {
-      const std::size_t o = state_offset_[e] + q * ss;
-      const PointFields fa = mat.fields(a.subspan(o, ss)), fb = mat.fields(b.subspan(o, ss));
-      // Mullins softening follows the load, not time: only the time-driven histories count.
-      const double c = std::abs(fb.fatigue_damage - fa.fatigue_damage) + std::abs(fb.viscous_strain - fa.viscous_strain);
-      if (c > worst) {
-        worst = c;
-        if (worst_element) *worst_element = e;
-      }
-    }
-  }
-  return worst;
-}
-
 std::vector<double> Assembler::history_scalars(std::span<const double> state) const {
   const int ne = model_.mesh.num_elements();
   std::vector<double> out(static_cast<std::size_t>(ne) * geom_.nqp * 2, 0.0);

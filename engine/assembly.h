@@ -71,15 +71,10 @@ class Assembler {
   /// stable-step estimates (Gershgorin) and for the fictitious masses of dynamic relaxation.
   Eigen::VectorXd row_abs_sums(const SparseMatrix& K) const;
 
-  /// Largest change between two material histories of any point's damage plus viscous strain
-  /// (Material::fields); the physical-time step control of rate-dependent runs.
-  /// `worst_element` (optional) receives the element of that point (-1 when nothing changed).
-  double max_history_change(std::span<const double> before, std::span<const double> after,
-                            int* worst_element = nullptr) const;
-
   /// Per material point (element-major, geom nqp points each, every element): its fatigue damage
   /// and viscous strain (Material::fields), 2 values per point; zeros where a law has no history.
-  /// The error-controlled physical time step compares three of these (engine/quasi_static.h).
+  /// The physical time step control compares these between states (engine/quasi_static.h); the
+  /// Mullins variable is left out: it follows the load, not time.
   std::vector<double> history_scalars(std::span<const double> state) const;
   /// Element of point i of history_scalars.
   int element_of_point(int i) const { return i / geom_.nqp; }

@@ -41,6 +41,30 @@ std::vector<double> get_vec(std::istream& is) {
   if (!is) throw InputError("checkpoint: file is truncated");
   return v;
 }
+
+// One physical step's history measures over points (history_scalars layout: 2 values per point):
+// the largest change |d' - d| + |e' - e| (cur -> next), and, with the previous step (prev non-empty,
+// r = h / h_prev), the largest local-error estimate: the change minus the previous change
+// extrapolated at constant rate, times r / (1 + r) (Milne's device for a first-order update).
+struct HistoryStep {
+  double change = 0.0, error = 0.0;
+  int change_point = -1, error_point = -1;  ///< where they are largest (-1: nothing changed)
+};
+HistoryStep history_step(const std::vector<double>& prev, const std::vector<double>& cur, const std::vector<double>& next,
+                         double r) {
+  HistoryStep out;
+  for (std::size_t i = 0; i < next.size(); i += 2) {
+    const int point = static_cast<int>(i / 2);
+    const double c = std::abs(next[i] - cur[i]) + std::abs(next[i + 1] - cur[i + 1]);
+    if (c > out.change) out.change = c, out.change_point = point;
+    if (prev.empty()) continue;
+    double e = 0.0;
+    for (std::size_t k = i; k < i + 2; ++k) e += std::abs((next[k] - cur[k]) - r * (cur[k] - prev[k]));
+    e *= r / (1.0 + r);
+    if (e > out.error) out.error = e, out.error_point = point;
+  }
+  return out;
+}
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
@@ -162,7 +186,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   const double span = s.g1 - s.g0;
   if (!rate_dependent_ || span <= 0.0) {
     if (span > 0.0 || s.p0 != s.p1) equilibrium(s.p0, s.p1, s.g0, s.g1);
-    hist_prev_.clear();  // a jump: the error control's last step is no longer the last state
+    hist_prev_.clear();  // a jump or an elastic state: the history memory is stale
     hist_cur_.clear();
     return;
   }
@@ -170,11 +194,8 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
   const bool error_control = opt_.time_control == TimeControl::Error;
   const double rate = (s.p1 - s.p0) / span;
-  // A kink of the load (its rate changes) starts afresh: the last step's rate says nothing here.
-  if (error_control && !hist_cur_.empty() && std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_))) {
-    hist_prev_.clear();
-    hist_cur_.clear();
-  }
+  // A kink of the load (its rate changes): the last step's rate says nothing about this one.
+  if (std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_))) hist_prev_.clear();
   double t = s.g0;
   long steps = 0;
   double last_change = 0.0, last_h = 0.0;
@@ -215,37 +236,16 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       ++stats_.rejected_steps;
       continue;
     }
-    double change = 0.0;
-    std::vector<double> hist_new;
-    // Error control with a previous step of the same load rate: the local-error estimate;
-    // otherwise the change limit. `measure` is what is compared with time_tol, `order` how it
-    // scales with the step (error ~ h^2, change ~ h).
-    double measure = 0.0, order = 1.0;
-    if (error_control) {
-      hist_new = asm_.history_scalars(state_);
-      if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
-      int worst_change = -1, worst_err = -1;
-      double err = 0.0;
-      const bool have_prev = !hist_prev_.empty() && h_prev_ > 0.0;
-      const double r = have_prev ? h / h_prev_ : 0.0;
-      for (std::size_t i = 0; i < hist_new.size(); i += 2) {
-        const double c = std::abs(hist_new[i] - hist_cur_[i]) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
-        if (c > change) change = c, worst_change = static_cast<int>(i / 2);
-        if (!have_prev) continue;
-        double e = 0.0;
-        for (int k = 0; k < 2; ++k)
-          e += std::abs((hist_new[i + k] - hist_cur_[i + k]) - r * (hist_cur_[i + k] - hist_prev_[i + k]));
-        e *= r / (1.0 + r);
-        if (e > err) err = e, worst_err = static_cast<int>(i / 2);
-      }
-      const int worst_point = have_prev ? worst_err : worst_change;
-      last_element = worst_point >= 0 ? asm_.element_of_point(worst_point) : -1;
-      measure = have_prev ? err : change;
-      order = have_prev ? 2.0 : 1.0;
-    } else {
-      change = asm_.max_history_change(state_saved, state_, &last_element);
-      measure = change;
-    }
+    // Error control with a previous step at the same load rate bounds the local-error estimate;
+    // otherwise time_tol bounds the change. `order`: how the measure scales with h.
+    std::vector<double> hist_new = asm_.history_scalars(state_);
+    if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
+    const bool estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
+    static const std::vector<double> kNoPrevious;
+    const HistoryStep hs = history_step(estimate ? hist_prev_ : kNoPrevious, hist_cur_, hist_new, estimate ? h / h_prev_ : 0.0);
+    const double change = hs.change, measure = estimate ? hs.error : hs.change, order = estimate ? 2.0 : 1.0;
+    const int worst_point = estimate ? hs.error_point : hs.change_point;
+    last_element = worst_point >= 0 ? asm_.element_of_point(worst_point) : -1;
     last_change = change;
     last_h = h;
     const bool reject = measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
@@ -265,10 +265,10 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
     if (error_control) {
       hist_prev_ = std::move(hist_cur_);
-      hist_cur_ = std::move(hist_new);
       h_prev_ = h;
-      rate_prev_ = rate;
     }
+    hist_cur_ = std::move(hist_new);
+    rate_prev_ = rate;
     t += h;
   }
 }

@@ -81,8 +81,8 @@ struct QuasiStaticCheckpoint {
   std::vector<double> path_p;
   std::vector<Eigen::VectorXd> path_u;
   QuasiStaticStats stats;
-  /// Error control's memory of the last accepted step (empty when it has none): per point
-  /// (damage, viscous strain) at that step's start and end, its length and load rate.
+  /// The step control's memory of the last accepted step (empty when it has none): per point
+  /// (damage, viscous strain) at its start (error control only) and end, its length and load rate.
   std::vector<double> hist_prev, hist_cur;
   double h_prev_s = 0.0, rate_prev_Pa_s = 0.0;
 
@@ -129,7 +129,7 @@ class QuasiStaticRun {
   double last_angle_ = 0.0;
   double dt_suggest_ = 0.0;
   bool rate_dependent_ = false;
-  // Error control (see TimeControl::Error): the last accepted step, as in the checkpoint.
+  // The last accepted step, as in the checkpoint (hist_cur_: the current history's scalars).
   std::vector<double> hist_prev_, hist_cur_;
   double h_prev_ = 0.0, rate_prev_ = 0.0;
 };

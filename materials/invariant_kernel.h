@@ -72,12 +72,7 @@ void invariant_stress_batch(const Law& law, StressBatch& b) {
       const Invariants v = isochoric_invariants(Fl);
       PointResponse r;
       invariant_response(Fl, v, law.derivatives(v), false, r);
-      b.psi_iso[l] = r.psi_iso;
-      b.psi_vol[l] = r.psi_vol;
-      for (int k = 0; k < 9; ++k) {
-        b.P_iso[k][l] = r.P_iso(k);
-        b.P_vol[k][l] = r.P_vol(k);
-      }
+      b.set_response(l, r);
     }
     return;
   }

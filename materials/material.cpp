@@ -11,14 +11,7 @@ void Material::stress(StressBatch& b, const TimeStep& step, std::span<const doub
   for (int l = 0; l < b.n; ++l) F[l] = b.F_of(l);
   evaluate(std::span<const Mat3>(F.data(), b.n), step, state_old, state_new, std::span<PointResponse>(r.data(), b.n),
            false);
-  for (int l = 0; l < b.n; ++l) {
-    b.psi_iso[l] = r[l].psi_iso;
-    b.psi_vol[l] = r[l].psi_vol;
-    for (int k = 0; k < 9; ++k) {
-      b.P_iso[k][l] = r[l].P_iso(k);
-      b.P_vol[k][l] = r[l].P_vol(k);
-    }
-  }
+  for (int l = 0; l < b.n; ++l) b.set_response(l, r[l]);
 }
 
 }  // namespace pneufem

@@ -59,6 +59,15 @@ struct StressBatch {
     for (int k = 0; k < 9; ++k) Fl(k) = F[k][l];
     return Fl;
   }
+  /// Stores a point's force-only response (psi and P halves) in lane l.
+  void set_response(int l, const PointResponse& r) {
+    psi_iso[l] = r.psi_iso;
+    psi_vol[l] = r.psi_vol;
+    for (int k = 0; k < 9; ++k) {
+      P_iso[k][l] = r.P_iso(k);
+      P_vol[k][l] = r.P_vol(k);
+    }
+  }
   /// Copies point 0's F into the unused lanes, so that a law may compute every lane.
   void pad() {
     for (int k = 0; k < 9; ++k)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <map>
 #include <set>
@@ -33,6 +34,21 @@ void require_keys(const Scene& scene, const std::string& table, const std::set<s
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
       scene.fail(table + "." + k, "unknown key for " + what + "; allowed: " + list);
     }
+}
+
+/// The value of a string key that must be one of `options` (its name -> value), or a failure
+/// naming the key and every allowed name.
+template <class T>
+T choice(const Scene& scene, const std::string& key, std::initializer_list<std::pair<const char*, T>> options) {
+  const std::string v = scene.string(key);
+  std::string allowed;
+  std::size_t i = 0;
+  for (const auto& [name, value] : options) {
+    if (v == name) return value;
+    allowed += std::string(i == 0 ? "" : i + 1 == options.size() ? " or " : ", ") + "\"" + name + "\"";
+    ++i;
+  }
+  scene.fail(key, "must be " + allowed + ", got \"" + v + "\"");
 }
 
 double positive(const Scene& scene, const std::string& key) {
@@ -526,49 +542,27 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
 
   // Solver.
   SolverSettings& sv = out->solver;
-  const std::string mode = s.string("solver.mode");
-  if (mode == "quasi_static")
-    sv.mode = SolverSettings::Mode::QuasiStatic;
-  else if (mode == "explicit")
-    sv.mode = SolverSettings::Mode::Explicit;
-  else
-    s.fail("solver.mode", "must be \"quasi_static\" or \"explicit\", got \"" + mode + "\"");
-  const std::string method = s.string("solver.method");
-  if (method == "newton")
-    sv.quasi_static.method = EquilibriumMethod::Newton;
-  else if (method == "relaxation")
-    sv.quasi_static.method = EquilibriumMethod::Relaxation;
-  else
-    s.fail("solver.method", "must be \"newton\" or \"relaxation\", got \"" + method + "\"");
+  sv.mode = choice<SolverSettings::Mode>(s, "solver.mode", {{"quasi_static", SolverSettings::Mode::QuasiStatic},
+                                                           {"explicit", SolverSettings::Mode::Explicit}});
+  sv.quasi_static.method = choice<EquilibriumMethod>(s, "solver.method", {{"newton", EquilibriumMethod::Newton},
+                                                                          {"relaxation", EquilibriumMethod::Relaxation}});
   sv.quasi_static.newton.rel_tol = positive(s, "solver.rel_tol");
   sv.quasi_static.relaxation.rel_tol = sv.quasi_static.newton.rel_tol;
   sv.quasi_static.newton.max_iterations = s.integer("solver.max_iterations");
   if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
   sv.quasi_static.newton.stiff_relaxation_steps = s.integer("solver.stiff_relaxation_steps");
   if (sv.quasi_static.newton.stiff_relaxation_steps < 0) s.fail("solver.stiff_relaxation_steps", "must be >= 0 (0 = off)");
-  const std::string indefinite = s.string("solver.indefinite_tangent");
-  if (indefinite == "last_factor")
-    sv.quasi_static.newton.indefinite = StaticOptions::Indefinite::LastFactor;
-  else if (indefinite == "shift")
-    sv.quasi_static.newton.indefinite = StaticOptions::Indefinite::Shift;
-  else
-    s.fail("solver.indefinite_tangent", "must be \"last_factor\" or \"shift\", got \"" + indefinite + "\"");
-  const std::string line_search = s.string("solver.line_search");
-  if (line_search != "energy" && line_search != "slope")
-    s.fail("solver.line_search", "must be \"energy\" or \"slope\", got \"" + line_search + "\"");
-  sv.quasi_static.newton.energy_line_search = line_search == "energy";
+  sv.quasi_static.newton.indefinite = choice<StaticOptions::Indefinite>(
+      s, "solver.indefinite_tangent",
+      {{"last_factor", StaticOptions::Indefinite::LastFactor}, {"shift", StaticOptions::Indefinite::Shift}});
+  sv.quasi_static.newton.energy_line_search = choice<bool>(s, "solver.line_search", {{"energy", true}, {"slope", false}});
   sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
   sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
   sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
   sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
   sv.quasi_static.time_tol = positive(s, "solver.time_tol");
-  const std::string time_control = s.string("solver.time_control");
-  if (time_control == "change")
-    sv.quasi_static.time_control = TimeControl::Change;
-  else if (time_control == "error")
-    sv.quasi_static.time_control = TimeControl::Error;
-  else
-    s.fail("solver.time_control", "must be \"change\" or \"error\", got \"" + time_control + "\"");
+  sv.quasi_static.time_control =
+      choice<TimeControl>(s, "solver.time_control", {{"change", TimeControl::Change}, {"error", TimeControl::Error}});
   sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
   sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
   if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
