@@ -4,11 +4,15 @@
 //   * tangent assembly and one Newton iteration (assembly + CHOLMOD factorisation + solve);
 //   * one staircase trial (10 levels, 0-45 kPa) of the default scene, quasi-static Newton.
 // Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
-//                     [--checksum]
+//                     [--checksum] [--scene-force FILE]
 // --checksum prints a hash of the bits of f_int, of K's values and of the energy (1 and N threads),
 // so two builds of the kernel can be compared bit for bit (A/B of an optimisation).
+// --scene-force FILE times the force-only kernel of a scene with history (e.g. the story's
+// viscoelastic(fatigue(mullins(yeoh))), scenes/examples/paper_story.toml) at h = --h-mm, from the
+// virgin state and from a loaded one, and hashes f_int and the trial state of both (A/B as above).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -88,6 +92,49 @@ void kernel_rates(const std::string& element, double h_mm, int threads, int reps
   }
 }
 
+/// Force only, with the material history of `file`'s scene. Virgin: from the initial state at the
+/// generic small u1. Loaded: from the trial state of a large smooth deformation u_big (principal
+/// stretches 0.1-1.9, period L/3 along each axis) at u2 = 0.7 u_big + u1, where points unload (Mullins
+/// softening), some stay above a fatigue stretch threshold of 1.6 (damage grows) and every point has
+/// an overstress (viscoelastic): the branches of a loaded state, not just the virgin ones.
+void scene_force(const std::string& file, double h_mm, int threads, int reps) {
+  const Scene scene = Scene::load(file, {"mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  const Mesh& mesh = bm->model.mesh;
+  const int n = bm->model.num_dofs();
+  Eigen::Vector3d lo = mesh.X[0], hi = mesh.X[0];
+  for (const auto& x : mesh.X) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  Eigen::VectorXd u1(n), u_big = Eigen::VectorXd::Zero(n), u2(n), f;
+  for (int i = 0; i < n; ++i) u1[i] = 2e-5 * std::sin(0.37 * i);
+  for (int a = 0; a < mesh.num_nodes(); ++a)
+    for (int d = 0; d < 3; ++d) {  // d u_d / d X_d = 0.9 cos(...)
+      const double L = hi[d] - lo[d], k = 2.0 * 3.14159265358979 * 3.0 / L;
+      u_big[3 * a + d] = 0.9 / k * std::sin(k * (mesh.X[a][d] - lo[d]));
+    }
+  u2 = 0.7 * u_big + u1;
+  const std::vector<double> s0 = A.initial_state();
+  std::vector<double> s_big(s0.size()), s1(s0.size()), s2(s0.size());
+  A.internal(u_big, TimeStep{1.0, 1.0}, s0, s_big, &f, nullptr, nullptr);
+  std::printf("  %s, h=%.2f mm, %d elements, %zu state doubles\n", file.c_str(), h_mm, mesh.num_elements(), s0.size());
+  for (int t : {1, threads}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, t);
+    for (const bool loaded : {false, true}) {
+      const Eigen::VectorXd& u = loaded ? u2 : u1;
+      const std::vector<double>& s_old = loaded ? s_big : s0;
+      std::vector<double>& s_new = loaded ? s2 : s1;
+      const TimeStep ts = loaded ? TimeStep{1.1, 0.1} : TimeStep{1.0, 0.1};
+      const double tf = median_seconds(reps, [&] { A.internal(u, ts, s_old, s_new, &f, nullptr, nullptr); });
+      std::printf("    threads=%d  %-7s force: %7.2f ms  f_int %016llx  trial state %016llx\n", t,
+                  loaded ? "loaded" : "virgin", tf * 1e3, static_cast<unsigned long long>(hash_bits(f.data(), f.size())),
+                  static_cast<unsigned long long>(hash_bits(s_new.data(), s_new.size())));
+    }
+  }
+}
+
 void newton_iteration(double h_mm, int threads) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
   const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
@@ -140,6 +187,7 @@ int main(int argc, char** argv) {
   bool skip_trial = false, kernel_only = false, checksum = false;
   int reps = 7;
   std::string only_element;  // "" = both
+  std::string scene_file;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
@@ -148,6 +196,12 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--element") && i + 1 < argc) only_element = argv[++i];
     else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--checksum")) checksum = true;
+    else if (!std::strcmp(argv[i], "--scene-force") && i + 1 < argc) scene_file = argv[++i];
+  }
+  if (!scene_file.empty()) {
+    std::printf("force kernel with history (threads available: %d):\n", tbb::info::default_concurrency());
+    scene_force(scene_file, h, threads, reps);
+    return 0;
   }
   if (checksum) {
     std::printf("kernel checksums (h=%.2f mm):\n", h);
