@@ -14,9 +14,15 @@
 //  * an EMPTY state_old means "the virgin state" (own history at its initial values; the base gets
 //    an empty span too), so a decorated law can be evaluated like an elastic one;
 //  * an empty state_new means "do not write the trial state" (the engine's energy-only passes).
-// Each layer evaluates its base one point at a time (one virtual call per point and layer, since the
-// base's slices are strided by the full block): the price of composability; the math itself is
-// fixed-size and allocation-free, and nothing is mutable, so evaluations are safe under TBB.
+// evaluate() calls the base one point at a time (one virtual call per point and layer, since the
+// base's slices are strided by the full block): the price of composability, paid where the tangent
+// dominates anyway. The force-only stress() calls the base's stress() once for the whole batch
+// (stress_base: the base's slices gathered into consecutive blocks on the stack), so nested layers and
+// the structure-of-arrays kernels of the base laws are used, and then applies its own modification:
+// Mullins and fatigue lane by lane through helpers shared with evaluate(), viscoelasticity in
+// structure-of-arrays form with the operation order of evaluate()'s Eigen expressions; the bits are
+// evaluate()'s either way (tests/damage, DecoratorBatch). The math is fixed-size and allocation-free,
+// and nothing is mutable, so evaluations are safe under TBB.
 #include <cassert>
 #include <cmath>
 #include <cstddef>
@@ -62,6 +68,16 @@ inline void evaluate_base(const Material& base, const Mat3& F, const TimeStep& s
   base.evaluate(std::span<const Mat3>(&F, 1), step, ps.base_old, ps.base_new, std::span<PointResponse>(&out, 1),
                 tangent);
 }
+
+/// Force-only evaluation of the base on the whole batch (Material::stress) for a decorator with `own`
+/// doubles per point: gathers the base's slices of the b.n state blocks [own | base] into consecutive
+/// blocks (empty spans stay empty: virgin / no trial state), calls base.stress() and scatters the
+/// base's trial slices back into state_new. Returns false, without calling the base, when the base's
+/// state is larger than the stack buffers (kMaxBaseState doubles per point; deeper nestings than any
+/// scene builds): the caller then takes the point-by-point path, Material::stress. Defined in decorator.cpp.
+inline constexpr std::size_t kMaxBaseState = 32;
+bool stress_base(const Material& base, StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                 std::span<double> state_new, std::size_t own);
 
 /// Throws InputError unless `base` is a non-null split (isochoric/volumetric) law.
 inline void require_split_base(const MaterialPtr& base, const std::string& effect) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "damage/decorator.h"
 
@@ -40,6 +41,23 @@ void Mullins::init_state(std::span<double> state) const {
   base_->init_state(state.subspan(kOwnState));
 }
 
+namespace {
+/// One point's Ogden-Roxburgh update from the base's isochoric energy W_dev, shared by evaluate() and
+/// stress(): writes the trial state [W_max, eta] and returns the softening, or nothing on the primary
+/// curve and in the virgin state, where the base response is kept as is.
+std::optional<MullinsEta> soften(double W_dev, const detail::PointState& ps, const MullinsParams& p) {
+  const double W_max_old = ps.own_old.empty() ? 0.0 : ps.own_old[0];
+  const double W_max = std::max(W_max_old, W_dev);
+  const MullinsEta e = ogden_roxburgh(W_dev, W_max_old, p);
+  if (!ps.own_new.empty()) {
+    ps.own_new[0] = W_max;
+    ps.own_new[1] = e.eta;
+  }
+  if (W_dev >= W_max_old || W_max_old <= 0.0) return std::nullopt;
+  return e;
+}
+}  // namespace
+
 void Mullins::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                        std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
@@ -48,20 +66,29 @@ void Mullins::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<
     PointResponse& r = out[q];
     detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
     const double W_dev = r.psi_iso;
-    const double W_max_old = ps.own_old.empty() ? 0.0 : ps.own_old[0];
-    const double W_max = std::max(W_max_old, W_dev);
-    const MullinsEta e = ogden_roxburgh(W_dev, W_max_old, p_);
-    if (!ps.own_new.empty()) {
-      ps.own_new[0] = W_max;
-      ps.own_new[1] = e.eta;
-    }
-    if (W_dev >= W_max_old || W_max_old <= 0.0) continue;  // primary curve or virgin: the base response as is
+    const std::optional<MullinsEta> e = soften(W_dev, ps, p_);
+    if (!e) continue;
     if (tangent) {
       const Vec9 p0 = flatten(r.P_iso);
-      r.A_iso = e.eta * r.A_iso + e.deta_dW * p0 * p0.transpose();
+      r.A_iso = e->eta * r.A_iso + e->deta_dW * p0 * p0.transpose();
     }
-    r.P_iso *= e.eta;
-    r.psi_iso = e.eta * W_dev + e.phi;
+    r.P_iso *= e->eta;
+    r.psi_iso = e->eta * W_dev + e->phi;
+  }
+}
+
+void Mullins::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                     std::span<double> state_new) const {
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+    return Material::stress(b, step, state_old, state_new);
+  for (int l = 0; l < b.n; ++l) {
+    const detail::PointState ps = detail::point_state(state_old, state_new, static_cast<std::size_t>(l), own, nb);
+    const double W_dev = b.psi_iso[l];
+    const std::optional<MullinsEta> e = soften(W_dev, ps, p_);
+    if (!e) continue;
+    for (int k = 0; k < 9; ++k) b.P_iso[k][l] *= e->eta;
+    b.psi_iso[l] = e->eta * W_dev + e->phi;
   }
 }
 

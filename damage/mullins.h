@@ -63,6 +63,9 @@ class Mullins final : public Material {
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
+  /// Force only: the base's batched stress, then the softening lane by lane (evaluate's bits).
+  void stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+              std::span<double> state_new) const override;
   /// W_max from this law; damage = 1 - eta_last (x) the base's stiffness fraction; the rest from the base.
   PointFields fields(std::span<const double> state) const override;
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
