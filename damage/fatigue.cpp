@@ -15,26 +15,17 @@ namespace {
 // an absurd overload (it is never reached with finite drivers in practice).
 constexpr double kMinIntegrity = std::numeric_limits<double>::min();
 
-/// Backward-Euler integrity update: the root s in (0, s_old] of s + a s^n = s_old, and ds/da.
-struct IntegrityUpdate {
-  double s = 1.0;
-  double ds_da = 0.0;
-};
-IntegrityUpdate integrity_update(double s_old, double a, double n) {
-  IntegrityUpdate u;
-  if (a == 0.0) {
-    u.s = s_old;
-    u.ds_da = -std::pow(s_old, n);
-    return u;
-  }
+/// Backward-Euler integrity update: the root s in (0, s_old] of s + a s^n = s_old (s_old for a = 0).
+double integrity_root(double s_old, double a, double n) {
+  if (a == 0.0) return s_old;
+  double s = s_old;
   if (n == 1.0) {
-    u.s = s_old / (1.0 + a);
+    s = s_old / (1.0 + a);
   } else {
     // f(s) = s + a s^n - s_old is increasing and convex on s > 0 with f(s_old) >= 0: Newton from
     // s_old decreases monotonically to the root (never overshoots below it, so s stays > 0).
     // Stop once a step no longer changes s beyond rounding; 60 iterations cover any a that leaves s
     // above kMinIntegrity (quadratic once near the root).
-    double s = s_old;
     for (int it = 0; it < 60; ++it) {
       const double sn1 = std::pow(s, n - 1.0);
       const double f = s + a * sn1 * s - s_old;
@@ -50,13 +41,84 @@ IntegrityUpdate integrity_update(double s_old, double a, double n) {
       }
       s = next;
     }
-    u.s = s;
   }
-  u.s = std::max(u.s, kMinIntegrity);
-  // Implicit differentiation of s + a s^n = s_old: ds/da = -s^n / (1 + n a s^(n-1)).
-  const double sn1 = n == 1.0 ? 1.0 : std::pow(u.s, n - 1.0);
-  u.ds_da = -sn1 * u.s / (1.0 + n * a * sn1);
+  return std::max(s, kMinIntegrity);
+}
+
+/// ds/da at the root s = integrity_root(s_old, a, n), by implicit differentiation of s + a s^n = s_old:
+/// -s^n / (1 + n a s^(n-1)). Only the consistent tangent needs it.
+double integrity_rate(double s, double s_old, double a, double n) {
+  if (a == 0.0) return -std::pow(s_old, n);
+  const double sn1 = n == 1.0 ? 1.0 : std::pow(s, n - 1.0);
+  return -sn1 * s / (1.0 + n * a * sn1);
+}
+
+/// The trial integrity of one point: backward Euler over the increment (a = dt g / tau), then the
+/// failure floor. evaluate() and stress() share it.
+struct IntegrityUpdate {
+  double s = 1.0;
+  double a = 0.0;
+  bool at_floor = false;  ///< held at the floor: ds/da = 0
+};
+IntegrityUpdate update_integrity(double s_old, double g, double dt_over_tau, const FatigueParams& p) {
+  IntegrityUpdate u;
+  u.a = dt_over_tau * g;
+  u.s = integrity_root(s_old, u.a, p.n);
+  // A failed point (d = d_fail) keeps its residual stiffness 1 - d_fail: the damage stops there
+  // (fatigue.h, "Failure"). min(): a state that was already below (an older checkpoint) stays.
+  const double s_floor = std::min(s_old, 1.0 - p.d_fail);
+  if (u.s < s_floor) {
+    u.s = s_floor;
+    u.at_floor = true;
+  }
   return u;
+}
+
+/// g = <X / X_th - 1>^q.
+double growth_factor(double X, const FatigueParams& p) {
+  const double X_th = p.driver == FatigueDriver::energy ? p.W_th_Pa : p.lambda_th;
+  const double x = X / X_th - 1.0;
+  return x > 0.0 ? std::pow(x, p.q) : 0.0;  // at or below the threshold: no damage growth
+}
+
+/// True when a cheap bound puts the largest principal stretch of F surely below lambda_th: then g = 0
+/// whatever its exact value, and the eigenvalue problem (most of the cost of the stretch driver) is
+/// skipped. With C = F^T F = (tr C / 3) I + dev C, lambda_max(C) <= tr C / 3 + sqrt(2/3) |dev C| (the
+/// largest eigenvalue of a traceless symmetric tensor is at most sqrt(2/3) of its norm; equality when the
+/// two smaller eigenvalues are equal, as in uniaxial tension). The relative margin 1e-6 exceeds the rounding of the bound and of the eigensolver
+/// (~1e-14 of |C|) by orders of magnitude, so a point passed here would have x < 0 in growth_factor too.
+/// A NaN fails the test and takes the exact path. F(k) is entry k = i + 3J of F, so that the same code
+/// serves a Mat3 and a lane of a StressBatch (where the lane loop vectorises).
+template <class Entry>
+bool stretch_surely_below(const Entry& F, double lambda_th) {
+  const double c00 = F(0) * F(0) + F(1) * F(1) + F(2) * F(2);
+  const double c11 = F(3) * F(3) + F(4) * F(4) + F(5) * F(5);
+  const double c22 = F(6) * F(6) + F(7) * F(7) + F(8) * F(8);
+  const double c01 = F(0) * F(3) + F(1) * F(4) + F(2) * F(5);
+  const double c02 = F(0) * F(6) + F(1) * F(7) + F(2) * F(8);
+  const double c12 = F(3) * F(6) + F(4) * F(7) + F(5) * F(8);
+  const double m = (c00 + c11 + c22) * (1.0 / 3.0), d0 = c00 - m, d1 = c11 - m, d2 = c22 - m;
+  const double dev2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (c01 * c01 + c02 * c02 + c12 * c12);
+  return m + std::sqrt((2.0 / 3.0) * dev2) <= (1.0 - 1e-6) * lambda_th * lambda_th;
+}
+bool stretch_surely_below(const Mat3& F, double lambda_th) {
+  return stretch_surely_below([&F](int k) { return F(k); }, lambda_th);
+}
+
+/// sqrt(lambda_max(F^T F)) from the eigenvalues alone. Eigen's tridiagonal QR iteration computes them
+/// with the same operations whether or not it also accumulates the eigenvectors (which only the
+/// tangent needs), so this is the tangent path's value bit for bit.
+double max_principal_stretch(const Mat3& F) {
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(F.transpose() * F, Eigen::EigenvaluesOnly);
+  return std::sqrt(eig.eigenvalues()(2));  // eigenvalues ascending
+}
+
+/// g of one point for a force-only evaluation: F and the base's isochoric energy W0 of the point;
+/// `below` = stretch_surely_below(F) when already known.
+double force_only_growth(const Mat3& F, double W0, const FatigueParams& p, bool below) {
+  if (p.driver == FatigueDriver::energy) return growth_factor(W0, p);
+  if (below) return 0.0;
+  return growth_factor(max_principal_stretch(F), p);
 }
 }  // namespace
 
@@ -64,10 +126,9 @@ FatigueRate fatigue_rate(double X, const FatigueParams& p) {
   const double X_th = p.driver == FatigueDriver::energy ? p.W_th_Pa : p.lambda_th;
   FatigueRate r;
   r.X = X;
+  r.g = growth_factor(X, p);
   const double x = X / X_th - 1.0;
-  if (!(x > 0.0)) return r;  // at or below the threshold: no damage growth
-  r.g = std::pow(x, p.q);
-  r.dg_dX = p.q * std::pow(x, p.q - 1.0) / X_th;
+  if (x > 0.0) r.dg_dX = p.q * std::pow(x, p.q - 1.0) / X_th;
   return r;
 }
 
@@ -114,32 +175,56 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
     detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
     const double s_old = ps.own_old.empty() ? 1.0 : ps.own_old[0];
 
-    // Driver X and dX/dF.
-    double X = r.psi_iso;
+    // Driver X, its rate factor g and dX/dF (the tangent's). Below the threshold g = dg/dX = 0, and
+    // dX/dF then drops out of the tangent (ds/dX = 0).
+    FatigueRate rate;
     Mat3 dX_dF = r.P_iso;
-    if (!by_energy) {
+    if (!tangent) {
+      const bool below = !by_energy && stretch_surely_below(F[q], p_.lambda_th);
+      rate.g = force_only_growth(F[q], r.psi_iso, p_, below);
+    } else if (by_energy) {
+      rate = fatigue_rate(r.psi_iso, p_);
+    } else if (!stretch_surely_below(F[q], p_.lambda_th)) {
       const Eigen::SelfAdjointEigenSolver<Mat3> eig(F[q].transpose() * F[q]);
       const Vec3 n = eig.eigenvectors().col(2);  // eigenvalues ascending
-      X = std::sqrt(eig.eigenvalues()(2));
-      dX_dF = F[q] * n * n.transpose() / X;
+      rate = fatigue_rate(std::sqrt(eig.eigenvalues()(2)), p_);
+      dX_dF = F[q] * n * n.transpose() / rate.X;
     }
-    const FatigueRate rate = fatigue_rate(X, p_);
-    const double a = dt_over_tau * rate.g;
-    IntegrityUpdate upd = integrity_update(s_old, a, p_.n);
-    // A failed point (d = d_fail) keeps its residual stiffness 1 - d_fail: the damage stops there
-    // (fatigue.h, "Failure"). min(): a state that was already below (an older checkpoint) stays.
-    const double s_floor = std::min(s_old, 1.0 - p_.d_fail);
-    if (upd.s < s_floor) upd = {s_floor, 0.0};
+    const IntegrityUpdate upd = update_integrity(s_old, rate.g, dt_over_tau, p_);
     const double s_new = upd.s;
     if (!ps.own_new.empty()) ps.own_new[0] = s_new;
     if (tangent) {
       // d s_new / dF = ds/da (dt / tau) g'(X) dX/dF
-      const double ds_dX = upd.ds_da * dt_over_tau * rate.dg_dX;
+      const double ds_da = upd.at_floor ? 0.0 : integrity_rate(s_new, s_old, upd.a, p_.n);
+      const double ds_dX = ds_da * dt_over_tau * rate.dg_dX;
       r.A_iso *= s_new;
       if (ds_dX != 0.0) r.A_iso += ds_dX * flatten(r.P_iso) * flatten(dX_dF).transpose();
     }
     r.P_iso *= s_new;
     r.psi_iso *= s_new;
+  }
+}
+
+void FatigueDamage::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                           std::span<double> state_new) const {
+  assert(step.dt_s >= 0.0);
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+    return Material::stress(b, step, state_old, state_new);
+  const double dt_over_tau = step.dt_s / p_.tau_s;
+  const bool by_energy = p_.driver == FatigueDriver::energy;
+  bool below[StressBatch::kLanes] = {};  // the stretch driver's bound, all lanes at once
+  if (!by_energy)
+    for (int l = 0; l < StressBatch::kLanes; ++l)
+      below[l] = stretch_surely_below([&b, l](int k) { return b.F[k][l]; }, p_.lambda_th);
+  for (int l = 0; l < b.n; ++l) {
+    const detail::PointState ps = detail::point_state(state_old, state_new, static_cast<std::size_t>(l), own, nb);
+    const double s_old = ps.own_old.empty() ? 1.0 : ps.own_old[0];
+    const double g = force_only_growth(b.F_of(l), b.psi_iso[l], p_, below[l]);
+    const double s_new = update_integrity(s_old, g, dt_over_tau, p_).s;
+    if (!ps.own_new.empty()) ps.own_new[0] = s_new;
+    for (int k = 0; k < 9; ++k) b.P_iso[k][l] *= s_new;
+    b.psi_iso[l] *= s_new;
   }
 }
 

@@ -10,7 +10,9 @@
 // with the driver X either the effective (undamaged) isochoric energy W0 = psi_iso of the base
 // (threshold W_th) or the largest principal stretch lambda = sqrt(lambda_max(C)) (threshold
 // lambda_th > 1). Below the threshold d does not change at all; above it, a higher driver breaks
-// faster. q > 1 makes g, and with it the consistent tangent, continuous at the threshold.
+// faster. q > 1 makes g, and with it the consistent tangent, continuous at the threshold. The stretch
+// driver solves the eigenvalue problem of C only where a cheap bound on lambda_max(C) does not already
+// put lambda below lambda_th (g = 0 there either way; fatigue.cpp, stretch_surely_below).
 //
 // The integrity exponent n >= 1 sets how growth slows as damage accumulates. n = 1 is first-order
 // kinetics (a constant overload halves the integrity every tau ln2 / g). n > 1 saturates: the rate
@@ -93,6 +95,9 @@ class FatigueDamage final : public Material {
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
+  /// Force only: the base's batched stress, then the damage lane by lane (evaluate's bits).
+  void stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+              std::span<double> state_new) const override;
   /// damage = 1 - (1 - d)(1 - base damage); failed = d >= d_fail or the base failed; the rest from the base.
   PointFields fields(std::span<const double> state) const override;
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
