@@ -31,6 +31,65 @@ double k_factor(double x) { return x > 0.0 ? -std::expm1(-x) / x : 1.0; }
 
 std::string term(const char* key, std::size_t i) { return std::string(key) + "_" + std::to_string(i + 1); }
 
+// ---- Structure-of-arrays arithmetic of the batched stress (material.h: StressBatch). Tensor component
+// k = i + 3J of lane l is at [k][l]. Each function performs the operations of the Eigen expression it
+// replaces in the order Eigen 3.4 evaluates it at the baseline ISA (SSE2 packets of 2 doubles, as in
+// materials/invariant_kernel.h), so the results are evaluate()'s bit for bit (test
+// DecoratorBattery.StressBatchIsEvaluateBitForBit, which would catch another ISA's order). Only the lanes
+// 0..n-1 in use are computed: the engine's batches with history hold one element (4 of the 8 lanes for
+// a quadratic tet).
+constexpr int N = StressBatch::kLanes;
+// Packed symmetric storage (pack/unpack): component k of the full tensor is packed entry kUnpacked[k].
+constexpr int kUnpacked[9] = {0, 5, 4, 5, 1, 3, 4, 3, 2};
+constexpr int kPacked[6] = {0, 4, 8, 7, 6, 3};  // packed entry v holds component kPacked[v]
+
+/// C = A B as Eigen's 3x3 product: rows 0-1 summed left to right (its packet path), row 2 as
+/// a0 b0 + (a1 b1 + a2 b2) (its scalar reduction).
+void product(const double A[9][N], const double B[9][N], double C[9][N], int n) {
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 2; ++i)
+      for (int l = 0; l < n; ++l)
+        C[i + 3 * j][l] = (A[i][l] * B[3 * j][l] + A[i + 3][l] * B[3 * j + 1][l]) + A[i + 6][l] * B[3 * j + 2][l];
+    for (int l = 0; l < n; ++l)
+      C[2 + 3 * j][l] = A[2][l] * B[3 * j][l] + (A[5][l] * B[3 * j + 1][l] + A[8][l] * B[3 * j + 2][l]);
+  }
+}
+
+/// F^-1 as Eigen's 3x3 inverse: cofactor(i, j) = F(i1, j1) F(i2, j2) - F(i1, j2) F(i2, j1) with
+/// i1 = i+1, i2 = i+2 (mod 3), det = (c00 F00 + c10 F10) + c20 F20, F^-1(r, c) = cofactor(c, r) (1 / det).
+void inverse(const double F[9][N], double Finv[9][N], int n) {
+  const auto cofactor = [&F](int i, int j, int l) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    return F[i1 + 3 * j1][l] * F[i2 + 3 * j2][l] - F[i1 + 3 * j2][l] * F[i2 + 3 * j1][l];
+  };
+  double invdet[N];
+  for (int l = 0; l < n; ++l)
+    invdet[l] = 1.0 / ((cofactor(0, 0, l) * F[0][l] + cofactor(1, 0, l) * F[1][l]) + cofactor(2, 0, l) * F[2][l]);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < n; ++l) Finv[r + 3 * c][l] = cofactor(c, r, l) * invdet[l];
+}
+
+/// |Q|^2 of lane l as Eigen's vectorised reduction of the 9 squares: pairs (2m, 2m+1) summed as
+/// packets ((p0 + p1) + (p2 + p3)), the packet's two halves added, then the odd ninth.
+double squared_norm(const double Q[9][N], int l) {
+  double q[9];
+  for (int k = 0; k < 9; ++k) q[k] = Q[k][l] * Q[k][l];
+  return (((q[0] + q[2]) + (q[4] + q[6])) + ((q[1] + q[3]) + (q[5] + q[7]))) + q[8];
+}
+
+/// Unpacks the symmetric tensor at `offset` of the state blocks of lanes 0..n-1 (zero in the virgin
+/// state, an empty span), and packs it back.
+void unpack_lanes(std::span<const double> state, std::size_t block, std::size_t offset, int n, double S[9][N]) {
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < n; ++l)
+      S[k][l] = !state.empty() ? state[static_cast<std::size_t>(l) * block + offset + kUnpacked[k]] : 0.0;
+}
+void pack_lanes(const double S[9][N], int n, std::size_t block, std::size_t offset, std::span<double> state) {
+  for (int l = 0; l < n; ++l)
+    for (int v = 0; v < 6; ++v) state[static_cast<std::size_t>(l) * block + offset + v] = S[kPacked[v]][l];
+}
+
 }  // namespace
 
 ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<double>& tau_s) {
@@ -76,18 +135,27 @@ void Viscoelastic::init_state(std::span<double> state) const {
   base_->init_state(state.subspan(own));
 }
 
+struct Viscoelastic::Increment {
+  std::array<double, kMaxTerms> decay{}, gk{};  // exp(-x_i), gamma_i k_i
+  double c = 0.0;                               // sum_i gamma_i k_i
+};
+
+Viscoelastic::Increment Viscoelastic::increment(double dt_s) const {
+  Increment inc;
+  for (int i = 0; i < n_; ++i) {
+    const double x = dt_s / tau_[i];
+    inc.decay[i] = std::exp(-x);
+    inc.gk[i] = gamma_[i] * k_factor(x);
+    inc.c += inc.gk[i];
+  }
+  return inc;
+}
+
 void Viscoelastic::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                             std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   assert(step.dt_s >= 0.0);
   const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
-  std::array<double, kMaxTerms> decay{}, gk{};  // exp(-x_i), gamma_i k_i
-  double c = 0.0;
-  for (int i = 0; i < n_; ++i) {
-    const double x = step.dt_s / tau_[i];
-    decay[i] = std::exp(-x);
-    gk[i] = gamma_[i] * k_factor(x);
-    c += gk[i];
-  }
+  const Increment inc = increment(step.dt_s);
   for (std::size_t q = 0; q < F.size(); ++q) {
     const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
     PointResponse& r = out[q];
@@ -101,22 +169,66 @@ void Viscoelastic::evaluate(std::span<const Mat3> F, const TimeStep& step, std::
     double psi_branches = 0.0;
     for (int i = 0; i < n_; ++i) {
       const Mat3 Q_old = virgin ? Mat3::Zero() : unpack(ps.own_old.subspan(6 * (i + 1), 6));
-      const Mat3 Q_new = decay[i] * Q_old + gk[i] * (S0 - S0_old);
-      H += decay[i] * Q_old - gk[i] * S0_old;
+      const Mat3 Q_new = inc.decay[i] * Q_old + inc.gk[i] * (S0 - S0_old);
+      H += inc.decay[i] * Q_old - inc.gk[i] * S0_old;
       if (gamma_[i] > 0.0) psi_branches += Q_new.squaredNorm() / (4.0 * gamma_[i] * mu_inf_);
       if (!ps.own_new.empty()) pack(Q_new, ps.own_new.subspan(6 * (i + 1), 6));
     }
     if (!ps.own_new.empty()) pack(S0, ps.own_new.subspan(0, 6));
 
     if (tangent) {
-      r.A_iso *= 1.0 + c;
+      r.A_iso *= 1.0 + inc.c;
       for (int i = 0; i < 3; ++i)  // + delta_ik H_JL
         for (int J = 0; J < 3; ++J)
           for (int L = 0; L < 3; ++L) r.A_iso(flat(i, J), flat(i, L)) += H(J, L);
     }
-    r.P_iso = (1.0 + c) * r.P_iso + F[q] * H;
+    r.P_iso = (1.0 + inc.c) * r.P_iso + F[q] * H;
     r.psi_iso += psi_branches;
   }
+}
+
+// evaluate()'s force part for the whole batch in structure-of-arrays form (the helpers above): the base's
+// batched stress, then S0 = sym(F^-1 P0_iso), the Prony update of each term and P_iso = (1 + c) P0_iso + F H.
+void Viscoelastic::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+                          std::span<double> state_new) const {
+  assert(step.dt_s >= 0.0);
+  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
+  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+    return Material::stress(b, step, state_old, state_new);
+  const std::size_t block = own + nb;
+  const Increment inc = increment(step.dt_s);
+  const int n = b.n;
+  double Finv[9][N], S0_trial[9][N], S0[9][N], S0_old[9][N], Q_old[9][N], Q_new[9][N], H[9][N], FH[9][N], psi_branches[N];
+  inverse(b.F, Finv, n);
+  product(Finv, b.P_iso, S0_trial, n);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int l = 0; l < n; ++l) S0[i + 3 * j][l] = 0.5 * (S0_trial[i + 3 * j][l] + S0_trial[j + 3 * i][l]);
+  unpack_lanes(state_old, block, 0, n, S0_old);
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < n; ++l) H[k][l] = 0.0;
+  for (int l = 0; l < n; ++l) psi_branches[l] = 0.0;
+  for (int i = 0; i < n_; ++i) {
+    const std::size_t offset = 6 * static_cast<std::size_t>(i + 1);
+    const double decay = inc.decay[i], gk = inc.gk[i];
+    unpack_lanes(state_old, block, offset, n, Q_old);
+    for (int k = 0; k < 9; ++k)
+      for (int l = 0; l < n; ++l) {
+        Q_new[k][l] = decay * Q_old[k][l] + gk * (S0[k][l] - S0_old[k][l]);
+        H[k][l] += decay * Q_old[k][l] - gk * S0_old[k][l];
+      }
+    if (gamma_[i] > 0.0) {
+      const double scale = 4.0 * gamma_[i] * mu_inf_;
+      for (int l = 0; l < n; ++l) psi_branches[l] += squared_norm(Q_new, l) / scale;
+    }
+    if (!state_new.empty()) pack_lanes(Q_new, n, block, offset, state_new);
+  }
+  if (!state_new.empty()) pack_lanes(S0, n, block, 0, state_new);
+  product(b.F, H, FH, n);
+  const double one_plus_c = 1.0 + inc.c;
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < n; ++l) b.P_iso[k][l] = one_plus_c * b.P_iso[k][l] + FH[k][l];
+  for (int l = 0; l < n; ++l) b.psi_iso[l] += psi_branches[l];
 }
 
 PointFields Viscoelastic::fields(std::span<const double> state) const {

@@ -63,6 +63,9 @@ class Viscoelastic final : public Material {
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
+  /// Force only: the base's batched stress, then the overstress of all lanes (evaluate's bits).
+  void stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
+              std::span<double> state_new) const override;
   /// viscous_strain from this law, the rest from the base.
   PointFields fields(std::span<const double> state) const override;
   /// The INSTANTANEOUS shear modulus (1 + sum gamma) mu_inf: stable-step estimates need the stiffest response.
@@ -79,6 +82,9 @@ class Viscoelastic final : public Material {
   int n_ = 0;
   std::array<double, kMaxTerms> gamma_{}, tau_{};
   double gamma_sum_ = 0.0, mu_inf_ = 0.0;
+
+  struct Increment;  ///< exp(-x_i), gamma_i k_i and c = sum gamma_i k_i of one increment dt
+  Increment increment(double dt_s) const;
 };
 
 }  // namespace pneufem
