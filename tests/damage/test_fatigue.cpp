@@ -2,10 +2,12 @@
 // first-order convergence of the backward-Euler update, threshold, failure flag.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "damage/effects.h"
 #include "damage/material_point.h"
@@ -225,6 +227,44 @@ TEST(Fatigue, MaxPrincipalStretchDriver) {
   above.advance(R * uniaxial(1.8), 5.0);
   const double g = std::pow(1.8 / 1.5 - 1.0, 2.5);
   EXPECT_NEAR(1.0 - damage(above), 1.0 / (1.0 + 5.0 * g / 10.0), 1e-14);
+}
+
+// Where a cheap bound puts lambda_max(C) below lambda_th^2 (with a relative margin of 1e-6), the stretch
+// driver skips the eigenvalue problem: g = 0 there whatever the exact value. At the threshold, for a
+// uniaxial stretch (where the bound is tight) and a triaxial one, on either side of the margin, the trial
+// integrity must still be that of the exact largest eigenvalue, bit for bit: 1 / (1 + dt g / tau) with X
+// from Eigen's solver (eigenvectors or not) - in the force-only and tangent evaluations and in stress().
+TEST(Fatigue, StretchDriverIsExactAtTheThreshold) {
+  const FatigueParams p{0.0, 10.0, 1.0, 0.5, FatigueDriver::max_principal_stretch, 1.5};  // q = 1: g = x
+  const MaterialPtr m = make_fatigue(ecoflex(), p);
+  const double dt = 5.0, s_old = 1.0;
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  int grew = 0;
+  for (double rel : {-1e-3, -1e-6, -5e-7, -2e-7, -1e-9, 0.0, 1e-9, 2e-7, 5e-7, 1e-6, 1e-3}) {
+    const double lambda = p.lambda_th * (1.0 + rel);
+    for (const Mat3& F : {Mat3(R * uniaxial(lambda)), Mat3(R * Vec3(lambda, 1.1, 0.8).asDiagonal())}) {
+      SCOPED_TRACE("lambda = lambda_th (1 + " + std::to_string(rel) + "), F =\n" + ::testing::PrintToString(F));
+      const Eigen::SelfAdjointEigenSolver<Mat3> eig(F.transpose() * F);
+      const double g = fatigue_rate(std::sqrt(eig.eigenvalues()(2)), p).g;
+      const double expected = s_old / (1.0 + dt / p.tau_s * g);
+      grew += expected < s_old;
+      for (const bool tangent : {false, true}) {
+        std::vector<double> trial(1);
+        PointResponse r;
+        m->evaluate(std::span<const Mat3>(&F, 1), TimeStep{dt, dt}, std::span<const double>(&s_old, 1), trial,
+                    std::span<PointResponse>(&r, 1), tangent);
+        EXPECT_EQ(trial[0], expected) << (tangent ? "tangent" : "force only");
+      }
+      StressBatch b;
+      b.n = 1;
+      b.set_F(0, F);
+      b.pad();
+      std::vector<double> trial(1);
+      m->stress(b, TimeStep{dt, dt}, std::span<const double>(&s_old, 1), trial);
+      EXPECT_EQ(trial[0], expected) << "stress()";
+    }
+  }
+  EXPECT_GE(grew, 8);  // above the threshold, including just above it (x ~ 2e-7: s = 1 - 1e-7)
 }
 
 TEST(Fatigue, RejectsBadParameters) {
