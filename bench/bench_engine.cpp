@@ -133,6 +133,20 @@ void scene_force(const std::string& file, double h_mm, int threads, int reps) {
                   static_cast<unsigned long long>(hash_bits(s_new.data(), s_new.size())));
     }
   }
+  // The other paths of a law with history at the loaded state: force + tangent, and energy only
+  // without a trial state (an empty state_new).
+  SparseMatrix K;
+  double W = 0.0, W_only = 0.0;
+  Eigen::VectorXd fk;
+  A.internal(u2, TimeStep{1.1, 0.1}, s_big, s2, &fk, &K, &W);
+  A.internal(u2, TimeStep{1.1, 0.1}, s_big, {}, nullptr, nullptr, &W_only);
+  std::printf("    loaded, tangent call: f_int %016llx  K %016llx  energy %016llx  trial state %016llx;"
+              "  energy without trial state %016llx\n",
+              static_cast<unsigned long long>(hash_bits(fk.data(), fk.size())),
+              static_cast<unsigned long long>(hash_bits(K.valuePtr(), K.nonZeros())),
+              static_cast<unsigned long long>(hash_bits(&W, 1)),
+              static_cast<unsigned long long>(hash_bits(s2.data(), s2.size())),
+              static_cast<unsigned long long>(hash_bits(&W_only, 1)));
 }
 
 void newton_iteration(double h_mm, int threads) {
