@@ -55,24 +55,7 @@ Scene elastic_reference(const Scene& scene) {
 /// without the tables of disabled effects, whose constants do not change the model (otherwise
 /// every calibration run of a history effect on top of gravity missed the cache of its elastic
 /// gravity offset, one FEM sweep per run).
-std::string curve_key(const Scene& s) {
-  std::istringstream in(s.with({"load.pressure_lag_s=0.0"}).to_toml());
-  std::string out, block, line;
-  bool disabled = false;
-  auto flush = [&] {
-    if (!disabled) out += block;
-    block.clear();
-    disabled = false;
-  };
-  while (std::getline(in, line)) {
-    const std::size_t first = line.find_first_not_of(' ');
-    if (first != std::string::npos && line[first] == '[') flush();
-    if (first != std::string::npos && line.compare(first, std::string::npos, "enabled = false") == 0) disabled = true;
-    block += line + '\n';
-  }
-  flush();
-  return out;
-}
+std::string curve_key(const Scene& s) { return s.with({"load.pressure_lag_s=0.0"}).model_toml(); }
 
 bool has_history(const Model& m) {
   for (const Part& p : m.parts)

@@ -79,6 +79,11 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   sim->add_option("--abort-after-checkpoints", abort_after, "Testing aid: exit abruptly after N checkpoints")
       ->group("");
+  std::string ideal_cache;
+  sim->add_option("--ideal-cache", ideal_cache,
+                  "Share the ideal elastic model of metrics.json between runs through this directory (keyed by "
+                  "pneufem version, mesh and every scene key but the inelastic ones): the first run computes it, "
+                  "later runs of the same actuator read it (pneufem sweep gives its points one)");
 
   CLI::App* mesh = app.add_subcommand("mesh", "Write the scene's mesh as .vtu (ParaView) or a runnable CalculiX deck .inp");
   mesh->add_option("scene", scene_path, "Scene file (TOML); omit for the built-in default pneu-net")->check(CLI::ExistingFile);
@@ -186,6 +191,7 @@ int main(int argc, char** argv) {
       opt.checkpoint_every_s = ckpt_every;
       opt.abort_after_checkpoints = abort_after;
       opt.threads = threads;
+      opt.ideal_cache_dir = ideal_cache;
       opt.progress = isatty(fileno(stderr));
       opt.command_line = join_args(argc, argv);
       const Scene scene = opt.resume ? Scene::load("") : Scene::load(scene_path, sets);

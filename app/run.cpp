@@ -11,6 +11,7 @@
 #include <tbb/info.h>
 
 #include "analysis/paper_metrics.h"
+#include "app/ideal_cache.h"
 #include "app/json.h"
 #include "app/version.h"
 #include "damage/registry.h"
@@ -48,15 +49,12 @@ std::string mesh_stats_json(const MeshStats& s) {
   return o.str(2);
 }
 
-/// angles.csv text; `exact` writes round-trip precision (for files read back on --resume).
-std::string angles_csv(const std::vector<StateRecord>& recs, bool exact = false) {
+/// angles.csv text (6 decimals; ideal_angles.csv, read back on --resume, uses exact_angles_csv).
+std::string angles_csv(const std::vector<StateRecord>& recs) {
   std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
   char line[160];
   for (const StateRecord& r : recs) {
-    if (exact)
-      std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
-    else
-      std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     s += line;
   }
   return s;
@@ -177,22 +175,6 @@ std::vector<StateRecord> records_of(const Scene& scene) {
   return recs;
 }
 
-std::vector<StateRecord> read_angles_csv(const fs::path& p) {
-  std::ifstream in(p);
-  std::string line;
-  std::vector<StateRecord> out;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    StateRecord r;
-    double pk = 0;
-    if (std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &r.trial, &r.time_s, &pk, &r.angle_deg) == 4) {
-      r.pressure_Pa = pk * 1e3;
-      out.push_back(r);
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
@@ -223,15 +205,28 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
   const bool staircase = scene.string("load.protocol") == "staircase";
   std::vector<StateRecord> ideal;
+  std::string ideal_source = "computed";
   if (opt.compare_ideal && any_effect && staircase && bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
     if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
-      ideal = read_angles_csv(dir / "ideal_angles.csv");
+      ideal = read_angles_csv((dir / "ideal_angles.csv").string());
+      ideal_source = "ideal_angles.csv of the resumed run";
     } else {
       std::vector<std::string> sets = ideal_sets;
       sets.push_back("load.trials=1");
-      if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
-      ideal = records_of(scene.with(sets));
-      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal, true));
+      const Scene ideal_scene = scene.with(sets);
+      auto compute = [&] {
+        if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
+        return records_of(ideal_scene);
+      };
+      if (opt.ideal_cache_dir.empty()) {
+        ideal = compute();
+      } else {
+        IdealResult r = cached_ideal(opt.ideal_cache_dir, ideal_cache_key(ideal_scene, bm->model, version_string()),
+                                     ideal_scene, bm->load.trials[0].output_s, compute, bm->warnings);
+        ideal = std::move(r.records);
+        ideal_source = r.source;
+      }
+      write_file_atomic((dir / "ideal_angles.csv").string(), exact_angles_csv(ideal));
     }
   }
 
@@ -387,6 +382,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       .add("timings", timings.str(2))
       .add("warnings", warnings)
       .add("metrics", metrics_note)
+      .add_str("ideal_model", ideal.empty() ? "none" : ideal_source)
       .add("states_reported", static_cast<double>(records.size()))
       .add("scene", scene.to_json());
   write_file_atomic((dir / "summary.json").string(), summary.str() + "\n");

@@ -30,6 +30,8 @@ struct RunOptions {
   double checkpoint_every_s = 30.0;    ///< wall-clock seconds between checkpoints (0 = every segment)
   int abort_after_checkpoints = -1;    ///< testing aid: die (as if killed) after this many checkpoints
   bool compare_ideal = true;           ///< also run the ideal elastic model and write metrics.json
+  /// Share the ideal model between runs through this directory (app/ideal_cache.h); "" = compute.
+  std::string ideal_cache_dir;
 };
 
 struct RunResult {

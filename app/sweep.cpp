@@ -642,8 +642,11 @@ SweepResult run_sweep(const SweepOptions& o) {
       fs::create_directories(dir);
       std::vector<std::string> argv = {o.exe, "simulate"};
       if (!scene_abs.empty()) argv.push_back(scene_abs);
+      // The points share one ideal elastic model per actuator (app/ideal_cache.h): a sweep over
+      // damage constants computes it once instead of once per point.
       for (const std::string& a : {std::string("--out"), dir.string(), std::string("--threads"),
-                                   std::to_string(o.threads_per_job)})
+                                   std::to_string(o.threads_per_job), std::string("--ideal-cache"),
+                                   (out / "ideal_cache").string()})
         argv.push_back(a);
       for (const std::string& s : o.sets) argv.insert(argv.end(), {"--set", s});
       for (const std::string& s : overrides[i]) argv.insert(argv.end(), {"--set", s});

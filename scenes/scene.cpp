@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -295,6 +296,29 @@ std::string Scene::resolve_path(const std::string& p) const {
 std::string Scene::to_toml() const {
   std::ostringstream s;
   s << impl_->table;
+  return s.str();
+}
+
+namespace {
+void drop_disabled_tables(toml::table& t) {
+  std::vector<std::string> off;
+  for (auto&& [key, node] : t)
+    if (toml::table* sub = node.as_table()) {
+      const std::optional<bool> enabled = (*sub)["enabled"].value<bool>();
+      if (enabled && !*enabled)
+        off.emplace_back(key.str());
+      else
+        drop_disabled_tables(*sub);
+    }
+  for (const std::string& key : off) t.erase(key);
+}
+}  // namespace
+
+std::string Scene::model_toml() const {
+  toml::table t = impl_->table;
+  drop_disabled_tables(t);
+  std::ostringstream s;
+  s << t;
   return s.str();
 }
 

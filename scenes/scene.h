@@ -47,6 +47,10 @@ class Scene {
   /// The fully resolved configuration.
   std::string to_toml() const;
   std::string to_json() const;
+  /// to_toml() without the tables switched off (`enabled = false`, e.g. a disabled effect), whose
+  /// other keys do not change the model: equal strings for scenes that build the same model, the
+  /// key of caches (the ideal model of app/ideal_cache.h, diagnose's elastic curves).
+  std::string model_toml() const;
 
   /// A copy with more overrides applied (used by sweeps and diagnosis).
   Scene with(const std::vector<std::string>& overrides) const;

@@ -214,6 +214,18 @@ TEST(SweepCli, GridSweepResumesAndDoesNotDependOnJobs) {
     EXPECT_TRUE(fs::exists(d / "points" / ("000" + std::to_string(i + 1)) / "summary.json"));
   }
   EXPECT_EQ(nrmse.size(), 3u);  // tau_s matters
+  // The points share one ideal elastic model (tau_s is not part of it): one computes, the others
+  // read the cache, and all compare against the same angles.
+  int computed = 0, cached = 0;
+  for (int i = 1; i <= 3; ++i) {
+    const fs::path pd = d / "points" / ("000" + std::to_string(i));
+    const std::string summary = slurp(pd / "summary.json");
+    computed += summary.find("\"ideal_model\": \"computed\"") != std::string::npos;
+    cached += summary.find("\"ideal_model\": \"cache ") != std::string::npos;
+    EXPECT_EQ(slurp(pd / "ideal_angles.csv"), slurp(d / "points" / "0001" / "ideal_angles.csv"));
+  }
+  EXPECT_EQ(computed, 1);
+  EXPECT_EQ(cached, 2);
   const std::string svg = slurp(d / ("sweep_" + kTau + ".svg"));
   EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
@@ -263,6 +275,62 @@ TEST(SweepCli, GridSweepResumesAndDoesNotDependOnJobs) {
   EXPECT_EQ(strip_wall(read_csv(d1 / "sweep.csv")), strip_wall(read_csv(d / "sweep_j2.csv"))) << csv_j1 << "\n" << csv1;
   fs::remove_all(d);
   fs::remove_all(d1);
+}
+
+/// The ideal_model entry of a run's summary.json ("computed", "cache <file>", ...).
+std::string ideal_source(const fs::path& run_dir) {
+  const std::string s = slurp(run_dir / "summary.json");
+  const std::string key = "\"ideal_model\": \"";
+  const std::size_t p = s.find(key);
+  if (p == std::string::npos) return "";
+  return s.substr(p + key.size(), s.find('"', p + key.size()) - p - key.size());
+}
+
+std::vector<fs::path> cache_files(const fs::path& dir) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".csv") out.push_back(e.path());
+  return out;
+}
+
+TEST(IdealCache, SharedBetweenRunsKeyedByTheElasticModelAndRepairedWhenDamaged) {
+  const fs::path d = fresh_dir("ideal_cache"), cache = d / "cache";
+  auto simulate = [&](const std::string& name, const std::string& extra, bool use_cache) {
+    const Result r = run("simulate " + kTiny + " " + extra + " --threads 1 --out " + (d / name).string() +
+                         (use_cache ? " --ideal-cache " + cache.string() : ""));
+    EXPECT_EQ(r.code, 0) << r.out;
+    return d / name;
+  };
+  // First run computes and stores; a run with other damage constants reads it, and its metrics are
+  // those of a run that computes its own ideal model (the cache only saves the time).
+  const fs::path a = simulate("a", "", true);
+  EXPECT_EQ(ideal_source(a), "computed");
+  ASSERT_EQ(cache_files(cache).size(), 1u);
+  const fs::path b = simulate("b", "--set " + kTau + "=300", true);
+  EXPECT_EQ(ideal_source(b), "cache " + cache_files(cache)[0].string());
+  EXPECT_EQ(slurp(b / "ideal_angles.csv"), slurp(a / "ideal_angles.csv"));
+  const fs::path b_own = simulate("b_own", "--set " + kTau + "=300", false);
+  EXPECT_EQ(ideal_source(b_own), "computed");
+  EXPECT_EQ(slurp(b / "metrics.json"), slurp(b_own / "metrics.json"));
+
+  // An elastic change (the silicone's stiffness) is another ideal model: a second entry.
+  const fs::path c = simulate("c", "--set materials.silicone.stiffness_scale=0.9", true);
+  EXPECT_EQ(ideal_source(c), "computed");
+  EXPECT_EQ(cache_files(cache).size(), 2u);
+  EXPECT_NE(slurp(c / "ideal_angles.csv"), slurp(a / "ideal_angles.csv"));
+
+  // A damaged entry (a line lost) is not trusted: recomputed, replaced, and said so.
+  const fs::path entry = fs::path(ideal_source(b).substr(6));
+  const std::string original = slurp(entry);
+  std::string text = original;
+  text.erase(text.rfind('\n', text.size() - 2) + 1);
+  std::ofstream(entry, std::ios::trunc) << text;
+  const fs::path b2 = simulate("b2", "--set " + kTau + "=300", true);
+  EXPECT_EQ(ideal_source(b2), "computed");
+  EXPECT_NE(slurp(b2 / "summary.json").find("recomputed and replaced"), std::string::npos);
+  EXPECT_EQ(slurp(b2 / "metrics.json"), slurp(b_own / "metrics.json"));
+  EXPECT_EQ(slurp(entry), original);  // the same model again, deterministically
+  fs::remove_all(d);
 }
 
 TEST(SweepCli, FailedPointIsRecordedAndTheOthersRun) {

@@ -70,6 +70,21 @@ TEST(Scene, ChangingAMaterialModelDropsTheOldConstants) {
   EXPECT_NO_THROW(make_material(s, "silicone"));
 }
 
+// model_toml: the key of the caches of the ideal model and of diagnose's elastic curves. The constants
+// of a switched-off effect do not change the model, so they must not change the key; anything else must.
+TEST(Scene, ModelTomlIgnoresOnlyTheTablesSwitchedOff) {
+  const Scene base = Scene::load("", {});
+  const std::string tau = "materials.silicone.fatigue.tau_s=";
+  EXPECT_EQ(base.with({tau + "123.0"}).model_toml(), base.model_toml());            // fatigue is off
+  EXPECT_NE(base.with({tau + "123.0"}).to_toml(), base.to_toml());                  // (the full text differs)
+  EXPECT_EQ(base.model_toml().find("[materials.silicone.fatigue]"), std::string::npos);
+  const Scene on = base.with({"materials.silicone.fatigue.enabled=true"});
+  EXPECT_NE(on.model_toml(), base.model_toml());
+  EXPECT_NE(on.with({tau + "123.0"}).model_toml(), on.model_toml());                 // now it counts
+  EXPECT_NE(base.with({"materials.silicone.C10_MPa=0.02"}).model_toml(), base.model_toml());
+  EXPECT_NE(base.model_toml().find("[materials.silicone]"), std::string::npos);     // the rest stays
+}
+
 TEST(SceneErrors, UnknownKeyNamesFileLineAndSuggestion) {
   const std::string p = write_temp("typo.toml", "# comment\n[solver]\nmetod = \"newton\"\n");
   const std::string msg = error_of([&] { Scene::load(p); });
