@@ -93,11 +93,14 @@ std::string ideal_cache_key(const Scene& ideal_scene, const Model& model, const 
   return h.hex();
 }
 
-std::string exact_angles_csv(const std::vector<StateRecord>& recs) {
+std::string angles_csv(const std::vector<StateRecord>& recs, bool exact) {
   std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
   char line[160];
   for (const StateRecord& r : recs) {
-    std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    if (exact)
+      std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    else
+      std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     s += line;
   }
   return s;
@@ -137,7 +140,7 @@ IdealResult cached_ideal(const std::string& dir, const std::string& key, const S
   }
   IdealResult r{compute(), "computed"};
   write_file_atomic(base.string() + ".toml", ideal_scene.to_toml());
-  write_file_atomic(csv, exact_angles_csv(r.records));
+  write_file_atomic(csv, angles_csv(r.records, true));
   return r;
 }
 

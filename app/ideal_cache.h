@@ -42,8 +42,9 @@ IdealResult cached_ideal(const std::string& dir, const std::string& key, const S
                          const std::vector<double>& expected_times_s,
                          const std::function<std::vector<StateRecord>()>& compute, std::vector<std::string>& warnings);
 
-/// angles.csv text at round-trip precision (%.17g) and its reader (malformed lines are skipped).
-std::string exact_angles_csv(const std::vector<StateRecord>& records);
+/// angles.csv text: 6 decimals, or round-trip precision (%.17g) with `exact` (files read back);
+/// and its reader (malformed lines are skipped).
+std::string angles_csv(const std::vector<StateRecord>& records, bool exact = false);
 std::vector<StateRecord> read_angles_csv(const std::string& path);
 
 }  // namespace pneufem

@@ -49,17 +49,6 @@ std::string mesh_stats_json(const MeshStats& s) {
   return o.str(2);
 }
 
-/// angles.csv text (6 decimals; ideal_angles.csv, read back on --resume, uses exact_angles_csv).
-std::string angles_csv(const std::vector<StateRecord>& recs) {
-  std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
-  char line[160];
-  for (const StateRecord& r : recs) {
-    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
-    s += line;
-  }
-  return s;
-}
-
 std::string states_csv(const std::vector<StateRecord>& recs) {
   std::string s = "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm\n";
   char line[256];
@@ -226,7 +215,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
         ideal = std::move(r.records);
         ideal_source = r.source;
       }
-      write_file_atomic((dir / "ideal_angles.csv").string(), exact_angles_csv(ideal));
+      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal, true));
     }
   }
 
