@@ -21,9 +21,41 @@ namespace {
 constexpr std::array<const char*, 4> kColumns = {"trial", "time_s", "pressure_kPa", "angle_deg"};
 enum Col { kTrial = 0, kTime = 1, kPressure = 2, kAngle = 3 };
 
+/// A column name with another unit that the reader converts: stem_unit (after canonical_name) and
+/// the factor to the canonical unit. Exact SI/NIST factors (1 psi = 6.894757293168361 kPa).
+struct UnitAlias {
+  Col col;
+  const char* name;
+  double to_canonical;
+};
+constexpr std::array<UnitAlias, 10> kAliases = {{{kTime, "time_ms", 1e-3},
+                                                 {kTime, "time_min", 60.0},
+                                                 {kPressure, "pressure_pa", 1e-3},
+                                                 {kPressure, "pressure_hpa", 0.1},
+                                                 {kPressure, "pressure_mbar", 0.1},
+                                                 {kPressure, "pressure_bar", 100.0},
+                                                 {kPressure, "pressure_mpa", 1e3},
+                                                 {kPressure, "pressure_psi", 6.894757293168361},
+                                                 {kAngle, "angle_rad", 57.29577951308232},
+                                                 {kTrial, "trial_number", 1.0}}};
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
+}
+
+/// A header name in the form the columns are matched in: "Time (s)", "time [s]" and "time_s" all
+/// become "time_s" (lower case, brackets and blanks turned into single underscores).
+std::string canonical_name(const std::string& header_name) {
+  std::string out;
+  for (char c : header_name) {
+    if (c == ')' || c == ']') continue;
+    if (c == '(' || c == '[' || c == ' ' || c == '\t') c = '_';
+    if (c == '_' && (out.empty() || out.back() == '_')) continue;
+    out += c;
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  return out;
 }
 
 /// A hint for a missing required column: a header cell that shares its stem ("pressure" for
@@ -33,7 +65,9 @@ std::string missing_column_hint(const std::string& required, const std::vector<s
   for (const std::string& n : names)
     if (n.rfind(stem, 0) == 0)
       return "the header has '" + n + "': rename it to " + required +
-             " (the unit is part of the name; convert the values if they are in another unit)";
+             " (the unit is part of the name; convert the values if they are in another unit; units read and "
+             "converted: time_s, time_ms, time_min; pressure_kPa, pressure_Pa, pressure_hPa, pressure_mbar, "
+             "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
   return "add the column; the header must name trial,time_s,pressure_kPa,angle_deg (any order, "
          "other columns are ignored, cells of pressure_kPa or angle_deg may be empty)";
 }
@@ -81,6 +115,7 @@ class CanonicalReader {
 
     Recording rec;
     rec.source = source_;
+    rec.warnings = conversions_;
     if (skipped_rows > 0)
       rec.warnings.push_back(source_ + ": " + std::to_string(skipped_rows) +
                              " row(s) with neither pressure_kPa nor angle_deg were skipped (first at line " +
@@ -106,16 +141,28 @@ class CanonicalReader {
     header_names_.clear();
     for (std::string_view f : fields_) header_names_.emplace_back(csv::trim(f));
     column_.fill(-1);
-    for (std::size_t i = 0; i < names.size(); ++i)
-      for (std::size_t c = 0; c < kColumns.size(); ++c) {
-        if (names[i] != lower(kColumns[c])) continue;
-        if (column_[c] >= 0)
-          csv::fail(source_, line.number, static_cast<int>(i) + 1,
-                    "column '" + std::string(kColumns[c]) + "' appears twice (also field " +
-                        std::to_string(column_[c] + 1) + ")",
-                    "keep one of them, or rename the other");
-        column_[c] = static_cast<int>(i);
-      }
+    scale_.fill(1.0);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      // The canonical name, or another unit of the same quantity (converted on reading).
+      const std::string name = canonical_name(names[i]);
+      int c = -1;
+      double factor = 1.0;
+      for (std::size_t k = 0; k < kColumns.size(); ++k)
+        if (name == lower(kColumns[k])) c = static_cast<int>(k);
+      for (const UnitAlias& a : kAliases)
+        if (name == a.name) c = a.col, factor = a.to_canonical;
+      if (c < 0) continue;
+      if (column_[c] >= 0)
+        csv::fail(source_, line.number, static_cast<int>(i) + 1,
+                  "column '" + std::string(kColumns[c]) + "' appears twice (also field " + std::to_string(column_[c] + 1) +
+                      ")",
+                  "keep one of them, or rename the other");
+      column_[c] = static_cast<int>(i);
+      scale_[c] = factor;
+      if (factor != 1.0)
+        conversions_.push_back(source_ + ": column '" + header_names_[i] + "' read as " + kColumns[c] +
+                               " (values times " + csv::number_text(factor) + ")");
+    }
     for (std::size_t c = 0; c < kColumns.size(); ++c) {
       if (column_[c] >= 0) continue;
       if (names.size() == 1 && line.text.find(';') != std::string_view::npos)
@@ -145,7 +192,9 @@ class CanonicalReader {
   bool number(const csv::Line& line, int col, bool required, double& v) const {
     const std::size_t f = static_cast<std::size_t>(column_[col]);
     switch (csv::parse_double(fields_[f], v)) {
-      case csv::Number::ok: return true;
+      case csv::Number::ok:
+        if (scale_[col] != 1.0) v *= scale_[col];  // another unit of the column (kAliases)
+        return true;
       case csv::Number::empty:
         if (!required) return false;
         fail_field(line, f, "is empty", "every row needs its " + std::string(kColumns[col]));
@@ -240,6 +289,8 @@ class CanonicalReader {
   std::vector<std::string_view> fields_;
   std::vector<std::string> header_names_;
   std::array<int, 4> column_{};
+  std::array<double, 4> scale_{};           ///< factor from the file's unit to the canonical one
+  std::vector<std::string> conversions_;    ///< one note per converted column
   std::size_t width_ = 0;
   std::vector<TrialState> trials_;
   std::map<int, std::size_t> trial_index_;  // ordered: the output is sorted by trial number

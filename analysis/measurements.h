@@ -11,6 +11,10 @@
 //     1,0.0333333,,0.12
 //
 //  * header names are case-insensitive and may come in any order; other columns are ignored;
+//    a unit may be written in brackets ("Time (s)", "pressure [kPa]"), and columns in other units
+//    are converted on reading, with a warning naming the column and the factor: time_ms, time_min;
+//    pressure_Pa, pressure_hPa, pressure_mbar, pressure_bar, pressure_MPa, pressure_psi;
+//    angle_rad; trial_number for trial. A name without a unit ("pressure") is an error;
 //    an optional UTF-8 byte-order mark and CRLF line ends are accepted;
 //  * one row per time stamp; the pressure and angle streams have different rates, so either cell
 //    may be empty (a row with both empty is skipped with a warning);

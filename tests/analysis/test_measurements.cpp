@@ -183,6 +183,35 @@ TEST(MeasurementsCsvErrors, MessagesNameFileLineAndColumn) {
   }
 }
 
+// Recordings made by other tools name their columns with units in brackets or in other units: the
+// reader converts those it knows exactly (and says so), so nobody has to edit the file.
+TEST(MeasurementsCsv, ColumnsInOtherUnitsAreConvertedAndReported) {
+  const Recording r = parse_measurements_csv(
+      "Trial,Time (ms),Pressure [psi],Angle (rad)\n1,0,0,0\n1,250,1,\n1,500,,0.5\n", "rig.csv");
+  ASSERT_EQ(r.trials.size(), 1u);
+  const TrialRecording& t = r.trials[0];
+  ASSERT_EQ(t.pressure_kPa.t_s.size(), 2u);
+  ASSERT_EQ(t.angle_deg.t_s.size(), 2u);
+  EXPECT_EQ(t.pressure_kPa.t_s[1], 0.25);                   // 250 ms (exact in binary)
+  EXPECT_EQ(t.pressure_kPa.value[1], 6.894757293168361);   // 1 psi in kPa (NIST)
+  EXPECT_EQ(t.angle_deg.t_s[1], 0.5);
+  EXPECT_NEAR(t.angle_deg.value[1], 28.64788975654116, 1e-13);  // 0.5 rad, to round-off
+  ASSERT_EQ(r.warnings.size(), 3u);
+  EXPECT_EQ(r.warnings[0], "rig.csv: column 'Time (ms)' read as time_s (values times 0.001)");
+  EXPECT_NE(r.warnings[1].find("'Pressure [psi]' read as pressure_kPa"), std::string::npos) << r.warnings[1];
+  EXPECT_NE(r.warnings[2].find("'Angle (rad)' read as angle_deg"), std::string::npos) << r.warnings[2];
+  // Units spelled in brackets, canonical unit: no conversion, no note, the same numbers.
+  const Recording c = parse_measurements_csv("trial, time [s] ,pressure (kPa),angle_deg\n1,0.1,2.5,\n1,0.2,,1\n", "c.csv");
+  EXPECT_TRUE(c.warnings.empty());
+  EXPECT_EQ(c.trials[0].pressure_kPa.value[0], 2.5);
+  for (const char* bad : {"trial,time_s,pressure_kPa,pressure_psi,angle_deg\n1,0,1,1,\n",
+                          "trial,time_s,pressure_atm,angle_deg\n1,0,1,\n"}) {
+    const std::string msg = error_of(bad);
+    EXPECT_TRUE(msg.find("appears twice") != std::string::npos || msg.find("pressure_psi; angle_deg") != std::string::npos)
+        << msg;
+  }
+}
+
 TEST(MeasurementsCsvErrors, MissingFileNamesThePath) {
   const std::string path = testing::temp_path("does_not_exist.csv");
   try {
