@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <sstream>
 #include <utility>
 
 #include <tbb/global_control.h>
@@ -102,10 +103,49 @@ Series simplify_pressure(const Series& p, double tolerance_kPa, double median_wi
   return out;
 }
 
+namespace {
+/// The model is driven by gauge pressure (0 = atmospheric, the actuator at rest). Two mistakes
+/// would otherwise surface as a misleading "limit point" failure of the first state: an absolute
+/// pressure record (it rests at ~101 kPa: every trial stays above 50 kPa, which no staircase from
+/// rest does) and a record in Pa labelled kPa (it reaches tens of thousands; a soft actuator bursts
+/// far below 2 MPa). Both are InputErrors naming the sample and what to do.
+void check_gauge_pressure(const Recording& rec) {
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  int low_trial = 0, high_trial = 0;
+  double low_t = 0.0, high_t = 0.0;
+  for (const TrialRecording& tr : rec.trials)
+    for (std::size_t i = 0; i < tr.pressure_kPa.t_s.size(); ++i) {
+      const double p = tr.pressure_kPa.value[i];
+      if (p < lowest) lowest = p, low_trial = tr.trial, low_t = tr.pressure_kPa.t_s[i];
+      if (p > highest) highest = p, high_trial = tr.trial, high_t = tr.pressure_kPa.t_s[i];
+    }
+  auto where = [](int trial, double t) {
+    std::ostringstream s;
+    s << "trial " << trial << ", time_s = " << t;
+    return s.str();
+  };
+  if (lowest >= 50.0 && std::isfinite(lowest)) {
+    std::ostringstream m;
+    m << rec.source << ": the pressure never falls below " << lowest << " kPa (lowest sample at " << where(low_trial, low_t)
+      << "), so the actuator never rests: this looks like ABSOLUTE pressure. pneufem drives the chamber with gauge "
+         "pressure (0 = atmospheric); subtract the atmospheric pressure (about 101.3 kPa) from pressure_kPa";
+    throw InputError(m.str());
+  }
+  if (highest > 2000.0) {
+    std::ostringstream m;
+    m << rec.source << ": pressure_kPa reaches " << highest << " kPa (at " << where(high_trial, high_t)
+      << "), far beyond what a soft actuator carries: if the column is in Pa, name it pressure_Pa (it is then "
+         "converted on reading)";
+    throw InputError(m.str());
+  }
+}
+}  // namespace
+
 LoadHistory measured_load(const Recording& rec, const DriveOptions& opt, double rest_s, bool rate_dependent,
                           std::vector<double>& t_offset_s, double* used_tolerance_kPa) {
   if (rec.trials.empty()) throw InputError(rec.source + ": the recording has no trials; nothing to simulate");
   if (!(opt.max_report_gap_s > 0)) throw InputError("max_report_gap_s must be > 0");
+  check_gauge_pressure(rec);
   LoadHistory h;
   h.rest_between_trials_s = rest_s;
   t_offset_s.clear();

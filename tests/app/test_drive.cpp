@@ -270,6 +270,37 @@ TEST(Drive, HoldStatesOnlyForModelsWithHistory) {
   }
 }
 
+// Absolute pressure (a record that rests at ~101 kPa) and Pa labelled kPa would drive the model far
+// past its limit point at once; they are named as what they are, with the fix.
+TEST(Drive, AbsolutePressureOrPascalsAreCaughtBeforeTheModelRuns) {
+  Recording rec;
+  rec.source = "rig.csv";
+  TrialRecording tr;
+  tr.trial = 2;
+  tr.pressure_kPa = {{0.0, 1.0, 2.0}, {101.3, 106.3, 101.2}};
+  rec.trials.push_back(tr);
+  DriveOptions opt;
+  std::vector<double> offset;
+  auto error = [&] {
+    try {
+      measured_load(rec, opt, 0.0, false, offset);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string e = error();
+  EXPECT_NE(e.find("rig.csv: the pressure never falls below 101.2 kPa (lowest sample at trial 2, time_s = 2)"),
+            std::string::npos) << e;
+  EXPECT_NE(e.find("ABSOLUTE pressure"), std::string::npos) << e;
+  rec.trials[0].pressure_kPa.value = {0.0, 45000.0, 0.0};
+  e = error();
+  EXPECT_NE(e.find("pressure_kPa reaches 45000 kPa (at trial 2, time_s = 1)"), std::string::npos) << e;
+  EXPECT_NE(e.find("name it pressure_Pa"), std::string::npos) << e;
+  rec.trials[0].pressure_kPa.value = {0.0, 45.0, 20.0};  // a gauge record in kPa: accepted
+  EXPECT_EQ(error(), "");
+}
+
 TEST_F(DriveTest, WritesTheWorstStatesAsVtu) {
   Recording rec = sampled_staircase(scene(), 0.0, 1);
   // Measured 1000 deg throughout trial 2 (constant: no outlier frames), 0 in trial 1: the states
