@@ -316,6 +316,21 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     rate_prev_ = resume->rate_prev_Pa_s;
     wall_before = stats_.wall_s;
   }
+  // The run starts from u = 0, which is an equilibrium only without load. When the load history
+  // starts loaded (a recording whose first pressure sample is not 0) or the rig has gravity, the
+  // first state is solved before anything is reported: otherwise a report at t = 0 (the first frame
+  // of a recording) would carry the unloaded shape, and the frames up to the next state an
+  // interpolation from it (seen as a 0 -> sag ramp over the first 0.25 s of a gravity recording).
+  if (!resume && !segs.empty()) {
+    const Segment& s0 = segs.front();
+    if (s0.p0 != 0.0 || !asm_.model().gravity_m_s2.isZero()) {
+      try {
+        equilibrium(0.0, s0.p0, s0.g0, s0.g0);
+      } catch (const PhysicsError& e) {
+        throw PhysicsError(std::string(e.what()) + failure_note(), e.element(), e.time_s());
+      }
+    }
+  }
   for (std::size_t i = first; i < segs.size(); ++i) {
     const Segment& s = segs[i];
     try {
