@@ -21,6 +21,37 @@ namespace {
 
 const std::vector<std::string> kSmall = {"geometry.chambers=2", "mesh.h_mm=6.0", "load.max_kPa=10.0"};
 
+// A load history that starts loaded (a recording's first frame at t = 0 under pressure or on a rig
+// with gravity) reports its first state solved: the same elastic equilibrium as a second report at
+// the same load, not the unloaded shape (which it was until 2026-11-25: angle 0 at t = 0 and a
+// ramp to the sag over the first 0.25 s of every gravity recording).
+TEST(PneuNetSolvers, AReportAtTimeZeroIsAnEquilibriumUnderLoadOrGravity) {
+  struct Case {
+    std::string gravity;
+    double p_Pa;
+  };
+  for (const Case& c : {Case{"[0.0, 0.0, -9.81]", 0.0}, Case{"[0.0, 0.0, 0.0]", 4e3}, Case{"[0.0, 0.0, -9.81]", 4e3}}) {
+    std::vector<std::string> sets = kSmall;
+    sets.push_back("gravity.g_m_s2=" + c.gravity);
+    auto bm = build_model(Scene::load("", sets));
+    Assembler A(bm->model);
+    LoadHistory load;
+    TrialLoad tl;
+    tl.time_s = {0.0, 1.0};
+    tl.pressure_Pa = {c.p_Pa, c.p_Pa};
+    tl.output_s = {0.0, 1.0};
+    load.trials.push_back(tl);
+    QuasiStaticRun run(A, bm->solver.quasi_static);
+    std::vector<double> angles;
+    run.run(load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { angles.push_back(r.angle_deg); });
+    ASSERT_EQ(angles.size(), 2u);
+    EXPECT_GT(std::abs(angles[1]), 0.01) << c.gravity << " " << c.p_Pa;  // the load bends it measurably
+    // Both are equilibria of the same elastic problem to rel_tol 1e-8 (the second from the first as
+    // its warm start): equal far below 1e-6 of the angle.
+    EXPECT_NEAR(angles[0], angles[1], 1e-6 * std::abs(angles[1])) << c.gravity << " " << c.p_Pa;
+  }
+}
+
 TEST(PneuNetSolvers, QuasiStaticDriverGivesTheSameAngleWithEitherMethod) {
   // The whole quasi-static driver (staircase, warm starts) with Newton and with relaxation.
   auto angle_at_top = [](const std::string& method) {
