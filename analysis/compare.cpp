@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "analysis/robust.h"
@@ -112,6 +113,37 @@ Projection project_residual(const std::vector<double>& e, const std::vector<doub
   p.fraction = std::min(1.0, se * se / (ss * ee));
   return p;
 }
+
+namespace {
+/// A recording in another convention than the model's shows as a measured angle proportional to
+/// the model's with the wrong factor: -1 (the camera or the tracking counts the bend the other way;
+/// pneufem's angle is positive towards the inextensible layer) or 1/57.3 (radians in a column named
+/// degrees). The least-squares factor measured ~ s model over the kept frames says which; nothing
+/// else makes it negative or ~0.017 when the model moves by more than a degree. A warning, not an
+/// error: the comparison is still written.
+void convention_hints(Comparison& c) {
+  double mm = 0.0, md = 0.0, lo = INFINITY, hi = -INFINITY;
+  for (const ComparedFrame& f : c.frames) {
+    if (!std::isfinite(f.model_deg)) continue;
+    mm += f.model_deg * f.model_deg;
+    md += f.model_deg * f.measured_deg;
+    lo = std::min(lo, f.model_deg);
+    hi = std::max(hi, f.model_deg);
+  }
+  if (!(hi - lo > 1.0) || !(mm > 0.0)) return;
+  const double s = md / mm, per_rad = 180.0 / 3.14159265358979323846;
+  char fit[64];
+  std::snprintf(fit, sizeof fit, "%.3g", s);
+  if (s < -0.3)
+    c.warnings.push_back(std::string("the measured angle runs opposite to the model's (least-squares fit measured = ") +
+                         fit + " x model): the recording probably counts the bend the other way; pneufem's angle is "
+                               "positive towards the inextensible (fabric) layer: negate angle_deg");
+  else if (std::abs(s * per_rad - 1.0) < 0.3)
+    c.warnings.push_back(std::string("the measured angle is ") + fit +
+                         " x the model's, about 1/57.3: it is probably in radians; name the column angle_rad (it is "
+                         "then converted on reading)");
+}
+}  // namespace
 
 Comparison compare_recording(const Recording& rec, const std::vector<Series>& model, const CompareOptions& opt) {
   if (model.size() != rec.trials.size())
@@ -258,6 +290,7 @@ Comparison compare_recording(const Recording& rec, const std::vector<Series>& mo
   out.profile_late_trials = late.profile();
   out.residual_before_mark_deg = before_n > 0 ? before_sum / static_cast<double>(before_n) : kNaN;
   out.residual_after_mark_deg = after_n > 0 ? after_sum / static_cast<double>(after_n) : kNaN;
+  convention_hints(out);
   return out;
 }
 

@@ -44,6 +44,10 @@ int run_compare_command(CompareCommand& c, const std::string& command_line) {
   std::printf("compare: NRMSE %.4f (noise floor %.4f) over %zu trials, %ld states, %.1f s; report %s/report.html\n",
               r.comparison.nrmse, r.comparison.noise_floor_nrmse, r.comparison.trials.size(), r.drive.states, r.wall_s,
               c.options.out_dir.c_str());
+  // Everything the run noted (converted columns, dropped outlier frames, a recording in another
+  // convention) is in metrics.json and the report; on the terminal too, so nobody misses it.
+  for (const std::string& w : r.warnings)
+    if (w.rfind("the model run stopped early", 0) != 0) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (!r.drive.failure.empty()) {
     std::fprintf(stderr,
                  "\nsimulation failed: %s\n(the frames solved before are compared and written to %s, with "

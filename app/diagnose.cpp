@@ -637,6 +637,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   if (opt.threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
 
   const Recording rec = read_measurements_csv(opt.data_path);
+  for (const std::string& w : rec.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   // Kept frames and metrics come from compare_recording; any model series gives the frames.
   std::vector<Series> zero(rec.trials.size());
   for (std::size_t k = 0; k < rec.trials.size(); ++k) {
@@ -679,6 +680,11 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   auto metrics = [&](const Scene& s) { return compare_recording(rec, rom.series(s)); };
   const Comparison base = metrics(cal_scene);
   ++rom_runs;
+  // A recording in another convention (the bend counted the other way, radians under angle_deg:
+  // analysis/compare.cpp) is not a missing physical effect: every candidate would be fitted to it.
+  for (const std::string& w : base.warnings)
+    if (w.find("runs opposite to the model's") != std::string::npos || w.find("probably in radians") != std::string::npos)
+      throw InputError(opt.data_path + ": " + w + ". diagnose stops here: no physical effect explains that");
   out.baseline_nrmse = base.nrmse;
   for (const TrialComparison& t : base.trials) out.baseline_nrmse_per_trial.push_back(t.nrmse);
   out.noise_floor_nrmse = base.noise_floor_nrmse;

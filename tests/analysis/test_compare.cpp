@@ -165,6 +165,31 @@ TEST(Compare, EveryMetricMatchesClosedForm) {
     }
 }
 
+// A recording in the opposite sign convention, or in radians under angle_deg, is named as such; a
+// recording in the model's convention (even a poor fit) gets no such note.
+TEST(Compare, AnOppositeSignOrRadiansIsPointedOut) {
+  const StaircaseSpec s = spec();
+  const std::vector<TrialTruth> truths = {{0.0, {0, 1, 2, 3, 4}, 0.0}};
+  auto notes = [&](double factor) {
+    Recording rec;
+    std::vector<Series> model;
+    make(s, truths, 0, rec, model);
+    rec.trials[0].angle_deg.value[0] -= 50.0;  // no outlier here
+    for (double& v : rec.trials[0].angle_deg.value) v *= factor;
+    std::string all;
+    for (const std::string& w : compare_recording(rec, model).warnings) all += w + "\n";
+    return all;
+  };
+  EXPECT_EQ(notes(1.0).find("opposite"), std::string::npos) << notes(1.0);
+  EXPECT_EQ(notes(0.6).find("opposite"), std::string::npos);   // too stiff a model is not a convention
+  EXPECT_EQ(notes(0.6).find("radians"), std::string::npos);
+  const std::string neg = notes(-1.0);
+  EXPECT_NE(neg.find("runs opposite to the model's (least-squares fit measured = -0.9"), std::string::npos) << neg;
+  EXPECT_NE(neg.find("negate angle_deg"), std::string::npos) << neg;
+  const std::string rad = notes(3.14159265358979 / 180.0);
+  EXPECT_NE(rad.find("probably in radians; name the column angle_rad"), std::string::npos) << rad;
+}
+
 TEST(Compare, NoiseFloorRecoversTheTrackingNoise) {
   // Smooth response + Gaussian noise sigma = 0.3 deg + glitches. The MAD estimator of 6000
   // second differences (correlated at lags 1, 2) has a relative standard error of ~2 %; 8 % is

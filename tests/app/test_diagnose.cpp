@@ -244,6 +244,31 @@ TEST(HiddenEffect, PressureLag) {
   EXPECT_NEAR(param(r, c.params[0].name), c.params[0].truth, 0.2 * c.params[0].truth);
 }
 
+// A recording whose angle is counted the other way (the bend's sign reversed) is a convention, not
+// a missing effect: diagnose says so and stops before fitting any candidate to it.
+TEST(Diagnose, ARecordingInTheOppositeSignConventionStopsWithTheFix) {
+  Recording rec = read_measurements_csv(data("none"));
+  for (TrialRecording& t : rec.trials)
+    for (double& v : t.angle_deg.value) v = -v;
+  const fs::path dir = fs::temp_directory_path() / "pneufem_diag_negated";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write_measurements_csv((dir / "data.csv").string(), rec);
+  DiagnoseOptions o;
+  o.data_path = (dir / "data.csv").string();
+  o.out_dir = (dir / "out").string();
+  try {
+    run_diagnosis(Scene::load("", kScene), o);
+    ADD_FAILURE() << "diagnose ran on negated angles";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("runs opposite to the model's"), std::string::npos) << what;
+    EXPECT_NE(what.find("negate angle_deg. diagnose stops here"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out" / "diagnosis.json"));
+  fs::remove_all(dir);
+}
+
 TEST(HiddenEffect, Gravity) {
   const DiagnosisResult r = diagnose("gravity");
   EXPECT_EQ(r.missing_effect, "gravity");
