@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <climits>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -163,8 +164,14 @@ class CanonicalReader {
         conversions_.push_back(source_ + ": column '" + header_names_[i] + "' read as " + kColumns[c] +
                                " (values times " + csv::number_text(factor) + ")");
     }
+    if (column_[kTrial] < 0 && column_[kTime] >= 0) {
+      // No trial column (one trial, or trials one after another as some loggers write them): a
+      // trial starts wherever time_s restarts.
+      auto_trials_ = true;
+      conversions_.push_back(source_ + ": no trial column: the trials are numbered 1, 2, ... where time_s restarts");
+    }
     for (std::size_t c = 0; c < kColumns.size(); ++c) {
-      if (column_[c] >= 0) continue;
+      if (column_[c] >= 0 || (c == kTrial && auto_trials_)) continue;
       if (names.size() == 1 && line.text.find(';') != std::string_view::npos)
         csv::fail(source_, line.number, 1, "the header has no commas but has ';'",
                   "save the file with ',' as the field separator and '.' as the decimal point");
@@ -221,16 +228,16 @@ class CanonicalReader {
                     std::to_string(width_),
                 "remove the extra fields or name them in the header (unnamed extra columns are not ignored)");
 
-    const std::size_t ft = static_cast<std::size_t>(column_[kTrial]);
     long trial = 0;
-    switch (csv::parse_int(fields_[ft], trial)) {
-      case csv::Number::ok: break;
-      case csv::Number::empty: fail_field(line, ft, "is empty", "every row needs its trial number");
-      default:
-        fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is not an integer", "number the trials 1, 2, 3, ...");
+    if (auto_trials_) {
+      double t = 0.0;
+      number(line, kTime, true, t);
+      if (t < last_row_time_) ++auto_trial_;
+      last_row_time_ = t;
+      trial = auto_trial_;
+    } else {
+      read_trial(line, trial);
     }
-    if (trial < INT_MIN || trial > INT_MAX)
-      fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is out of range", "number the trials 1, 2, 3, ...");
 
     double t = 0.0, p = 0.0, a = 0.0;
     number(line, kTime, true, t);
@@ -242,6 +249,18 @@ class CanonicalReader {
     if (has_p) append(line, st.rec.trial, "pressure", st.rec.pressure_kPa, st.pressure, t, p);
     if (has_a) append(line, st.rec.trial, "angle", st.rec.angle_deg, st.angle, t, a);
     return true;
+  }
+
+  void read_trial(const csv::Line& line, long& trial) {
+    const std::size_t ft = static_cast<std::size_t>(column_[kTrial]);
+    switch (csv::parse_int(fields_[ft], trial)) {
+      case csv::Number::ok: break;
+      case csv::Number::empty: fail_field(line, ft, "is empty", "every row needs its trial number");
+      default:
+        fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is not an integer", "number the trials 1, 2, 3, ...");
+    }
+    if (trial < INT_MIN || trial > INT_MAX)
+      fail_field(line, ft, "= " + csv::quoted(fields_[ft]) + " is out of range", "number the trials 1, 2, 3, ...");
   }
 
   TrialState& trial_state(int trial) {
@@ -290,7 +309,10 @@ class CanonicalReader {
   std::vector<std::string> header_names_;
   std::array<int, 4> column_{};
   std::array<double, 4> scale_{};           ///< factor from the file's unit to the canonical one
-  std::vector<std::string> conversions_;    ///< one note per converted column
+  std::vector<std::string> conversions_;    ///< one note per converted column (or the trial numbering)
+  bool auto_trials_ = false;                ///< no trial column: numbered where time_s restarts
+  long auto_trial_ = 1;
+  double last_row_time_ = -INFINITY;
   std::size_t width_ = 0;
   std::vector<TrialState> trials_;
   std::map<int, std::size_t> trial_index_;  // ordered: the output is sorted by trial number

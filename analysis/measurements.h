@@ -15,6 +15,7 @@
 //    are converted on reading, with a warning naming the column and the factor: time_ms, time_min;
 //    pressure_Pa, pressure_hPa, pressure_mbar, pressure_bar, pressure_MPa, pressure_psi;
 //    angle_rad; trial_number for trial. A name without a unit ("pressure") is an error;
+//  * without a trial column the trials are numbered 1, 2, ... where time_s restarts (a note says so);
 //    an optional UTF-8 byte-order mark and CRLF line ends are accepted;
 //  * one row per time stamp; the pressure and angle streams have different rates, so either cell
 //    may be empty (a row with both empty is skipped with a warning);

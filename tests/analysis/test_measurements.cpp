@@ -212,6 +212,20 @@ TEST(MeasurementsCsv, ColumnsInOtherUnitsAreConvertedAndReported) {
   }
 }
 
+// Loggers that write one file per session without a trial column: a trial starts where the time
+// restarts (and a single run is trial 1), said in a note.
+TEST(MeasurementsCsv, WithoutATrialColumnTrialsStartWhereTheTimeRestarts) {
+  const Recording r = parse_measurements_csv(
+      "time_s,pressure_kPa,angle_deg\n0,0,0\n0.5,5,1\n1.0,5,1.1\n0,0,0.2\n0.5,5,1.3\n", "log.csv");
+  ASSERT_EQ(r.trials.size(), 2u);
+  EXPECT_EQ(r.trials[0].trial, 1);
+  EXPECT_EQ(r.trials[1].trial, 2);
+  EXPECT_EQ(r.trials[0].angle_deg.value, (std::vector<double>{0, 1, 1.1}));
+  EXPECT_EQ(r.trials[1].angle_deg.value, (std::vector<double>{0.2, 1.3}));
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0], "log.csv: no trial column: the trials are numbered 1, 2, ... where time_s restarts");
+}
+
 TEST(MeasurementsCsvErrors, MissingFileNamesThePath) {
   const std::string path = testing::temp_path("does_not_exist.csv");
   try {
