@@ -140,7 +140,28 @@ struct Loc {
   int line = 0;  ///< 1-based
 };
 
-enum class Block { None, Skip, Node, Element, NodeSet, ElementSet, Surface, Dload, Boundary };
+enum class Block { None, Skip, Node, Element, SurfaceElement, NodeSet, ElementSet, Surface, Dload, Boundary };
+
+/// Nodes of a triangular surface/shell/membrane/plane element type, or 0. Meshers (Gmsh among
+/// them) write a deck's named boundary surfaces as such elements; pneufem reads them as faces of
+/// its tetrahedra (DeckReader::finish).
+int triangle_nodes(const std::string& type) {
+  static const std::set<std::string> three = {"CPS3", "CPE3", "CAX3", "S3", "S3R", "S3RS", "STRI3", "M3D3",
+                                              "SFM3D3", "DS3", "R3D3"};
+  static const std::set<std::string> six = {"CPS6", "CPS6M", "CPE6", "CPE6M", "CAX6", "CAX6M", "S6",
+                                            "STRI65", "M3D6", "SFM3D6", "DS6"};
+  return three.count(type) ? 3 : six.count(type) ? 6 : 0;
+}
+
+/// Line and quadrilateral elements (trusses, beams, quad shells and planes): nothing a tetrahedral
+/// model can use; a mesher writes them for named curves or quad-meshed faces.
+bool skipped_element_type(const std::string& type) {
+  static const std::set<std::string> skipped = {"T2D2", "T2D3", "T3D2", "T3D3", "B21", "B22", "B31", "B32", "B33",
+                                                "R2D2", "CPS4", "CPS4R", "CPE4", "CPE4R", "CAX4", "CAX4R", "S4",
+                                                "S4R", "M3D4", "M3D4R", "SFM3D4", "CPS8", "CPS8R", "CPE8", "CPE8R",
+                                                "S8R", "M3D8", "M3D8R", "R3D4"};
+  return skipped.count(type) != 0;
+}
 
 constexpr int kMaxIncludeDepth = 32;
 constexpr std::size_t kMaxRegions = 65535;  // Mesh::region holds std::uint16_t
@@ -280,6 +301,11 @@ class DeckReader {
   }
 
   void end_block() {
+    if (block_ == Block::SurfaceElement && !pending_.empty())
+      fail(pending_loc_,
+           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
+               " nodes but a " + surface_type_ + " has " + std::to_string(surface_npe_),
+           "list all its nodes (a line ending with ',' continues on the next data line)");
     if (block_ == Block::Element && !pending_.empty()) {
       fail(pending_loc_,
            "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
@@ -303,6 +329,8 @@ class DeckReader {
         return node_line(loc);
       case Block::Element:
         return element_line(loc);
+      case Block::SurfaceElement:
+        return surface_element_line(loc);
       case Block::NodeSet:
       case Block::ElementSet:
         return set_line(loc);
@@ -361,6 +389,14 @@ class DeckReader {
       fail(loc, "*ELEMENT, INPUT= is not supported", "put the element lines in a file read with *INCLUDE");
     const std::string type = upper(kw.get("TYPE"));
     if (type.empty()) fail(loc, "*ELEMENT without TYPE=", "add TYPE=C3D4 or TYPE=C3D10");
+    if (const int n = triangle_nodes(type); n > 0) return begin_surface_elements(kw, loc, type, n);
+    if (skipped_element_type(type)) {
+      warn_once("type " + type, loc,
+                "*ELEMENT, TYPE=" + type + " skipped (line and quadrilateral elements: a tetrahedral model uses "
+                "triangles for named surfaces)");
+      block_ = Block::Skip;
+      return;
+    }
     ElementType et;
     if (type == "C3D4" || type == "C3D4H") {
       et = ElementType::Tet4;
@@ -370,8 +406,8 @@ class DeckReader {
       type_name_ = "C3D10";
     } else {
       fail(loc, "element type " + type + " is not supported (pneufem has only C3D4 and C3D10 tetrahedra)",
-           "convert the mesh to C3D4 or C3D10 tetrahedra, or delete this *ELEMENT block if it holds surface "
-           "or line elements");
+           "convert the mesh to C3D4 or C3D10 tetrahedra (triangular surface elements such as CPS3/CPS6/S3 "
+           "are read as named surfaces; line and quadrilateral elements are skipped)");
     }
     if (type != type_name_)
       warn_once("type " + type, loc,
@@ -443,6 +479,95 @@ class DeckReader {
     mesh.region.push_back(region_);
     if (open_members_) open_members_->push_back(index);
     pending_.clear();
+  }
+
+  // ---- triangular surface elements (a mesher's named surfaces) -----------------------------------
+  void begin_surface_elements(const Keyword& kw, const Loc& loc, const std::string& type, int nodes) {
+    surface_type_ = type;
+    surface_npe_ = nodes;
+    surface_set_ = upper(kw.get("ELSET"));
+    if (surface_set_.empty())
+      fail(loc, "*ELEMENT, TYPE=" + type + " without ELSET=",
+           "name the surface (ELSET=CAVITY, say): pneufem reads triangular elements as named surfaces");
+    warn_once("surface " + surface_set_, loc,
+              "*ELEMENT, TYPE=" + type + ", ELSET=" + surface_set_ +
+                  " read as faces of the tetrahedra: surface and node set " + surface_set_ +
+                  " (usable as mesh.cavity_surface, fixed_set, tip_set)");
+    block_ = Block::SurfaceElement;
+  }
+
+  void surface_element_line(const Loc& loc) {
+    if (pending_.empty()) pending_loc_ = loc;
+    for (const std::string_view f : fields_) {
+      const std::optional<long> v = parse_long(f);
+      if (!v)
+        fail(loc, "surface element: '" + std::string(f) + "' is not an integer",
+             "an *ELEMENT data line is 'id, node1, node2, ...'");
+      pending_.push_back(*v);
+    }
+    const std::size_t need = static_cast<std::size_t>(surface_npe_) + 1;
+    if (pending_.size() < need && trailing_comma_) return;
+    if (pending_.size() != need)
+      fail(pending_loc_,
+           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
+               " nodes but a " + surface_type_ + " has " + std::to_string(surface_npe_),
+           "fix the connectivity (or the TYPE= of the block)");
+    SurfaceTriangle t{pending_[0], pending_loc_, {}};
+    for (int k = 0; k < 3; ++k) {
+      const auto it = node_index_.find(pending_[static_cast<std::size_t>(k) + 1]);
+      if (it == node_index_.end())
+        fail(pending_loc_,
+             "element " + std::to_string(t.id) + " refers to node " + std::to_string(pending_[k + 1]) +
+                 ", which is not defined",
+             "define the node under *NODE before this *ELEMENT block, or fix the connectivity");
+      t.corners[static_cast<std::size_t>(k)] = it->second;
+    }
+    surface_elements_[surface_set_].push_back(t);
+    pending_.clear();
+  }
+
+  /// Each triangle of a surface element set -> the boundary face of the tetrahedron it covers
+  /// (matched by its three corner nodes, so the triangle's own node order and order do not
+  /// matter, and the face's outward normal, which orients the cavity pressure, comes from the
+  /// tetrahedron). The set becomes a surface and, unless a node set of that name exists, a node
+  /// set of the faces' nodes.
+  void resolve_surface_elements() {
+    if (surface_elements_.empty()) return;
+    Mesh& mesh = deck_.mesh;
+    std::map<std::array<int, 3>, std::pair<FaceRef, int>> faces;  // sorted corners -> face, times seen
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      for (int f = 0; f < 4; ++f) {
+        const int* ln = face_local_nodes(mesh.type, f);
+        std::array<int, 3> key = {mesh.element(e)[ln[0]], mesh.element(e)[ln[1]], mesh.element(e)[ln[2]]};
+        std::sort(key.begin(), key.end());
+        auto [it, inserted] = faces.try_emplace(key, FaceRef{e, f}, 0);
+        ++it->second.second;
+      }
+    const int npf = nodes_per_face(mesh.type);
+    for (const auto& [name, tris] : surface_elements_) {
+      std::vector<FaceRef>& surface = mesh.surfaces[name];
+      std::vector<int> nodes;
+      for (const SurfaceTriangle& t : tris) {
+        std::array<int, 3> key = t.corners;
+        std::sort(key.begin(), key.end());
+        const auto it = faces.find(key);
+        if (it == faces.end())
+          fail(t.loc, "surface element " + std::to_string(t.id) + " (ELSET=" + name + ") matches no face of the tetrahedra",
+               "its first three nodes must be the corners of a tetrahedron's face (export the surface from the same mesh)");
+        if (it->second.second > 1)
+          fail(t.loc,
+               "surface element " + std::to_string(t.id) + " (ELSET=" + name +
+                   ") lies inside the solid: two tetrahedra share that face",
+               "a named surface (a cavity, a clamped face) must lie on the boundary of the mesh");
+        surface.push_back(it->second.first);
+        const int* ln = face_local_nodes(mesh.type, it->second.first.local_face);
+        for (int a = 0; a < npf; ++a) nodes.push_back(mesh.element(it->second.first.element)[ln[a]]);
+      }
+      if (!mesh.node_sets.count(name)) {
+        normalise(nodes);
+        mesh.node_sets[name] = std::move(nodes);
+      }
+    }
   }
 
   // ---- *NSET / *ELSET -----------------------------------------------------------------------
@@ -698,6 +823,7 @@ class DeckReader {
       fail(end, "the deck defines no elements", "add an *ELEMENT, TYPE=C3D4 or TYPE=C3D10 block");
     for (auto& [name, v] : mesh.node_sets) normalise(v);
     for (auto& [name, v] : mesh.element_sets) normalise(v);
+    resolve_surface_elements();
     for (auto& [name, faces] : mesh.surfaces) {  // a face listed twice would be loaded twice
       std::unordered_set<long long> seen;
       std::erase_if(faces, [&](const FaceRef& f) {
@@ -749,6 +875,14 @@ class DeckReader {
   int npe_ = 0;
   std::uint16_t region_ = 0;
   std::vector<long> pending_;  // element id + nodes read so far (continuation lines)
+  struct SurfaceTriangle {
+    long id;
+    Loc loc;
+    std::array<int, 3> corners;  // node indices
+  };
+  std::map<std::string, std::vector<SurfaceTriangle>> surface_elements_;  // ELSET -> triangles
+  std::string surface_type_, surface_set_;
+  int surface_npe_ = 0;
   Loc pending_loc_;
 
   std::unordered_map<long, int> node_index_;

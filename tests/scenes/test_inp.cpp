@@ -16,6 +16,9 @@
 #include <vector>
 
 #include "materials/errors.h"
+#include "engine/assembly.h"
+#include "engine/quasi_static.h"
+#include "scenes/build_model.h"
 #include "scenes/inp.h"
 
 namespace pneufem {
@@ -367,6 +370,75 @@ TEST_F(InpFiles, RoundTripOfAGeneratedTet10MeshKeepsOrderAndPrecision) {
   for (int i = 0; i < m.num_nodes(); ++i)
     exact += m.X[static_cast<std::size_t>(i)] == back.X[static_cast<std::size_t>(i)];
   EXPECT_GT(exact, m.num_nodes() / 2);
+}
+
+// A mesher's deck: Gmsh and others write named boundary surfaces as triangular elements (CPS6 for
+// a second-order mesh), not as an element-face *SURFACE. The cavity given so, its triangles in
+// either winding, is the cavity of the *SURFACE deck (same faces, a node set of their nodes), and
+// the actuator bends the same; line elements are skipped with a note.
+TEST_F(InpFiles, TriangularSurfaceElementsAreNamedSurfaces) {
+  const Mesh mesh = build_mesh(Scene::load("", {"geometry.chambers=2", "mesh.h_mm=6.0"}));
+  std::ostringstream os;
+  write_inp_mesh(os, mesh, 1e-3);
+  const std::string faces_deck = os.str();
+  std::string deck = faces_deck;
+  const std::size_t a = deck.find("*SURFACE, NAME=CAVITY");
+  ASSERT_NE(a, std::string::npos);
+  deck.erase(a, deck.find('*', a + 1) - a);
+  std::string tris = "*ELEMENT, TYPE=CPS6, ELSET=CAVITY\n";
+  long id = *std::max_element(mesh.element_ids.begin(), mesh.element_ids.end());
+  int k = 0;
+  for (const FaceRef& f : mesh.surfaces.at("CAVITY")) {
+    const int* ln = face_local_nodes(mesh.type, f.local_face);
+    std::array<long, 6> n{};
+    for (int j = 0; j < 6; ++j) n[static_cast<std::size_t>(j)] = mesh.node_ids[static_cast<std::size_t>(mesh.element(f.element)[ln[j]])];
+    if (k++ % 2) n = {n[0], n[2], n[1], n[5], n[4], n[3]};  // the other winding
+    tris += std::to_string(++id);
+    for (long v : n) tris += ", " + std::to_string(v);
+    tris += "\n";
+  }
+  deck += tris + "*ELEMENT, TYPE=T3D3, ELSET=EDGE\n" + std::to_string(++id) + ", 1, 2, 3\n";
+  const std::string gmsh_path = write("gmsh.inp", deck), faces_path = write("faces.inp", faces_deck);
+  const InpDeck A = read_inp(faces_path, 1e-3), B = read_inp(gmsh_path, 1e-3);
+  ASSERT_EQ(B.mesh.num_elements(), A.mesh.num_elements());  // the triangles are not elements
+  std::vector<FaceRef> fa = A.mesh.surfaces.at("CAVITY"), fb = B.mesh.surfaces.at("CAVITY");
+  auto less = [](const FaceRef& x, const FaceRef& y) { return std::tie(x.element, x.local_face) < std::tie(y.element, y.local_face); };
+  std::sort(fa.begin(), fa.end(), less);
+  std::sort(fb.begin(), fb.end(), less);
+  EXPECT_EQ(fa, fb);
+  std::vector<int> nodes;
+  for (const FaceRef& f : fa)
+    for (int j = 0; j < 6; ++j) nodes.push_back(A.mesh.element(f.element)[face_local_nodes(A.mesh.type, f.local_face)[j]]);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  EXPECT_EQ(B.mesh.node_sets.at("CAVITY"), nodes);
+  EXPECT_EQ(count_containing(B.warnings, "TYPE=CPS6, ELSET=CAVITY read as faces of the tetrahedra"), 1);
+  EXPECT_EQ(count_containing(B.warnings, "TYPE=T3D3 skipped"), 1);
+
+  auto angle_at_5kPa = [](const std::string& path) {
+    auto bm = build_model(Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"",
+                                           "mesh.symmetry_set=\"SYMMETRY\"", "load.max_kPa=5.0"}));
+    const Assembler asmb(bm->model);
+    QuasiStaticRun run(asmb, bm->solver.quasi_static);
+    double last = 0.0;
+    run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { last = r.angle_deg; });
+    return last;
+  };
+  const double angle_faces = angle_at_5kPa(faces_path), angle_gmsh = angle_at_5kPa(gmsh_path);
+  EXPECT_GT(angle_faces, 0.05);
+  // The same faces summed in another order: equal to round-off (rel_tol 1e-8 equilibria).
+  EXPECT_NEAR(angle_gmsh, angle_faces, 1e-7 * angle_faces);
+}
+
+TEST_F(InpFiles, SurfaceElementsOffTheBoundaryAreRejected) {
+  // Two tets sharing the face 2-3-4: a triangle there is inside the solid; one on no face at all.
+  const std::string two = "*NODE\n1,0,0,0\n2,1,0,0\n3,0,1,0\n4,0,0,1\n5,1,1,1\n"
+                          "*ELEMENT, TYPE=C3D4, ELSET=B\n1, 1, 2, 3, 4\n2, 2, 3, 4, 5\n";
+  expect_error(two + "*ELEMENT, TYPE=CPS3, ELSET=S\n10, 2, 3, 4\n", 11,
+               {"surface element 10 (ELSET=S) lies inside the solid", "boundary of the mesh"});
+  expect_error(two + "*ELEMENT, TYPE=CPS3, ELSET=S\n10, 1, 2, 5\n", 11,
+               {"surface element 10 (ELSET=S) matches no face of the tetrahedra", "corners of a tetrahedron's face"});
+  expect_error(two + "*ELEMENT, TYPE=CPS3\n10, 1, 2, 3\n", 10, {"without ELSET=", "name the surface"});
 }
 
 TEST(InpWrite, RefusesNamesADeckCannotHold) {
