@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <initializer_list>
@@ -9,6 +10,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+
+#include <Eigen/Eigenvalues>
 
 #include "damage/effects.h"
 #include "damage/registry.h"
@@ -362,6 +365,64 @@ MaterialPtr make_base_material(const Scene& s, const std::string& name) {
                            "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
 }
 
+/// Vector text for messages, e.g. "[0.0, -1.0, 0.0]" (rounded to 3 decimals: a hint, not data).
+std::string vec_text(const Eigen::Vector3d& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%.3f, %.3f, %.3f]", v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
+  return buf;
+}
+
+/// The angle's frame against the mesh, for decks oriented otherwise than the built-in actuator
+/// (whose defaults the scene keys are). The clamped nodes (all three dofs fixed) of a plane end
+/// face give its outward normal: angle.fixed_normal more than ~25 deg off it would measure the
+/// rotation in a wrong plane, so that is an error naming the normal to use. The inextensible
+/// (stiffest, 100x the softest) part lies on the side the actuator curls to: a bend_direction
+/// pointing away from it only flips the angle's sign, so that is a warning.
+void check_angle_frame(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
+  const Mesh& mesh = model.mesh;
+  Eigen::Vector3d body = Eigen::Vector3d::Zero();
+  for (const auto& x : mesh.X) body += x;
+  body /= static_cast<double>(mesh.num_nodes());
+  std::vector<Eigen::Vector3d> clamped;
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
+  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
+  if (clamped.size() >= 3) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const auto& x : clamped) c += x;
+    c /= static_cast<double>(clamped.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& x : clamped) cov += (x - c) * (x - c).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);  // ascending eigenvalues
+    const bool planar = es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0;
+    Eigen::Vector3d n_fit = es.eigenvectors().col(0);
+    if (n_fit.dot(c - body) < 0.0) n_fit = -n_fit;  // outward: away from the body
+    if (planar && (c - body).norm() > 0.0 && n_fit.dot(n_given) < 0.9)
+      s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
+                                   "normal is " + vec_text(n_fit) + ": set angle.fixed_normal = " + vec_text(n_fit) +
+                                   " and angle.bend_direction perpendicular to it, towards the inextensible layer");
+  }
+  double mu_min = INFINITY, mu_max = 0.0;
+  for (const Part& p : model.parts) {
+    mu_min = std::min(mu_min, p.material->initial_shear_modulus());
+    mu_max = std::max(mu_max, p.material->initial_shear_modulus());
+  }
+  if (!(mu_max > 100.0 * mu_min)) return;
+  Eigen::Vector3d layer = Eigen::Vector3d::Zero();
+  double count = 0.0;
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    if (model.material_of(e).initial_shear_modulus() == mu_max)
+      for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
+  Eigen::Vector3d side = layer / count - body;
+  side -= side.dot(n_given) * n_given;  // across the actuator, not along it
+  const Eigen::Vector3d d = model.angle.bend_direction.normalized();
+  if (side.norm() > 0.0 && d.dot(side.normalized()) < -0.5)
+    warnings.push_back("angle.bend_direction " + vec_text(d) + " points away from the inextensible layer (towards " +
+                       vec_text(-side.normalized()) + "), to which the actuator curls: its angles will come out "
+                       "negative; set angle.bend_direction = " + vec_text(side.normalized()) +
+                       " for the usual positive convention");
+}
+
 }  // namespace
 
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
@@ -514,6 +575,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
   if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
+  check_angle_frame(s, model, out->warnings);
   out->stats = compute_stats(mesh);
 
   // Load.

@@ -441,6 +441,37 @@ TEST_F(InpFiles, SurfaceElementsOffTheBoundaryAreRejected) {
   expect_error(two + "*ELEMENT, TYPE=CPS3\n10, 1, 2, 3\n", 10, {"without ELSET=", "name the surface"});
 }
 
+// A deck oriented otherwise than the built-in actuator (here along x instead of y): the default
+// angle.fixed_normal would measure the rotation in a wrong plane, so the model is refused with the
+// normal to use; a bend direction pointing away from the fabric only flips the sign: a warning.
+TEST_F(InpFiles, TheAngleFrameIsCheckedAgainstTheClampedFaceAndTheLayer) {
+  Mesh mesh = build_mesh(Scene::load("", {"geometry.chambers=2", "mesh.h_mm=6.0", "mesh.half=false"}));
+  for (Eigen::Vector3d& x : mesh.X) x = Eigen::Vector3d(x.y(), -x.x(), x.z());  // y -> x: along x now
+  std::ostringstream os;
+  write_inp_mesh(os, mesh, 1e-3);
+  const std::string path = write("along_x.inp", os.str());
+  auto scene = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\""});
+    return Scene::load("", extra);
+  };
+  try {
+    build_model(scene({}));
+    ADD_FAILURE() << "the default frame was accepted for a deck along x";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("angle.fixed_normal"), std::string::npos) << what;
+    EXPECT_NE(what.find("outward normal is [-1.000, 0.000, 0.000]: set angle.fixed_normal = [-1.000, 0.000, 0.000]"),
+              std::string::npos) << what;
+  }
+  const auto ok = build_model(scene({"angle.fixed_normal=[-1.0, 0.0, 0.0]"}));
+  EXPECT_EQ(count_containing(ok->warnings, "angle.bend_direction"), 0);
+  const auto flipped = build_model(scene({"angle.fixed_normal=[-1.0, 0.0, 0.0]", "angle.bend_direction=[0.0, 0.0, 1.0]"}));
+  EXPECT_EQ(count_containing(flipped->warnings, "points away from the inextensible layer"), 1);
+  EXPECT_EQ(count_containing(flipped->warnings, "set angle.bend_direction = [0.000, 0.000, -1.000]"), 1);
+  // The built-in actuator with its own defaults: neither.
+  EXPECT_EQ(count_containing(build_model(Scene::load("", {"geometry.chambers=2", "mesh.h_mm=6.0"}))->warnings, "angle"), 0);
+}
+
 TEST(InpWrite, RefusesNamesADeckCannotHold) {
   Mesh m = read_inp(data_path("tet4_two.inp"), 0.01).mesh;
   m.node_sets["two words"] = {0};
