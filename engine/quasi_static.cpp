@@ -18,6 +18,7 @@ namespace pneufem {
 namespace {
 constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;   // "PNEFCKP1"
 constexpr std::uint64_t kMagic2 = 0x32504b4346454e50ULL;  // "PNEFCKP2": + error-control memory
+constexpr std::uint64_t kMagic3 = 0x33504b4346454e50ULL;  // "PNEFCKP3": + ramp-start memory
 
 template <class T>
 void put(std::ostream& os, const T& v) {
@@ -68,7 +69,7 @@ HistoryStep history_step(const std::vector<double>& prev, const std::vector<doub
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
-  put(os, kMagic2);
+  put(os, kMagic3);
   put(os, static_cast<std::uint64_t>(next_segment));
   put(os, dt_suggest_s);
   put(os, last_angle_deg);
@@ -84,13 +85,15 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put_vec(os, hist_cur.data(), hist_cur.size());
   put(os, h_prev_s);
   put(os, rate_prev_Pa_s);
+  put(os, ramp_start_dp_Pa[0]);
+  put(os, ramp_start_dp_Pa[1]);
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
   QuasiStaticCheckpoint c;
   std::uint64_t magic = 0, seg = 0;
   get(is, magic);
-  if (magic != kMagic && magic != kMagic2) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  if (magic != kMagic && magic != kMagic2 && magic != kMagic3) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
   get(is, seg);
   c.next_segment = static_cast<std::size_t>(seg);
   get(is, c.dt_suggest_s);
@@ -107,11 +110,15 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   get(is, c.stats.rejected_steps);
   get(is, c.stats.relaxation_iterations);
   get(is, c.stats.wall_s);
-  if (magic == kMagic2) {
+  if (magic == kMagic2 || magic == kMagic3) {
     c.hist_prev = get_vec(is);
     c.hist_cur = get_vec(is);
     get(is, c.h_prev_s);
     get(is, c.rate_prev_Pa_s);
+  }
+  if (magic == kMagic3) {
+    get(is, c.ramp_start_dp_Pa[0]);
+    get(is, c.ramp_start_dp_Pa[1]);
   }
   if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size)
     throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
@@ -188,6 +195,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     if (span > 0.0 || s.p0 != s.p1) equilibrium(s.p0, s.p1, s.g0, s.g1);
     hist_prev_.clear();  // a jump or an elastic state: the history memory is stale
     hist_cur_.clear();
+    ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
     return;
   }
   auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
@@ -195,7 +203,22 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   const bool error_control = opt_.time_control == TimeControl::Error;
   const double rate = (s.p1 - s.p0) / span;
   // A kink of the load (its rate changes): the last step's rate says nothing about this one.
-  if (std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_))) hist_prev_.clear();
+  const bool kink = std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_));
+  if (kink) hist_prev_.clear();
+  // A ramp that starts after a hold would otherwise be tried in the hold's long step, i.e. over the
+  // whole ramp: a full Newton solve of the load increment, then rejected for its history change
+  // and cut down by at most 5x per try (2-3 rejected solves per ramp of the staircase, ~27 % of a
+  // trial's Newton iterations at h = 6). The previous ramp's start in the same direction, as a
+  // pressure increment, is a far better first guess: ramps of a climb get harder, so it is at
+  // worst rejected as a short step. Forgotten at a release (span 0), where a new climb starts.
+  // Only ramps after a hold (rate 0, as in a staircase) use and set it: between the segments of
+  // a sampled pressure record the rate changes at every sample, and an increment learnt on a slow
+  // segment would needlessly shorten the next fast one.
+  const int dir = rate > 0.0 ? 1 : 0;
+  const bool ramp_start = kink && rate != 0.0 && rate_prev_ == 0.0;
+  if (ramp_start && ramp_start_dp_[dir] > 0.0)
+    dt_suggest_ = std::max(opt_.min_dt_s, std::min(dt_suggest_, ramp_start_dp_[dir] / std::abs(rate)));
+  bool first_step = true;
   double t = s.g0;
   long steps = 0;
   double last_change = 0.0, last_h = 0.0;
@@ -221,6 +244,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     const bool minimal = dt_suggest_ <= opt_.min_dt_s * (1.0 + 1e-9);
     double h = std::min(dt_suggest_, s.g1 - t);
     if (s.g1 - (t + h) < 0.25 * h) h = s.g1 - t;  // do not leave a sliver
+    const bool by_control = h == dt_suggest_;  // not cut or stretched to the segment's end
     const Eigen::VectorXd u_saved = u_;
     const std::vector<double> state_saved = state_;
     const StaticSolver::Path path_saved = newton_.path();
@@ -263,6 +287,10 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     }
     const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
     dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+    // The ramp's first step, when the control (not the segment's end) set its length: the step
+    // the control would now take, as a pressure increment, starts the next ramp.
+    if (ramp_start && first_step && by_control) ramp_start_dp_[dir] = dt_suggest_ * std::abs(rate);
+    first_step = false;
     if (error_control) {
       hist_prev_ = std::move(hist_cur_);
       h_prev_ = h;
@@ -314,6 +342,8 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     hist_cur_ = resume->hist_cur;
     h_prev_ = resume->h_prev_s;
     rate_prev_ = resume->rate_prev_Pa_s;
+    ramp_start_dp_[0] = resume->ramp_start_dp_Pa[0];
+    ramp_start_dp_[1] = resume->ramp_start_dp_Pa[1];
     wall_before = stats_.wall_s;
   }
   // The run starts from u = 0, which is an equilibrium only without load. When the load history
@@ -369,6 +399,8 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.hist_cur = hist_cur_;
       c.h_prev_s = h_prev_;
       c.rate_prev_Pa_s = rate_prev_;
+      c.ramp_start_dp_Pa[0] = ramp_start_dp_[0];
+      c.ramp_start_dp_Pa[1] = ramp_start_dp_[1];
       sink(c);
     }
   }

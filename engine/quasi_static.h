@@ -85,6 +85,9 @@ struct QuasiStaticCheckpoint {
   /// (damage, viscous strain) at its start (error control only) and end, its length and load rate.
   std::vector<double> hist_prev, hist_cur;
   double h_prev_s = 0.0, rate_prev_Pa_s = 0.0;
+  /// The first step of the last falling [0] and rising [1] ramp since the last release, as the
+  /// pressure increment the control suggested after it (Pa; 0 = none): the next ramp's first guess.
+  double ramp_start_dp_Pa[2] = {0.0, 0.0};
 
   void write(std::ostream& os) const;
   /// Throws InputError when the stream is not a checkpoint of a model with `dofs` and `state_size`.
@@ -132,6 +135,7 @@ class QuasiStaticRun {
   // The last accepted step, as in the checkpoint (hist_cur_: the current history's scalars).
   std::vector<double> hist_prev_, hist_cur_;
   double h_prev_ = 0.0, rate_prev_ = 0.0;
+  double ramp_start_dp_[2] = {0.0, 0.0};  // as QuasiStaticCheckpoint::ramp_start_dp_Pa
 };
 
 }  // namespace pneufem
