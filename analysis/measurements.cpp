@@ -172,9 +172,6 @@ class CanonicalReader {
     }
     for (std::size_t c = 0; c < kColumns.size(); ++c) {
       if (column_[c] >= 0 || (c == kTrial && auto_trials_)) continue;
-      if (names.size() == 1 && line.text.find(';') != std::string_view::npos)
-        csv::fail(source_, line.number, 1, "the header has no commas but has ';'",
-                  "save the file with ',' as the field separator and '.' as the decimal point");
       std::string have;
       for (const std::string& n : header_names_) have += (have.empty() ? "" : ",") + n;
       csv::fail(source_, line.number, 1,
@@ -321,8 +318,40 @@ class CanonicalReader {
 
 }  // namespace
 
+namespace {
+/// The field separator of a file whose header (first non-blank line) has no comma: ';' (how
+/// spreadsheets save "CSV" in locales with a decimal comma) or a tab; 0 for a comma-separated file.
+char foreign_separator(std::string_view text) {
+  csv::LineCursor lines(text);
+  csv::Line line;
+  while (lines.next(line)) {
+    if (csv::trim(line.text).empty()) continue;
+    if (line.text.find(',') != std::string_view::npos) return 0;
+    if (line.text.find(';') != std::string_view::npos) return ';';
+    if (line.text.find('\t') != std::string_view::npos) return '\t';
+    return 0;
+  }
+  return 0;
+}
+}  // namespace
+
 Recording parse_measurements_csv(std::string_view text, const std::string& source) {
-  return CanonicalReader(text, source).read();
+  const char sep = foreign_separator(text);
+  if (sep == 0) return CanonicalReader(text, source).read();
+  // A ';'- or tab-separated file: its commas can only be decimal marks ("0,25"). One character
+  // for one, so every line and column number in a message is the file's own.
+  std::string comma_separated(text);
+  long decimal_commas = 0;
+  for (char& c : comma_separated) {
+    if (c == ',') c = '.', ++decimal_commas;
+    else if (c == sep) c = ',';
+  }
+  Recording rec = CanonicalReader(comma_separated, source).read();
+  rec.warnings.insert(rec.warnings.begin(),
+                      source + ": read as " + (sep == ';' ? "';'" : "tab") + "-separated" +
+                          (decimal_commas > 0 ? ", with ',' as the decimal mark" : "") +
+                          " (the header has no commas); check the values in the report");
+  return rec;
 }
 
 Recording read_measurements_csv(const std::string& path) {

@@ -17,6 +17,8 @@
 //    angle_rad; trial_number for trial. A name without a unit ("pressure") is an error;
 //  * without a trial column the trials are numbered 1, 2, ... where time_s restarts (a note says so);
 //    an optional UTF-8 byte-order mark and CRLF line ends are accepted;
+//  * a file whose header has no commas but ';' or tabs (how spreadsheets in decimal-comma locales
+//    save CSV) is read with that separator and ',' as the decimal mark, with a note;
 //  * one row per time stamp; the pressure and angle streams have different rates, so either cell
 //    may be empty (a row with both empty is skipped with a warning);
 //  * time_s restarts (typically at 0) for every trial; within a trial the pressure samples must

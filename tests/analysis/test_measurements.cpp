@@ -151,7 +151,7 @@ TEST(MeasurementsCsvErrors, MessagesNameFileLineAndColumn) {
       {"trial,time_s,pressure,angle_deg\n1,0,1,2\n",
        "data.csv:1:1: missing column 'pressure_kPa' (the header is 'trial,time_s,pressure,angle_deg'); the header has "
        "'pressure': rename it to pressure_kPa"},
-      {"trial;time_s;pressure_kPa;angle_deg\n1;0;1;2\n", "data.csv:1:1: the header has no commas but has ';'; "},
+      {"trial;time_s;pressure_kPa;angle_deg\n1;0;1;2.5.1\n", "data.csv:2:4: angle_deg = '2.5.1' is not a number; "},
       {"trial,time_s,pressure_kPa,angle_deg,Time_s\n", "data.csv:1:5: column 'time_s' appears twice (also field 2); "},
       {h, "data.csv:2:1: no data rows after the header; "},
       {h + "1,0,abc,\n", "data.csv:2:3: pressure_kPa = 'abc' is not a number; "},
@@ -224,6 +224,27 @@ TEST(MeasurementsCsv, WithoutATrialColumnTrialsStartWhereTheTimeRestarts) {
   EXPECT_EQ(r.trials[1].angle_deg.value, (std::vector<double>{0.2, 1.3}));
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_EQ(r.warnings[0], "log.csv: no trial column: the trials are numbered 1, 2, ... where time_s restarts");
+}
+
+// Spreadsheets in locales with a decimal comma save "CSV" with ';' between fields; tab-separated
+// exports exist too. Both read as the comma-separated file with the same numbers, with a note.
+TEST(MeasurementsCsv, SemicolonOrTabSeparatedFilesWithDecimalCommasAreRead) {
+  const Recording ref = parse_measurements_csv("trial,time_s,pressure_kPa,angle_deg\n1,0,0,0\n1,2.5,5,1.25\n", "ref.csv");
+  for (const char* text : {"trial;time_s;pressure_kPa;angle_deg\r\n1;0;0;0\r\n1;2,5;5;1,25\r\n",
+                           "trial\ttime_s\tpressure_kPa\tangle_deg\n1\t0\t0\t0\n1\t2,5\t5\t1,25\n",
+                           "trial;time_s;pressure_kPa;angle_deg\n1;0;0;0\n1;2.5;5;1.25\n"}) {
+    SCOPED_TRACE(text);
+    const Recording r = parse_measurements_csv(text, "eu.csv");
+    ASSERT_EQ(r.trials.size(), 1u);
+    EXPECT_EQ(r.trials[0].pressure_kPa.t_s, ref.trials[0].pressure_kPa.t_s);
+    EXPECT_EQ(r.trials[0].pressure_kPa.value, ref.trials[0].pressure_kPa.value);
+    EXPECT_EQ(r.trials[0].angle_deg.value, ref.trials[0].angle_deg.value);
+    ASSERT_EQ(r.warnings.size(), 1u);
+    EXPECT_NE(r.warnings[0].find("eu.csv: read as "), std::string::npos) << r.warnings[0];
+  }
+  EXPECT_NE(parse_measurements_csv("trial;time_s;pressure_kPa;angle_deg\n1;2,5;5;1\n", "eu.csv").warnings[0].find(
+                "with ',' as the decimal mark"),
+            std::string::npos);
 }
 
 TEST(MeasurementsCsvErrors, MissingFileNamesThePath) {
