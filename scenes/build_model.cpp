@@ -69,8 +69,10 @@ bool fabric_is_membrane(const Scene& s) {
   return v == "membrane";
 }
 
-/// The membrane fabric: the mesher's FABRIC_MEMBRANE faces, thickness geometry.fabric_thickness_mm,
-/// plane-stress St Venant-Kirchhoff with E and nu of materials.fabric (which must be linear_elastic).
+/// The membrane fabric: the faces of surface mesh.fabric_surface (the mesher's FABRIC_MEMBRANE on
+/// the layer's mid-plane, or a deck's surface: an embedded sheet of M3D3/M3D6 elements, a
+/// *SURFACE), thickness geometry.fabric_thickness_mm, plane-stress St Venant-Kirchhoff with E and
+/// nu of materials.fabric (which must be linear_elastic).
 MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   const std::string T = "materials.fabric";
   if (!s.has(T))
@@ -84,9 +86,22 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   const auto* scaled = dynamic_cast<const ScaledMaterial*>(mat.get());
   const auto* svk = dynamic_cast<const SaintVenantKirchhoff*>(scaled ? scaled->base().get() : mat.get());
   if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
+  const std::string name = s.string("mesh.fabric_surface");
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  auto it = mesh.surfaces.find(name);
+  if (it == mesh.surfaces.end()) it = mesh.surfaces.find(upper);
+  if (it == mesh.surfaces.end() || it->second.empty()) {
+    std::string have;
+    for (const auto& [k, v] : mesh.surfaces) have += (have.empty() ? "" : ", ") + k;
+    s.fail("mesh.fabric_surface", "surface '" + name + "' " + (it == mesh.surfaces.end() ? "not found" : "has no faces") +
+                                      " (the mesh has: " + (have.empty() ? "none" : have) +
+                                      "); name the surface that carries the fabric membrane, or use "
+                                      "mesh.fabric_model = \"solid\"");
+  }
   MembraneSet m;
-  m.name = "FABRIC_MEMBRANE";
-  m.nodes = membrane_nodes_of_faces(mesh, mesh.surfaces.at("FABRIC_MEMBRANE"));
+  m.name = it->first;
+  m.nodes = membrane_nodes_of_faces(mesh, it->second);
   m.thickness_m = positive(s, "geometry.fabric_thickness_mm") * kmm;
   // Plane-stress SVK is linear in E: materials.fabric.stiffness_scale scales E exactly (the region
   // scales of [regions] apply to solid elements only).
@@ -468,9 +483,6 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   Mesh& mesh = model.mesh;
   mesh.ensure_ids();
   const bool membrane_fabric = fabric_is_membrane(s);
-  if (membrane_fabric && source != "pneunet")
-    s.fail("mesh.fabric_model", "\"membrane\" needs mesh.source = \"pneunet\" (the built-in mesher places the "
-                                "membrane on the fabric mid-plane); use \"solid\" for a deck");
 
   // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
   for (const std::string& elset : s.table_keys("mesh.regions")) {
@@ -564,6 +576,18 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     model.pressure_faces = it->second;
   }
   if (model.pressure_faces.empty()) s.fail("mesh.cavity_surface", "the cavity surface has no faces");
+  {
+    // A deck's surface may be an embedded sheet (a fabric membrane's faces, shared by two
+    // tetrahedra): pressure there would push on the solid from inside, so a cavity must not.
+    std::set<std::pair<int, int>> outside;
+    for (const FaceRef& f : boundary_faces(mesh)) outside.emplace(f.element, f.local_face);
+    for (const FaceRef& f : model.pressure_faces)
+      if (!outside.count({f.element, f.local_face}))
+        s.fail("mesh.cavity_surface", "'" + cav + "' has a face inside the solid (face " + std::to_string(f.local_face + 1) +
+                                          " of element " + std::to_string(mesh.element_ids[f.element]) +
+                                          ", shared by two tetrahedra): the cavity must be the chambers' boundary; "
+                                          "name the surface of the chamber walls");
+  }
 
   // Bending angle.
   model.angle.tip_nodes = node_set(s, mesh, is_inp ? "mesh.tip_set" : "mesh.tip_set");

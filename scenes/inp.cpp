@@ -293,6 +293,14 @@ class DeckReader {
       block_ = Block::Dload;
     else if (kw.name == "BOUNDARY")
       block_ = Block::Boundary;
+    else if (kw.name == "MEMBRANE SECTION" || kw.name == "SHELL SECTION")
+      // A fabric modelled as membrane or shell elements: its triangles are read as a surface, so
+      // say how to give it stiffness, since a solid-fabric scene would silently leave it out.
+      warn_once("section " + upper(kw.get("ELSET")), loc,
+                "*" + kw.name + ", ELSET=" + upper(kw.get("ELSET")) +
+                    ": its elements are read as a surface, without stiffness; to model them as the fabric set "
+                    "mesh.fabric_model = \"membrane\" and mesh.fabric_surface = \"" + upper(kw.get("ELSET")) +
+                    "\" (thickness geometry.fabric_thickness_mm, E and nu from [materials.fabric])");
     else
       warn_once("keyword " + kw.name, loc,
                 "*" + kw.name +
@@ -492,7 +500,7 @@ class DeckReader {
     warn_once("surface " + surface_set_, loc,
               "*ELEMENT, TYPE=" + type + ", ELSET=" + surface_set_ +
                   " read as faces of the tetrahedra: surface and node set " + surface_set_ +
-                  " (usable as mesh.cavity_surface, fixed_set, tip_set)");
+                  " (usable as mesh.cavity_surface, fixed_set, tip_set, fabric_surface)");
     block_ = Block::SurfaceElement;
   }
 
@@ -547,6 +555,7 @@ class DeckReader {
     for (const auto& [name, tris] : surface_elements_) {
       std::vector<FaceRef>& surface = mesh.surfaces[name];
       std::vector<int> nodes;
+      std::size_t inside = 0;
       for (const SurfaceTriangle& t : tris) {
         std::array<int, 3> key = t.corners;
         std::sort(key.begin(), key.end());
@@ -554,11 +563,7 @@ class DeckReader {
         if (it == faces.end())
           fail(t.loc, "surface element " + std::to_string(t.id) + " (ELSET=" + name + ") matches no face of the tetrahedra",
                "its first three nodes must be the corners of a tetrahedron's face (export the surface from the same mesh)");
-        if (it->second.second > 1)
-          fail(t.loc,
-               "surface element " + std::to_string(t.id) + " (ELSET=" + name +
-                   ") lies inside the solid: two tetrahedra share that face",
-               "a named surface (a cavity, a clamped face) must lie on the boundary of the mesh");
+        if (it->second.second > 1) ++inside;  // an embedded sheet: only a membrane may use it
         surface.push_back(it->second.first);
         const int* ln = face_local_nodes(mesh.type, it->second.first.local_face);
         for (int a = 0; a < npf; ++a) nodes.push_back(mesh.element(it->second.first.element)[ln[a]]);
@@ -567,6 +572,11 @@ class DeckReader {
         normalise(nodes);
         mesh.node_sets[name] = std::move(nodes);
       }
+      if (inside > 0)
+        deck_.warnings.push_back(where(tris.front().loc) + ": " + std::to_string(inside) + " of the " + std::to_string(tris.size()) +
+                                 " triangles of ELSET=" + name +
+                                 " lie inside the solid (two tetrahedra share each): an embedded sheet, usable as "
+                                 "the fabric membrane (mesh.fabric_surface), not as a cavity");
     }
   }
 

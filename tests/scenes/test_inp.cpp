@@ -430,12 +430,79 @@ TEST_F(InpFiles, TriangularSurfaceElementsAreNamedSurfaces) {
   EXPECT_NEAR(angle_gmsh, angle_faces, 1e-7 * angle_faces);
 }
 
-TEST_F(InpFiles, SurfaceElementsOffTheBoundaryAreRejected) {
-  // Two tets sharing the face 2-3-4: a triangle there is inside the solid; one on no face at all.
+// A deck whose fabric is a membrane: Abaqus users model the inextensible layer as membrane (M3D6)
+// or shell elements sharing nodes with the silicone, often embedded in it. The built-in actuator
+// with mesh.fabric_model = "membrane" (its membrane on interior faces, the layer's mid-plane),
+// written as a deck once with a *SURFACE and once with M3D6 elements, bends as the built-in model
+// (same faces, same law; the sums run in another order: to the equilibria's round-off), and an
+// embedded sheet named as the cavity is refused.
+TEST_F(InpFiles, AMembraneFabricOnADeckSurfaceOrEmbeddedElementsBendsAsTheBuiltInOne) {
+  const std::vector<std::string> base = {"geometry.chambers=2", "mesh.h_mm=6.0", "mesh.fabric_model=\"membrane\"",
+                                         "load.max_kPa=5.0"};
+  const Mesh mesh = build_mesh(Scene::load("", base));
+  ASSERT_FALSE(mesh.surfaces.at("FABRIC_MEMBRANE").empty());
+  std::ostringstream os;
+  write_inp_mesh(os, mesh, 1e-3);
+  const std::string faces_deck = os.str();
+  std::string deck = faces_deck;
+  const std::size_t a = deck.find("*SURFACE, NAME=FABRIC_MEMBRANE");
+  ASSERT_NE(a, std::string::npos);
+  deck.erase(a, deck.find('*', a + 1) - a);
+  std::string tris = "*ELEMENT, TYPE=M3D6, ELSET=FABRIC_MEMBRANE\n";
+  long id = *std::max_element(mesh.element_ids.begin(), mesh.element_ids.end());
+  for (const FaceRef& f : mesh.surfaces.at("FABRIC_MEMBRANE")) {
+    const int* ln = face_local_nodes(mesh.type, f.local_face);
+    tris += std::to_string(++id);
+    for (int j = 0; j < 6; ++j) tris += ", " + std::to_string(mesh.node_ids[static_cast<std::size_t>(mesh.element(f.element)[ln[j]])]);
+    tris += "\n";
+  }
+  tris += "*MEMBRANE SECTION, ELSET=FABRIC_MEMBRANE, MATERIAL=FABRIC\n0.4\n";
+  const std::string faces_path = write("membrane_faces.inp", faces_deck), elements_path = write("membrane_m3d6.inp", deck + tris);
+  auto angle = [](const Scene& scene, std::vector<std::string>* warnings) {
+    auto bm = build_model(scene);
+    EXPECT_EQ(bm->model.membranes.size(), 1u);
+    if (warnings) *warnings = bm->warnings;
+    const Assembler asmb(bm->model);
+    QuasiStaticRun run(asmb, bm->solver.quasi_static);
+    double last = 0.0;
+    run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { last = r.angle_deg; });
+    return last;
+  };
+  auto deck_scene = [&](const std::string& path, std::vector<std::string> extra = {}) {
+    std::vector<std::string> o = base;
+    o.insert(o.end(), {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"", "mesh.symmetry_set=\"SYMMETRY\""});
+    o.insert(o.end(), extra.begin(), extra.end());
+    return Scene::load("", o);
+  };
+  const double builtin = angle(Scene::load("", base), nullptr);
+  std::vector<std::string> warnings;
+  const double on_faces = angle(deck_scene(faces_path), nullptr);
+  const double on_elements = angle(deck_scene(elements_path), &warnings);
+  EXPECT_GT(builtin, 0.05);
+  EXPECT_NEAR(on_faces, builtin, 1e-7 * builtin);
+  EXPECT_NEAR(on_elements, builtin, 1e-7 * builtin);
+  EXPECT_EQ(count_containing(warnings, "triangles of ELSET=FABRIC_MEMBRANE lie inside the solid"), 1);
+  EXPECT_EQ(count_containing(warnings, "*MEMBRANE SECTION, ELSET=FABRIC_MEMBRANE: its elements are read as a surface, "
+                                       "without stiffness; to model them as the fabric set mesh.fabric_model"), 1);
+  try {
+    build_model(deck_scene(elements_path, {"mesh.cavity_surface=\"FABRIC_MEMBRANE\""}));
+    ADD_FAILURE() << "an embedded sheet was accepted as the cavity";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has a face inside the solid"), std::string::npos) << e.what();
+  }
+  try {
+    build_model(deck_scene(elements_path, {"mesh.fabric_surface=\"FABRIC\""}));
+    ADD_FAILURE() << "a missing membrane surface was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("surface 'FABRIC' not found (the mesh has: "), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(InpFiles, SurfaceElementsOffTheMeshAreRejected) {
+  // Two tets sharing the face 2-3-4 (a triangle there is an embedded sheet, tested above); a
+  // triangle on no face at all.
   const std::string two = "*NODE\n1,0,0,0\n2,1,0,0\n3,0,1,0\n4,0,0,1\n5,1,1,1\n"
                           "*ELEMENT, TYPE=C3D4, ELSET=B\n1, 1, 2, 3, 4\n2, 2, 3, 4, 5\n";
-  expect_error(two + "*ELEMENT, TYPE=CPS3, ELSET=S\n10, 2, 3, 4\n", 11,
-               {"surface element 10 (ELSET=S) lies inside the solid", "boundary of the mesh"});
   expect_error(two + "*ELEMENT, TYPE=CPS3, ELSET=S\n10, 1, 2, 5\n", 11,
                {"surface element 10 (ELSET=S) matches no face of the tetrahedra", "corners of a tetrahedron's face"});
   expect_error(two + "*ELEMENT, TYPE=CPS3\n10, 1, 2, 3\n", 10, {"without ELSET=", "name the surface"});
