@@ -62,6 +62,16 @@ double positive(const Scene& scene, const std::string& key) {
 
 // ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
 
+/// A surface of the mesh by its name as the scene writes it, or upper-cased (decks' names are);
+/// nullptr if it has neither.
+const std::pair<const std::string, std::vector<FaceRef>>* find_surface(const Mesh& mesh, const std::string& name) {
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  auto it = mesh.surfaces.find(name);
+  if (it == mesh.surfaces.end()) it = mesh.surfaces.find(upper);
+  return it == mesh.surfaces.end() ? nullptr : &*it;
+}
+
 /// mesh.fabric_model: "solid" (elements of set FABRIC) or "membrane".
 bool fabric_is_membrane(const Scene& s) {
   const std::string v = s.string("mesh.fabric_model");
@@ -87,21 +97,18 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   const auto* svk = dynamic_cast<const SaintVenantKirchhoff*>(scaled ? scaled->base().get() : mat.get());
   if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
   const std::string name = s.string("mesh.fabric_surface");
-  std::string upper = name;
-  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
-  auto it = mesh.surfaces.find(name);
-  if (it == mesh.surfaces.end()) it = mesh.surfaces.find(upper);
-  if (it == mesh.surfaces.end() || it->second.empty()) {
+  const auto* surface = find_surface(mesh, name);
+  if (!surface || surface->second.empty()) {
     std::string have;
     for (const auto& [k, v] : mesh.surfaces) have += (have.empty() ? "" : ", ") + k;
-    s.fail("mesh.fabric_surface", "surface '" + name + "' " + (it == mesh.surfaces.end() ? "not found" : "has no faces") +
+    s.fail("mesh.fabric_surface", "surface '" + name + "' " + (!surface ? "not found" : "has no faces") +
                                       " (the mesh has: " + (have.empty() ? "none" : have) +
                                       "); name the surface that carries the fabric membrane, or use "
                                       "mesh.fabric_model = \"solid\"");
   }
   MembraneSet m;
-  m.name = it->first;
-  m.nodes = membrane_nodes_of_faces(mesh, it->second);
+  m.name = surface->first;
+  m.nodes = membrane_nodes_of_faces(mesh, surface->second);
   m.thickness_m = positive(s, "geometry.fabric_thickness_mm") * kmm;
   // Plane-stress SVK is linear in E: materials.fabric.stiffness_scale scales E exactly (the region
   // scales of [regions] apply to solid elements only).
@@ -567,13 +574,10 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
       s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn lines");
     for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
   } else {
-    std::string upper = cav;
-    std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
-    auto it = mesh.surfaces.find(cav);
-    if (it == mesh.surfaces.end()) it = mesh.surfaces.find(upper);
-    if (it == mesh.surfaces.end())
+    const auto* surface = find_surface(mesh, cav);
+    if (!surface)
       s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
-    model.pressure_faces = it->second;
+    model.pressure_faces = surface->second;
   }
   if (model.pressure_faces.empty()) s.fail("mesh.cavity_surface", "the cavity surface has no faces");
   {

@@ -309,12 +309,7 @@ class DeckReader {
   }
 
   void end_block() {
-    if (block_ == Block::SurfaceElement && !pending_.empty())
-      fail(pending_loc_,
-           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
-               " nodes but a " + surface_type_ + " has " + std::to_string(surface_npe_),
-           "list all its nodes (a line ending with ',' continues on the next data line)");
-    if (block_ == Block::Element && !pending_.empty()) {
+    if ((block_ == Block::Element || block_ == Block::SurfaceElement) && !pending_.empty()) {
       fail(pending_loc_,
            "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
                " nodes but a " + type_name_ + " has " + std::to_string(npe_),
@@ -441,10 +436,12 @@ class DeckReader {
     region_ = deck_.mesh.region_id(region);
   }
 
-  void element_line(const Loc& loc) {
+  /// Appends a data line of an *ELEMENT block (solid or surface: type_name_, npe_) to pending_
+  /// (id, then nodes). False while the element continues on the next line (trailing comma); true
+  /// when it is complete.
+  bool gather_element(const Loc& loc) {
     if (pending_.empty()) pending_loc_ = loc;
-    for (std::size_t i = 0; i < fields_.size(); ++i) {
-      const std::string_view f = fields_[i];
+    for (const std::string_view f : fields_) {
       const std::optional<long> v = parse_long(f);
       if (!v) {
         const std::string who =
@@ -455,18 +452,30 @@ class DeckReader {
       pending_.push_back(*v);
     }
     const std::size_t need = static_cast<std::size_t>(npe_) + 1;
-    if (pending_.size() < need) {
-      if (trailing_comma_) return;  // continued on the next data line
+    if (pending_.size() < need && trailing_comma_) return false;  // continued on the next data line
+    if (pending_.size() != need)
       fail(pending_loc_,
            "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
                " nodes but a " + type_name_ + " has " + std::to_string(npe_),
-           "list all its nodes (end a line with ',' to continue on the next)");
-    }
-    if (pending_.size() > need)
+           pending_.size() < need ? "list all its nodes (end a line with ',' to continue on the next)"
+                                  : "fix the connectivity (or the TYPE= of the block)");
+    return true;
+  }
+
+  /// Index of node `node` of the element being read (pending_[0]); fails if it is not defined.
+  int element_node(long node) const {
+    const auto it = node_index_.find(node);
+    if (it == node_index_.end())
       fail(pending_loc_,
-           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
-               " nodes but a " + type_name_ + " has " + std::to_string(npe_),
-           "fix the connectivity (or the TYPE= of the block)");
+           "element " + std::to_string(pending_[0]) + " refers to node " + std::to_string(node) +
+               ", which is not defined",
+           "define the node under *NODE before this *ELEMENT block, or fix the connectivity");
+    return it->second;
+  }
+
+  void element_line(const Loc& loc) {
+    if (!gather_element(loc)) return;
+    const std::size_t need = static_cast<std::size_t>(npe_) + 1;
     Mesh& mesh = deck_.mesh;
     const long id = pending_[0];
     if (id <= 0) fail(pending_loc_, "element id " + std::to_string(id) + " is not positive", "use ids >= 1");
@@ -474,15 +483,7 @@ class DeckReader {
     if (!element_index_.try_emplace(id, index).second)
       fail(pending_loc_, "element " + std::to_string(id) + " is defined twice",
            "element ids must be unique: renumber or remove one");
-    for (std::size_t k = 1; k < need; ++k) {
-      const auto it = node_index_.find(pending_[k]);
-      if (it == node_index_.end())
-        fail(pending_loc_,
-             "element " + std::to_string(id) + " refers to node " + std::to_string(pending_[k]) +
-                 ", which is not defined",
-             "define the node under *NODE before this *ELEMENT block, or fix the connectivity");
-      mesh.conn.push_back(it->second);
-    }
+    for (std::size_t k = 1; k < need; ++k) mesh.conn.push_back(element_node(pending_[k]));
     mesh.element_ids.push_back(id);
     mesh.region.push_back(region_);
     if (open_members_) open_members_->push_back(index);
@@ -491,8 +492,8 @@ class DeckReader {
 
   // ---- triangular surface elements (a mesher's named surfaces) -----------------------------------
   void begin_surface_elements(const Keyword& kw, const Loc& loc, const std::string& type, int nodes) {
-    surface_type_ = type;
-    surface_npe_ = nodes;
+    type_name_ = type;
+    npe_ = nodes;
     surface_set_ = upper(kw.get("ELSET"));
     if (surface_set_.empty())
       fail(loc, "*ELEMENT, TYPE=" + type + " without ELSET=",
@@ -505,40 +506,19 @@ class DeckReader {
   }
 
   void surface_element_line(const Loc& loc) {
-    if (pending_.empty()) pending_loc_ = loc;
-    for (const std::string_view f : fields_) {
-      const std::optional<long> v = parse_long(f);
-      if (!v)
-        fail(loc, "surface element: '" + std::string(f) + "' is not an integer",
-             "an *ELEMENT data line is 'id, node1, node2, ...'");
-      pending_.push_back(*v);
-    }
-    const std::size_t need = static_cast<std::size_t>(surface_npe_) + 1;
-    if (pending_.size() < need && trailing_comma_) return;
-    if (pending_.size() != need)
-      fail(pending_loc_,
-           "element " + std::to_string(pending_[0]) + " lists " + std::to_string(pending_.size() - 1) +
-               " nodes but a " + surface_type_ + " has " + std::to_string(surface_npe_),
-           "fix the connectivity (or the TYPE= of the block)");
+    if (!gather_element(loc)) return;
     SurfaceTriangle t{pending_[0], pending_loc_, {}};
-    for (int k = 0; k < 3; ++k) {
-      const auto it = node_index_.find(pending_[static_cast<std::size_t>(k) + 1]);
-      if (it == node_index_.end())
-        fail(pending_loc_,
-             "element " + std::to_string(t.id) + " refers to node " + std::to_string(pending_[k + 1]) +
-                 ", which is not defined",
-             "define the node under *NODE before this *ELEMENT block, or fix the connectivity");
-      t.corners[static_cast<std::size_t>(k)] = it->second;
-    }
+    for (std::size_t k = 0; k < 3; ++k) t.corners[k] = element_node(pending_[k + 1]);
     surface_elements_[surface_set_].push_back(t);
     pending_.clear();
   }
 
-  /// Each triangle of a surface element set -> the boundary face of the tetrahedron it covers
-  /// (matched by its three corner nodes, so the triangle's own node order and order do not
-  /// matter, and the face's outward normal, which orients the cavity pressure, comes from the
-  /// tetrahedron). The set becomes a surface and, unless a node set of that name exists, a node
-  /// set of the faces' nodes.
+  /// Each triangle of a surface element set -> the face of a tetrahedron it covers (matched by
+  /// its three corner nodes, so the triangle's own node order and order do not matter, and the
+  /// face's outward normal, which orients the cavity pressure, comes from the tetrahedron). A face
+  /// shared by two tetrahedra (an embedded sheet) is kept with a note: build_model refuses it as
+  /// a cavity, a membrane may lie there. The set becomes a surface and, unless a node set of that
+  /// name exists, a node set of the faces' nodes.
   void resolve_surface_elements() {
     if (surface_elements_.empty()) return;
     Mesh& mesh = deck_.mesh;
@@ -891,8 +871,7 @@ class DeckReader {
     std::array<int, 3> corners;  // node indices
   };
   std::map<std::string, std::vector<SurfaceTriangle>> surface_elements_;  // ELSET -> triangles
-  std::string surface_type_, surface_set_;
-  int surface_npe_ = 0;
+  std::string surface_set_;  // ELSET of the surface element block being read
   Loc pending_loc_;
 
   std::unordered_map<long, int> node_index_;

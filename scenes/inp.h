@@ -5,9 +5,10 @@
 // Supported on read (case-insensitive keywords, continuation lines, comments "**"):
 //   *NODE [, NSET=]            *ELEMENT, TYPE=C3D4|C3D10 [, ELSET=]
 //   *ELEMENT, TYPE=<triangle>, ELSET=  (CPS3/CPS6, S3/S6, M3D3/M3D6, STRI3/STRI65, ...: how Gmsh and
-//        other meshers write named boundary surfaces) -> the surface ELSET of the tetrahedron faces
-//        they cover, matched by corner nodes (any winding), and a node set of the same name unless
-//        one exists; line and quadrilateral elements are skipped with a warning
+//        other meshers write named surfaces; membrane/shell sheets, also embedded in the solid, with a
+//        note) -> the surface ELSET of the tetrahedron faces they cover, matched by corner nodes (any
+//        winding), and a node set of the same name unless one exists; line and quadrilateral elements
+//        are skipped with a warning; *MEMBRANE/SHELL SECTION: a warning naming mesh.fabric_surface
 //   *NSET, NSET= [, GENERATE]  *ELSET, ELSET= [, GENERATE]   (members may name other sets)
 //   *SURFACE, NAME= [, TYPE=ELEMENT]  lines "elset_or_element, S1..S4"
 //   *DLOAD  lines "element_or_elset, Pn, magnitude"  (pressure faces; magnitudes kept)

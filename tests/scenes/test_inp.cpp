@@ -54,6 +54,26 @@ int count_containing(const std::vector<std::string>& lines, const std::string& n
                                         [&](const std::string& l) { return l.find(needle) != std::string::npos; }));
 }
 
+/// The faces of a Tet10 mesh's surface as a deck's 6-node triangle elements: the block header
+/// line, then one element per face (ids after the mesh's), every second in the other winding when
+/// `flip_every_other` (a mesher need not follow the faces' orientation).
+std::string surface_as_elements(const Mesh& mesh, const std::string& surface, const std::string& header,
+                                bool flip_every_other) {
+  std::string out = header + "\n";
+  long id = *std::max_element(mesh.element_ids.begin(), mesh.element_ids.end());
+  int k = 0;
+  for (const FaceRef& f : mesh.surfaces.at(surface)) {
+    const int* ln = face_local_nodes(mesh.type, f.local_face);
+    std::array<long, 6> n{};
+    for (int j = 0; j < 6; ++j) n[static_cast<std::size_t>(j)] = mesh.node_ids[static_cast<std::size_t>(mesh.element(f.element)[ln[j]])];
+    if (flip_every_other && k++ % 2) n = {n[0], n[2], n[1], n[5], n[4], n[3]};
+    out += std::to_string(++id);
+    for (long v : n) out += ", " + std::to_string(v);
+    out += "\n";
+  }
+  return out;
+}
+
 /// A fresh directory per test, removed afterwards.
 class InpFiles : public ::testing::Test {
  protected:
@@ -385,19 +405,8 @@ TEST_F(InpFiles, TriangularSurfaceElementsAreNamedSurfaces) {
   const std::size_t a = deck.find("*SURFACE, NAME=CAVITY");
   ASSERT_NE(a, std::string::npos);
   deck.erase(a, deck.find('*', a + 1) - a);
-  std::string tris = "*ELEMENT, TYPE=CPS6, ELSET=CAVITY\n";
-  long id = *std::max_element(mesh.element_ids.begin(), mesh.element_ids.end());
-  int k = 0;
-  for (const FaceRef& f : mesh.surfaces.at("CAVITY")) {
-    const int* ln = face_local_nodes(mesh.type, f.local_face);
-    std::array<long, 6> n{};
-    for (int j = 0; j < 6; ++j) n[static_cast<std::size_t>(j)] = mesh.node_ids[static_cast<std::size_t>(mesh.element(f.element)[ln[j]])];
-    if (k++ % 2) n = {n[0], n[2], n[1], n[5], n[4], n[3]};  // the other winding
-    tris += std::to_string(++id);
-    for (long v : n) tris += ", " + std::to_string(v);
-    tris += "\n";
-  }
-  deck += tris + "*ELEMENT, TYPE=T3D3, ELSET=EDGE\n" + std::to_string(++id) + ", 1, 2, 3\n";
+  deck += surface_as_elements(mesh, "CAVITY", "*ELEMENT, TYPE=CPS6, ELSET=CAVITY", true) +
+          "*ELEMENT, TYPE=T3D3, ELSET=EDGE\n999999, 1, 2, 3\n";
   const std::string gmsh_path = write("gmsh.inp", deck), faces_path = write("faces.inp", faces_deck);
   const InpDeck A = read_inp(faces_path, 1e-3), B = read_inp(gmsh_path, 1e-3);
   ASSERT_EQ(B.mesh.num_elements(), A.mesh.num_elements());  // the triangles are not elements
@@ -448,14 +457,7 @@ TEST_F(InpFiles, AMembraneFabricOnADeckSurfaceOrEmbeddedElementsBendsAsTheBuiltI
   const std::size_t a = deck.find("*SURFACE, NAME=FABRIC_MEMBRANE");
   ASSERT_NE(a, std::string::npos);
   deck.erase(a, deck.find('*', a + 1) - a);
-  std::string tris = "*ELEMENT, TYPE=M3D6, ELSET=FABRIC_MEMBRANE\n";
-  long id = *std::max_element(mesh.element_ids.begin(), mesh.element_ids.end());
-  for (const FaceRef& f : mesh.surfaces.at("FABRIC_MEMBRANE")) {
-    const int* ln = face_local_nodes(mesh.type, f.local_face);
-    tris += std::to_string(++id);
-    for (int j = 0; j < 6; ++j) tris += ", " + std::to_string(mesh.node_ids[static_cast<std::size_t>(mesh.element(f.element)[ln[j]])]);
-    tris += "\n";
-  }
+  std::string tris = surface_as_elements(mesh, "FABRIC_MEMBRANE", "*ELEMENT, TYPE=M3D6, ELSET=FABRIC_MEMBRANE", false);
   tris += "*MEMBRANE SECTION, ELSET=FABRIC_MEMBRANE, MATERIAL=FABRIC\n0.4\n";
   const std::string faces_path = write("membrane_faces.inp", faces_deck), elements_path = write("membrane_m3d6.inp", deck + tris);
   auto angle = [](const Scene& scene, std::vector<std::string>* warnings) {
