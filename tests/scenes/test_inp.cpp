@@ -74,6 +74,16 @@ std::string surface_as_elements(const Mesh& mesh, const std::string& surface, co
   return out;
 }
 
+/// `deck` without its *SURFACE, NAME=<name> block (a test failure if it has none).
+std::string without_surface_block(std::string deck, const std::string& name) {
+  const std::size_t a = deck.find("*SURFACE, NAME=" + name + ",");
+  if (a == std::string::npos) {
+    ADD_FAILURE() << "the deck has no *SURFACE, NAME=" << name;
+    return deck;
+  }
+  return deck.erase(a, deck.find('*', a + 1) - a);
+}
+
 /// A fresh directory per test, removed afterwards.
 class InpFiles : public ::testing::Test {
  protected:
@@ -401,10 +411,7 @@ TEST_F(InpFiles, TriangularSurfaceElementsAreNamedSurfaces) {
   std::ostringstream os;
   write_inp_mesh(os, mesh, 1e-3);
   const std::string faces_deck = os.str();
-  std::string deck = faces_deck;
-  const std::size_t a = deck.find("*SURFACE, NAME=CAVITY");
-  ASSERT_NE(a, std::string::npos);
-  deck.erase(a, deck.find('*', a + 1) - a);
+  std::string deck = without_surface_block(faces_deck, "CAVITY");
   deck += surface_as_elements(mesh, "CAVITY", "*ELEMENT, TYPE=CPS6, ELSET=CAVITY", true) +
           "*ELEMENT, TYPE=T3D3, ELSET=EDGE\n999999, 1, 2, 3\n";
   const std::string gmsh_path = write("gmsh.inp", deck), faces_path = write("faces.inp", faces_deck);
@@ -453,10 +460,7 @@ TEST_F(InpFiles, AMembraneFabricOnADeckSurfaceOrEmbeddedElementsBendsAsTheBuiltI
   std::ostringstream os;
   write_inp_mesh(os, mesh, 1e-3);
   const std::string faces_deck = os.str();
-  std::string deck = faces_deck;
-  const std::size_t a = deck.find("*SURFACE, NAME=FABRIC_MEMBRANE");
-  ASSERT_NE(a, std::string::npos);
-  deck.erase(a, deck.find('*', a + 1) - a);
+  const std::string deck = without_surface_block(faces_deck, "FABRIC_MEMBRANE");
   std::string tris = surface_as_elements(mesh, "FABRIC_MEMBRANE", "*ELEMENT, TYPE=M3D6, ELSET=FABRIC_MEMBRANE", false);
   tris += "*MEMBRANE SECTION, ELSET=FABRIC_MEMBRANE, MATERIAL=FABRIC\n0.4\n";
   const std::string faces_path = write("membrane_faces.inp", faces_deck), elements_path = write("membrane_m3d6.inp", deck + tris);
