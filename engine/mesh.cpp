@@ -39,8 +39,14 @@ int Mesh::find_region(const std::string& name) const {
 std::string Mesh::element_label(int e) const {
   const std::size_t i = static_cast<std::size_t>(e);
   std::string s = "element " + std::to_string(i < element_ids.size() ? element_ids[i] : static_cast<long>(e) + 1);
-  if (i < region.size() && region[i] < region_names.size()) s += " (region '" + region_names[region[i]] + "')";
-  return s;
+  std::string detail;
+  if (element_sources.size() == static_cast<std::size_t>(num_elements()) && element_sources[i].piece > 0) {
+    const ElementSource& src = element_sources[i];
+    detail = "tet " + std::to_string(src.piece) + " of " + std::string(src.type.data()) + " " + std::to_string(src.id);
+  }
+  if (i < region.size() && region[i] < region_names.size())
+    detail += (detail.empty() ? "region '" : ", region '") + region_names[region[i]] + "'";
+  return detail.empty() ? s : s + " (" + detail + ")";
 }
 
 void Mesh::ensure_ids() {

@@ -5,6 +5,7 @@
 //   corners 0..3, mid-edge nodes 4:(0,1) 5:(1,2) 6:(2,0) 7:(0,3) 8:(1,3) 9:(2,3)   (0-based)
 //   faces S1:(0,1,2) S2:(0,3,1) S3:(1,3,2) S4:(2,3,0)  -- local_face 0..3 here.
 // Coordinates are in metres (SI); importers convert.
+#include <array>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -37,6 +38,16 @@ inline constexpr const char* kBase = "base";
 inline constexpr const char* kFabric = "fabric";
 }  // namespace regions
 
+/// Where an element of a mesh read from a deck of hexahedra, wedges or pyramids came from: the
+/// deck's elements are split into tetrahedra (scenes/solid_split.h), and messages should still lead
+/// the user to the element of their mesh file.
+struct ElementSource {
+  long id = 0;                ///< the deck's element id
+  std::uint8_t piece = 0;     ///< 1-based tetrahedron of that element; 0 = the deck's own tetrahedron
+  std::uint8_t pieces = 0;    ///< tetrahedra it was split into
+  std::array<char, 6> type{};  ///< its type, NUL-terminated ("C3D8", "C3D20")
+};
+
 struct Mesh {
   ElementType type = ElementType::Tet10;
   std::vector<Eigen::Vector3d> X;  ///< reference node coordinates (m)
@@ -47,6 +58,7 @@ struct Mesh {
 
   std::vector<long> node_ids;     ///< external (1-based, as in a deck) id of each node
   std::vector<long> element_ids;  ///< external id of each element
+  std::vector<ElementSource> element_sources;  ///< per element, or empty when nothing was split
 
   std::map<std::string, std::vector<int>> node_sets;     ///< name -> sorted node indices
   std::map<std::string, std::vector<int>> element_sets;  ///< name -> sorted element indices
@@ -66,7 +78,8 @@ struct Mesh {
   void ensure_ids();
 
   /// "element <external id> (region '<tag>')" for messages: the id the user's mesh file uses
-  /// (1-based index when the mesh has none), the region when the mesh is tagged.
+  /// (1-based index when the mesh has none), the region when the mesh is tagged, and for a
+  /// tetrahedron split from a deck's element "element 1043 (tet 3 of C3D8 57, region '<tag>')".
   std::string element_label(int e) const;
 };
 
