@@ -15,6 +15,7 @@
 #include <unordered_set>
 
 #include "materials/errors.h"
+#include "scenes/solid_split.h"
 
 namespace pneufem {
 
@@ -400,32 +401,30 @@ class DeckReader {
       block_ = Block::Skip;
       return;
     }
-    ElementType et;
-    if (type == "C3D4" || type == "C3D4H") {
-      et = ElementType::Tet4;
-      type_name_ = "C3D4";
-    } else if (type == "C3D10" || type == "C3D10H" || type == "C3D10M") {
-      et = ElementType::Tet10;
-      type_name_ = "C3D10";
-    } else {
-      fail(loc, "element type " + type + " is not supported (pneufem has only C3D4 and C3D10 tetrahedra)",
-           "convert the mesh to C3D4 or C3D10 tetrahedra (triangular surface elements such as CPS3/CPS6/S3 "
-           "are read as named surfaces; line and quadrilateral elements are skipped)");
-    }
+    const std::optional<SolidType> solid = solid_type(type);
+    if (!solid)
+      fail(loc,
+           "element type " + type + " is not supported (pneufem reads the solid elements C3D4, C3D10, C3D5, C3D6, "
+           "C3D15, C3D8 and C3D20, with the suffixes H, R, I, M, S)",
+           "convert the mesh to one of them (triangular surface elements such as CPS3/CPS6/S3 are read as named "
+           "surfaces; line and quadrilateral elements are skipped)");
+    solid_ = *solid;
+    type_name_ = solid_name(solid_);
     if (type != type_name_)
       warn_once("type " + type, loc,
-                type + " is read as " + type_name_ + " (the hybrid/modified formulation is the scene's choice)");
+                type + " is read as " + type_name_ + " (the hybrid/reduced/modified formulation is the scene's choice)");
+    const ElementType et = solid_quadratic(solid_) ? ElementType::Tet10 : ElementType::Tet4;
     if (!first_type_loc_) {
       deck_.mesh.type = et;
       first_type_loc_ = loc;
+      first_type_ = type_name_;
     } else if (deck_.mesh.type != et) {
       fail(loc,
-           "TYPE=" + type + " mixes element orders with the " +
-               std::string(deck_.mesh.type == ElementType::Tet4 ? "C3D4" : "C3D10") + " elements of " +
-               where(*first_type_loc_),
-           "use one element order throughout (all C3D4 or all C3D10)");
+           "TYPE=" + type + " mixes element orders with the " + first_type_ + " elements of " + where(*first_type_loc_),
+           "use one element order throughout (all linear: C3D4, C3D5, C3D6, C3D8; or all quadratic: C3D10, C3D15, "
+           "C3D20)");
     }
-    npe_ = nodes_per_element(et);
+    npe_ = solid_nodes(solid_);
     block_ = Block::Element;
     const std::string elset = kw.get("ELSET");
     open_set(deck_.mesh.element_sets, elset);
@@ -479,11 +478,14 @@ class DeckReader {
     Mesh& mesh = deck_.mesh;
     const long id = pending_[0];
     if (id <= 0) fail(pending_loc_, "element id " + std::to_string(id) + " is not positive", "use ids >= 1");
-    const int index = mesh.num_elements();
+    const int index = solids_.size();
     if (!element_index_.try_emplace(id, index).second)
       fail(pending_loc_, "element " + std::to_string(id) + " is defined twice",
            "element ids must be unique: renumber or remove one");
-    for (std::size_t k = 1; k < need; ++k) mesh.conn.push_back(element_node(pending_[k]));
+    element_nodes_.clear();
+    for (std::size_t k = 1; k < need; ++k) element_nodes_.push_back(element_node(pending_[k]));
+    solids_.add(solid_, element_nodes_);
+    solid_loc_.push_back(pending_loc_);
     mesh.element_ids.push_back(id);
     mesh.region.push_back(region_);
     if (open_members_) open_members_->push_back(index);
@@ -712,13 +714,30 @@ class DeckReader {
 
   void surface_line(const Loc& loc) {
     if (fields_.size() < 2 || fields_[1].empty())
-      fail(loc, "a *SURFACE data line needs a face label", "write 'element_or_elset, S1' (faces S1..S4)");
+      fail(loc, "a *SURFACE data line needs a face label", "write 'element_or_elset, S1' (faces S1..S6)");
     const std::string label = upper(fields_[1]);
     int face = -1;
-    if (label.size() == 2 && label[0] == 'S' && label[1] >= '1' && label[1] <= '4') face = label[1] - '1';
-    if (face < 0) fail(loc, "'" + std::string(fields_[1]) + "' is not a tetrahedron face", "use S1, S2, S3 or S4");
+    if (label.size() == 2 && label[0] == 'S' && label[1] >= '1' && label[1] <= '6') face = label[1] - '1';
+    if (face < 0)
+      fail(loc, "'" + std::string(fields_[1]) + "' is not an element face",
+           "use S1..S4 (tetrahedra), S1..S5 (wedges, pyramids) or S1..S6 (hexahedra)");
     std::vector<FaceRef>& faces = deck_.mesh.surfaces[surface_];
-    for_elements(fields_[0], loc, "*SURFACE " + surface_, [&](int e) { faces.push_back(FaceRef{e, face}); });
+    for_elements(fields_[0], loc, "*SURFACE " + surface_, [&](int e) {
+      check_face(e, face, label, loc);
+      faces.push_back(FaceRef{e, face});
+    });
+  }
+
+  /// Face `face` (0-based) named by `label` (S3, P3) must exist on element e.
+  void check_face(int e, int face, const std::string& label, const Loc& loc) const {
+    const SolidType t = solids_.type[static_cast<std::size_t>(e)];
+    const int faces = solid_faces(t);
+    if (face >= faces)
+      fail(loc,
+           label + " names face " + std::to_string(face + 1) + " of element " +
+               std::to_string(deck_.mesh.element_ids[static_cast<std::size_t>(e)]) + ", a " + solid_name(t) +
+               " with faces 1-" + std::to_string(faces),
+           "use " + label.substr(0, 1) + "1.." + label.substr(0, 1) + std::to_string(faces) + " for that element");
   }
 
   // ---- *DLOAD -------------------------------------------------------------------------------
@@ -732,14 +751,13 @@ class DeckReader {
       return;
     }
     const int face = label[1] - '1';
-    if (face > 3)
-      fail(loc, "load " + label + " names face " + label.substr(1) + " but a tetrahedron has faces 1-4", "use P1..P4");
     if (fields_.size() < 3 || fields_[2].empty())
       fail(loc, "*DLOAD " + label + " without a magnitude", "write 'element_or_elset, " + label + ", magnitude'");
     const std::optional<double> p = parse_double(fields_[2]);
     if (!p) fail(loc, "*DLOAD magnitude '" + std::string(fields_[2]) + "' is not a finite number", "fix the value");
     for_elements(fields_[0], loc, "*DLOAD", [&](int e) {
-      const long long key = static_cast<long long>(e) * 4 + face;
+      check_face(e, face, label, loc);
+      const long long key = static_cast<long long>(e) * 8 + face;
       const auto [it, inserted] = load_index_.try_emplace(key, deck_.pressure_faces.size());
       if (inserted) {
         deck_.pressure_faces.push_back(InpPressure{FaceRef{e, face}, *p});
@@ -809,10 +827,11 @@ class DeckReader {
     Mesh& mesh = deck_.mesh;
     const Loc end{0, std::max(1, last_line_of_top_)};
     if (mesh.num_nodes() == 0) fail(end, "the deck defines no nodes", "add a *NODE block with 'id, x, y, z' lines");
-    if (mesh.num_elements() == 0)
+    if (solids_.size() == 0)
       fail(end, "the deck defines no elements", "add an *ELEMENT, TYPE=C3D4 or TYPE=C3D10 block");
     for (auto& [name, v] : mesh.node_sets) normalise(v);
     for (auto& [name, v] : mesh.element_sets) normalise(v);
+    split_solids(solids_, deck_, [&](int s) { return where(solid_loc_[static_cast<std::size_t>(s)]); });
     resolve_surface_elements();
     for (auto& [name, faces] : mesh.surfaces) {  // a face listed twice would be loaded twice
       std::unordered_set<long long> seen;
@@ -861,6 +880,11 @@ class DeckReader {
   std::string surface_;
 
   std::optional<Loc> first_type_loc_;
+  std::string first_type_;    // TYPE of the first *ELEMENT block (its order is the deck's)
+  SolidType solid_ = SolidType::C3D4;  // of the current *ELEMENT block
+  SolidElements solids_;      // the deck's solid elements, split into tetrahedra by finish()
+  std::vector<Loc> solid_loc_;
+  std::vector<int> element_nodes_;
   std::string type_name_;
   int npe_ = 0;
   std::uint16_t region_ = 0;

@@ -3,15 +3,21 @@
 // pressure faces of a user's model, and writing our meshes so CalculiX can run the identical mesh.
 //
 // Supported on read (case-insensitive keywords, continuation lines, comments "**"):
-//   *NODE [, NSET=]            *ELEMENT, TYPE=C3D4|C3D10 [, ELSET=]
+//   *NODE [, NSET=]            *ELEMENT, TYPE=<solid> [, ELSET=]
+//   <solid>: tetrahedra C3D4, C3D10, read as they are; hexahedra C3D8, C3D20, wedges C3D6, C3D15 and
+//        pyramids C3D5, split conformingly into tetrahedra (scenes/solid_split.h: Abaqus node and face
+//        numbering, the split rule, curved C3D20/C3D15 stay curved); element sets, regions, surfaces,
+//        *DLOAD faces, node sets and *BOUNDARY follow the split, with a note counting it; mixed decks
+//        of these shapes are fine
 //   *ELEMENT, TYPE=<triangle>, ELSET=  (CPS3/CPS6, S3/S6, M3D3/M3D6, STRI3/STRI65, ...: how Gmsh and
 //        other meshers write named surfaces; membrane/shell sheets, also embedded in the solid, with a
 //        note) -> the surface ELSET of the tetrahedron faces they cover, matched by corner nodes (any
 //        winding), and a node set of the same name unless one exists; line and quadrilateral elements
 //        are skipped with a warning; *MEMBRANE/SHELL SECTION: a warning naming mesh.fabric_surface
 //   *NSET, NSET= [, GENERATE]  *ELSET, ELSET= [, GENERATE]   (members may name other sets)
-//   *SURFACE, NAME= [, TYPE=ELEMENT]  lines "elset_or_element, S1..S4"
-//   *DLOAD  lines "element_or_elset, Pn, magnitude"  (pressure faces; magnitudes kept)
+//   *SURFACE, NAME= [, TYPE=ELEMENT]  lines "elset_or_element, Sn"  (S1..S4 tetrahedra, S1..S5
+//        wedges and pyramids, S1..S6 hexahedra; a quadrilateral face -> the 2 tetrahedron faces tiling it)
+//   *DLOAD  lines "element_or_elset, Pn, magnitude"  (pressure faces as Sn; magnitudes kept)
 //   *BOUNDARY lines "node_or_nset, first_dof[, last_dof[, value]]"  (dofs 1-3; value must be 0)
 //   *INCLUDE, INPUT=file (relative to the including file)
 // Everything else (materials, steps, outputs) is skipped: the scene maps sets to materials.
@@ -22,15 +28,20 @@
 //    defined again (or by several ELSET= blocks) collects the union, as in CalculiX;
 //  * region of an element = the ELSET= of its *ELEMENT block in lower case (so the canonical
 //    names of regions:: round-trip), or "default";
-//  * C3D4H/C3D10H/C3D10M are read as C3D4/C3D10 (with a warning); one element order per deck;
+//  * formulation variants (C3D8R, C3D8H, C3D20RH, C3D10M, ...: suffixes H, R, I, M, S) are read as
+//    their base type (with a warning); one element order per deck: linear (C3D4, C3D5, C3D6, C3D8
+//    -> Tet4; mesh.promote_to_tet10 recommended) or quadratic (C3D10, C3D15, C3D20 -> Tet10);
+//  * a split element's first tetrahedron keeps its id, the others get ids above the deck's largest;
+//    Mesh::element_label names the deck element ("element 1043 (tet 3 of C3D8 57)");
 //  * a data line ending with ',' continues on the next line only where more entries are due
 //    (element connectivity); elsewhere the trailing comma is ignored; blank fields in *NODE are 0;
 //  * *INCLUDE is textual, as in CalculiX: a data block may continue into the included file;
 //  * sets and *BOUNDARY/*DLOAD/*SURFACE lines may only name nodes, elements and sets defined
 //    above them; GENERATE skips undefined ids (with a warning), explicit lists reject them;
 //  * *DLOAD: each (element, face) once, the first magnitude wins (a differing repeat warns);
-//    fixed_dofs: each (node, dof) once, in order of appearance;
-//  * warnings also report nodes used by no element and elements with non-positive volume.
+//    fixed_dofs: each (node, dof) once, in order of appearance (a split's new nodes last);
+//  * warnings also report nodes used by no element and tetrahedra with non-positive volume (for
+//    an element to be split it is an error naming the element and the node order to use).
 #include <map>
 #include <ostream>
 #include <string>

@@ -565,8 +565,8 @@ TEST(InpWrite, RefusesNamesADeckCannotHold) {
 const std::string kNodes = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n";  // lines 1-5
 
 TEST_F(InpFiles, UnknownElementType) {
-  expect_error(kNodes + "*ELEMENT, TYPE=C3D8R, ELSET=B\n1, 1, 2, 3, 4, 1, 2, 3, 4\n", 6,
-               {"C3D8R", "not supported", "convert the mesh to C3D4 or C3D10"});
+  expect_error(kNodes + "*ELEMENT, TYPE=C3D27, ELSET=B\n1, 1, 2, 3, 4, 1, 2, 3, 4\n", 6,
+               {"C3D27", "not supported", "C3D8 and C3D20", "convert the mesh to one of them"});
 }
 
 TEST_F(InpFiles, MixedElementOrders) {
@@ -609,7 +609,8 @@ TEST_F(InpFiles, NodeSetWhereAnElementSetIsDue) {
 
 TEST_F(InpFiles, BadSurfaceFaceAndDloadFace) {
   const std::string head = kNodes + "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n";
-  expect_error(head + "*SURFACE, NAME=S\n1, S5\n", 9, {"'S5' is not a tetrahedron face", "S1, S2, S3 or S4"});
+  expect_error(head + "*SURFACE, NAME=S\n1, S5\n", 9, {"S5 names face 5 of element 1, a C3D4 with faces 1-4", "use S1..S4"});
+  expect_error(head + "*SURFACE, NAME=S\n1, S7\n", 9, {"'S7' is not an element face", "S1..S6 (hexahedra)"});
   expect_error(head + "*DLOAD\n1, P6, 1.0\n", 9, {"faces 1-4", "P1..P4"});
   expect_error(head + "*DLOAD\n1, P2\n", 9, {"without a magnitude"});
 }
