@@ -22,6 +22,7 @@
 #include "scenes/inp.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/solid_split.h"
 
 namespace pneufem {
 
@@ -478,12 +479,12 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
     deck = read_inp(s.resolve_path(file), length_unit(s));
     out->warnings = deck.warnings;
-    model.mesh = std::move(deck.mesh);
     if (s.boolean("mesh.promote_to_tet10")) {
-      if (model.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
+      if (deck.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
         out->warnings.push_back("mesh.promote_to_tet10: *DLOAD faces are kept (faces map one to one)");
-      model.mesh = promote_to_tet10(model.mesh);
+      promote_deck_to_tet10(deck);  // also the *BOUNDARY dofs of the new mid-edge nodes
     }
+    model.mesh = std::move(deck.mesh);
   } else {
     s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
   }

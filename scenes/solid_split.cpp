@@ -484,4 +484,25 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   deck.warnings.push_back(note.str());
 }
 
+void promote_deck_to_tet10(InpDeck& deck) {
+  if (deck.mesh.type == ElementType::Tet10) return;
+  const int n_original = deck.mesh.num_nodes();
+  deck.mesh = promote_to_tet10(deck.mesh);
+  if (deck.fixed_dofs.empty()) return;
+  std::vector<std::array<char, 3>> fixed(static_cast<std::size_t>(deck.mesh.num_nodes()), {0, 0, 0});
+  for (const auto& [node, dof] : deck.fixed_dofs) fixed[static_cast<std::size_t>(node)][static_cast<std::size_t>(dof)] = 1;
+  // Each new mid-edge node once, in node order (the dofs' order of appearance continues with them).
+  std::vector<std::array<int, 2>> corners(deck.mesh.X.size(), {-1, -1});
+  for (int e = 0; e < deck.mesh.num_elements(); ++e) {
+    const int* n = deck.mesh.element(e);
+    for (int k = 0; k < 6; ++k)
+      if (n[4 + k] >= n_original) corners[static_cast<std::size_t>(n[4 + k])] = {n[kTet.edge[k][0]], n[kTet.edge[k][1]]};
+  }
+  for (int m = n_original; m < deck.mesh.num_nodes(); ++m) {
+    const auto [a, b] = corners[static_cast<std::size_t>(m)];
+    for (int d = 0; d < 3; ++d)
+      if (fixed[static_cast<std::size_t>(a)][d] && fixed[static_cast<std::size_t>(b)][d]) deck.fixed_dofs.emplace_back(m, d);
+  }
+}
+
 }  // namespace pneufem

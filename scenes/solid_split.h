@@ -99,4 +99,10 @@ struct SolidElements {
 /// tetrahedron of zero or negative volume (inverted, wrongly numbered or degenerate).
 void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where);
 
+/// mesh.promote_to_tet10 for a deck: promote_to_tet10 of the mesh, and its *BOUNDARY dofs extended
+/// to the new mid-edge nodes whose two corners both have the dof fixed (as promote_to_tet10 does
+/// for node sets), so a face fixed node by node stays fixed. The faces of pressure_faces map one to
+/// one.
+void promote_deck_to_tet10(InpDeck& deck);
+
 }  // namespace pneufem
