@@ -412,7 +412,8 @@ class DeckReader {
     type_name_ = solid_name(solid_);
     if (type != type_name_)
       warn_once("type " + type, loc,
-                type + " is read as " + type_name_ + " (the hybrid/reduced/modified formulation is the scene's choice)");
+                type + " is read as " + type_name_ +
+                    " (hybrid, reduced-integration, incompatible-mode or modified: the scene chooses the formulation)");
     const ElementType et = solid_quadratic(solid_) ? ElementType::Tet10 : ElementType::Tet4;
     if (!first_type_loc_) {
       deck_.mesh.type = et;
@@ -747,7 +748,7 @@ class DeckReader {
     const std::string label = upper(fields_[1]);
     const bool pressure = label.size() == 2 && label[0] == 'P' && label[1] >= '1' && label[1] <= '9';
     if (!pressure) {
-      warn_once("dload " + label, loc, "*DLOAD load type " + label + " skipped (only face pressures P1..P4 are read)");
+      warn_once("dload " + label, loc, "*DLOAD load type " + label + " skipped (only face pressures P1..P6 are read)");
       return;
     }
     const int face = label[1] - '1';
