@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -83,7 +84,17 @@ Eigen::Vector3d ref(const ShapeTables& s, int corner) {
   return Eigen::Vector3d(r[0], r[1], r[2]);
 }
 
-/// Shape function values of a type at reference point xi (not for the pyramid).
+/// Shape function values of a type at reference point xi (not for the pyramid): the interpolations
+/// of Abaqus Theory Guide, "Solid isoparametric quadrilaterals and hexahedra" and "Triangular,
+/// tetrahedral, and wedge elements" (same node numbering).
+///   tetrahedra: L = (1 - xi - eta - zeta, xi, eta, zeta); corners L_a (C3D10: L_a (2 L_a - 1)),
+///     mid-edge 4 L_a L_b;
+///   bricks, corner a at r_a in {-1, 1}^3: (1 + xi r_a)(1 + eta s_a)(1 + zeta t_a) / 8, times
+///     (xi r_a + eta s_a + zeta t_a - 2) for C3D20; C3D20 mid-edge node with r_a = 0 (and likewise):
+///     (1 - xi^2)(1 + eta s_a)(1 + zeta t_a) / 4;
+///   wedges, L = (1 - g - h, g, h), corner a at r = r_a = -+1: L_a (1 + r r_a) / 2 (C3D15:
+///     L_a (2 L_a - 1)(1 + r r_a) / 2 - L_a (1 - r^2) / 2); C3D15 mid-edge in a triangle
+///     2 L_a L_b (1 + r r_a), on a vertical edge L_a (1 - r^2).
 void shape_values(SolidType t, const Eigen::Vector3d& xi, double* N) {
   const TypeInfo& ti = info(t);
   const ShapeTables& s = *ti.shape;
@@ -94,7 +105,7 @@ void shape_values(SolidType t, const Eigen::Vector3d& xi, double* N) {
       for (int k = 0; k < 6; ++k) N[4 + k] = 4.0 * L[s.edge[k][0]] * L[s.edge[k][1]];
     return;
   }
-  if (s.corners == 8) {  // serendipity brick (Zienkiewicz & Taylor, The FEM vol. 1, ch. 6)
+  if (s.corners == 8) {
     for (int a = 0; a < 8; ++a) {
       const Eigen::Vector3d r = ref(s, a);
       const double p = (1 + xi[0] * r[0]) * (1 + xi[1] * r[1]) * (1 + xi[2] * r[2]) / 8.0;
