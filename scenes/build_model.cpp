@@ -589,7 +589,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     for (const FaceRef& f : model.pressure_faces)
       if (!outside.count({f.element, f.local_face}))
         s.fail("mesh.cavity_surface", "'" + cav + "' has a face inside the solid (face " + std::to_string(f.local_face + 1) +
-                                          " of element " + std::to_string(mesh.element_ids[f.element]) +
+                                          " of " + mesh.element_label(f.element) +
                                           ", shared by two tetrahedra): the cavity must be the chambers' boundary; "
                                           "name the surface of the chamber walls");
   }

@@ -848,6 +848,24 @@ TEST_F(SolidDecks, AHexahedralActuatorDeckBendsTheSameAsC3D20AndAsPromotedC3D8) 
   EXPECT_EQ(count_containing(w8, "mesh.promote_to_tet10 = true (recommended)"), 1);
 }
 
+// A scene's error about a split element names the deck's element.
+TEST_F(SolidDecks, SceneErrorsNameTheDeckElement) {
+  const HexBlock b(2, 1, 1, false, 3, [](const Vec& s) { return Vec(10.0 * s.x(), 5.0 * s.y(), 5.0 * s.z()); });
+  const std::string path =
+      write("inner.inp", b.nodes() + b.elements("*ELEMENT, TYPE=C3D8, ELSET=SILICONE") + "*ELSET, ELSET=FABRIC\n" +
+                             "*SURFACE, NAME=CAVITY\n1, S4\n" +  // S4 of element 1 (x+) is element 2's S6: inside
+                             b.nset("FIXED", [](const Vec& s) { return s.x() == 0.0; }) +
+                             b.nset("TIP", [](const Vec& s) { return s.x() == 1.0; }));
+  try {
+    build_model(Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\""}));
+    ADD_FAILURE() << "an inner face was accepted as the cavity";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'CAVITY' has a face inside the solid"), std::string::npos) << what;
+    EXPECT_NE(what.find(" of C3D8 1, region 'silicone'), shared by two tetrahedra"), std::string::npos) << what;
+  }
+}
+
 // ------------------------------------------------------------------------------------------------
 // Bad input
 // ------------------------------------------------------------------------------------------------
