@@ -4,8 +4,9 @@
 // *BOUNDARY dofs follow the split.
 //
 // Element conventions, 1-based as in a deck (Abaqus Elements Guide, "Three-dimensional solid element
-// library": node ordering and face numbering; CalculiX uses the same, ccx src/getnodel.f, tables
-// ifaceq, ifacew1, ifacew2, which list each face's nodes):
+// library": node ordering and face numbering; CalculiX numbers the same faces alike: ccx
+// src/getnodel.f, tables ifaceq (C3D8/C3D20), ifacew1 (C3D6), ifacew2 (C3D15) list each face's
+// corner and mid-edge nodes, in the outward order; the Abaqus lists below run inward):
 //   C3D8   corners 1-2-3-4 around one face, counter-clockwise seen from the opposite face 5-6-7-8,
 //          node 4+i opposite node i. Faces S1 1-2-3-4, S2 5-8-7-6, S3 1-5-6-2, S4 2-6-7-3, S5 3-7-8-4,
 //          S6 4-8-5-1.
