@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <optional>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -394,21 +395,31 @@ std::string vec_text(const Eigen::Vector3d& v) {
   return buf;
 }
 
-/// The angle's frame against the mesh, for decks oriented otherwise than the built-in actuator
-/// (whose defaults the scene keys are). The clamped nodes (all three dofs fixed) of a plane end
-/// face give its outward normal: angle.fixed_normal more than ~25 deg off it would measure the
-/// rotation in a wrong plane, so that is an error naming the normal to use. The inextensible
-/// (stiffest, 100x the softest) part lies on the side the actuator curls to: a bend_direction
-/// pointing away from it only flips the angle's sign, so that is a warning.
-void check_angle_frame(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
+/// The angle's frame from the mesh, for decks oriented otherwise than the built-in actuator (whose
+/// defaults the scene keys are). Two facts of the mesh fix it:
+///  * the clamped nodes (all three dofs fixed) of a plane end face give the face's outward normal;
+///    when they are not one plane face (a clamp over a length of the body), the direction from the
+///    tip face's centroid to the clamped nodes' does;
+///  * the inextensible (stiffest, 100x the softest) part lies on the side the actuator curls to.
+/// With `from_mesh` (a deck whose scene leaves angle.fixed_normal / angle.bend_direction at their
+/// defaults) the keys left at their defaults are taken from these, with a note naming the values (so a
+/// deck along x, or tilted, needs no angle keys). Keys the user set are checked instead: a fixed normal
+/// more than ~25 deg off the clamped face's would measure the rotation in a wrong plane, an error
+/// naming the normal to use; a bend direction pointing away from the layer only flips the angle's
+/// sign, a warning.
+void resolve_angle_frame(const Scene& s, Model& model, bool from_mesh, std::vector<std::string>& warnings) {
   const Mesh& mesh = model.mesh;
+  const bool normal_free = from_mesh && s.origin("angle.fixed_normal") == "default scene";
+  const bool bend_free = from_mesh && s.origin("angle.bend_direction") == "default scene";
   Eigen::Vector3d body = Eigen::Vector3d::Zero();
   for (const auto& x : mesh.X) body += x;
   body /= static_cast<double>(mesh.num_nodes());
   std::vector<Eigen::Vector3d> clamped;
   for (int n = 0; n < mesh.num_nodes(); ++n)
     if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
-  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
+  // n_face: outward normal of the clamped plane face (or 0); n_axis: the body's axis at the clamp,
+  // pointing out of it, from the tip face (or 0).
+  Eigen::Vector3d n_face = Eigen::Vector3d::Zero(), n_axis = Eigen::Vector3d::Zero();
   if (clamped.size() >= 3) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (const auto& x : clamped) c += x;
@@ -419,30 +430,105 @@ void check_angle_frame(const Scene& s, const Model& model, std::vector<std::stri
     const bool planar = es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0;
     Eigen::Vector3d n_fit = es.eigenvectors().col(0);
     if (n_fit.dot(c - body) < 0.0) n_fit = -n_fit;  // outward: away from the body
-    if (planar && (c - body).norm() > 0.0 && n_fit.dot(n_given) < 0.9)
-      s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
-                                   "normal is " + vec_text(n_fit) + ": set angle.fixed_normal = " + vec_text(n_fit) +
-                                   " and angle.bend_direction perpendicular to it, towards the inextensible layer");
+    if (planar && (c - body).norm() > 0.0) n_face = n_fit;
+    if (!model.angle.tip_nodes.empty()) {
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      for (int n : model.angle.tip_nodes) t += mesh.X[n];
+      t /= static_cast<double>(model.angle.tip_nodes.size());
+      if ((c - t).norm() > 0.0) n_axis = (c - t).normalized();
+    }
   }
+  const Eigen::Vector3d n_mesh = n_face.norm() > 0.0 ? n_face : n_axis;
+  if (normal_free && n_mesh.norm() > 0.0 && n_mesh.dot(model.angle.fixed_normal_out.normalized()) < 1.0 - 1e-9) {
+    model.angle.fixed_normal_out = n_mesh;
+    warnings.push_back("angle.fixed_normal taken from the mesh: " + vec_text(n_mesh) + " (the outward normal of " +
+                       (n_face.norm() > 0.0 ? std::string("the clamped end face")
+                                            : std::string("the clamped end, from the tip face's centroid to the clamped nodes'")) +
+                       "); set angle.fixed_normal to choose another");
+  }
+  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
+  if (!normal_free && n_face.norm() > 0.0 && n_face.dot(n_given) < 0.9)
+    s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
+                                 "normal is " + vec_text(n_face) + ": set angle.fixed_normal = " + vec_text(n_face) +
+                                 " and angle.bend_direction perpendicular to it, towards the inextensible layer");
+  // The side of the stiff layer, across the actuator (0 when no part is 100x stiffer than another).
+  Eigen::Vector3d side = Eigen::Vector3d::Zero();
   double mu_min = INFINITY, mu_max = 0.0;
   for (const Part& p : model.parts) {
     mu_min = std::min(mu_min, p.material->initial_shear_modulus());
     mu_max = std::max(mu_max, p.material->initial_shear_modulus());
   }
-  if (!(mu_max > 100.0 * mu_min)) return;
   Eigen::Vector3d layer = Eigen::Vector3d::Zero();
   double count = 0.0;
-  for (int e = 0; e < mesh.num_elements(); ++e)
-    if (model.material_of(e).initial_shear_modulus() == mu_max)
-      for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
-  Eigen::Vector3d side = layer / count - body;
-  side -= side.dot(n_given) * n_given;  // across the actuator, not along it
+  if (mu_max > 100.0 * mu_min) {
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      if (model.material_of(e).initial_shear_modulus() == mu_max)
+        for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
+  } else {  // a membrane fabric (mesh.fabric_model = "membrane") is the layer
+    for (const MembraneSet& m : model.membranes)
+      for (int n : m.nodes) layer += mesh.X[n], count += 1.0;
+  }
+  if (count > 0.0) {
+    side = layer / count - body;
+    side -= side.dot(n_given) * n_given;  // across the actuator, not along it
+  }
+  if (model.angle.mirror_axis >= 0) side[model.angle.mirror_axis] = 0.0;  // a half model bends in its symmetry plane
+  if (bend_free) {
+    // The default direction made perpendicular to the normal is kept when it points within 10 deg of
+    // the layer's side (a translated deck keeps the built-in's exact axes: the centroid of an
+    // asymmetric section is a little off its bending plane); otherwise the side of the layer; without
+    // a stiff layer the default, else the coordinate axis most perpendicular to the normal.
+    Eigen::Vector3d d0 = model.angle.bend_direction - model.angle.bend_direction.dot(n_given) * n_given;
+    const bool d0_ok = d0.norm() >= 1e-3 * model.angle.bend_direction.norm();
+    Eigen::Vector3d d = side;
+    if (d0_ok && (side.norm() == 0.0 || d0.normalized().dot(side.normalized()) > std::cos(10.0 * std::numbers::pi / 180.0))) {
+      d = d0;
+    } else if (side.norm() == 0.0) {
+      Eigen::Index k = 0;
+      n_given.cwiseAbs().minCoeff(&k);
+      d = Eigen::Vector3d::Unit(k) - n_given[k] * n_given;
+    }
+    d.normalize();
+    if (d.dot(model.angle.bend_direction.normalized()) < 1.0 - 1e-9) {
+      model.angle.bend_direction = d;
+      warnings.push_back("angle.bend_direction taken from the mesh: " + vec_text(d) +
+                         (side.norm() > 0.0 ? std::string(" (towards the inextensible layer, so angles are positive)")
+                                            : std::string(" (no part is 100x stiffer than another, so the side the actuator "
+                                                          "bends to is not known from the mesh: check the sign of the angles)")) +
+                         "; set angle.bend_direction to choose another");
+    }
+    return;
+  }
   const Eigen::Vector3d d = model.angle.bend_direction.normalized();
   if (side.norm() > 0.0 && d.dot(side.normalized()) < -0.5)
     warnings.push_back("angle.bend_direction " + vec_text(d) + " points away from the inextensible layer (towards " +
                        vec_text(-side.normalized()) + "), to which the actuator curls: its angles will come out "
                        "negative; set angle.bend_direction = " + vec_text(side.normalized()) +
                        " for the usual positive convention");
+}
+
+/// gravity.rig_angle_deg >= 0: the rig's orientation relative to the actuator, in its angle frame
+/// (so a deck in any orientation, whose frame may come from the mesh, hangs the same way):
+/// g = 9.81 (cos(phi) a + sin(phi) d), a = -angle.fixed_normal (along the actuator, away from the
+/// clamp), d = the bend direction made perpendicular to a. For the built-in frame a = +y, d = -z, so
+/// g = [0, 9.81 cos(phi), -9.81 sin(phi)] to the bit (components below 1e-12 g are exactly 0).
+void set_rig_gravity(const Scene& s, Model& model) {
+  const double phi_deg = s.number("gravity.rig_angle_deg");
+  if (!std::isfinite(phi_deg)) s.fail("gravity.rig_angle_deg", "must be a number (< 0: off)");
+  if (phi_deg < 0.0) return;
+  if (phi_deg > 180.0) s.fail("gravity.rig_angle_deg", "must lie in [0, 180] deg (or < 0: off)");
+  if (model.gravity_m_s2.norm() > 0.0)
+    s.fail("gravity.rig_angle_deg", "and gravity.g_m_s2 both give gravity: set g_m_s2 = [0.0, 0.0, 0.0] or "
+                                    "rig_angle_deg = -1.0");
+  constexpr double g = 9.81;
+  const double phi = phi_deg * std::numbers::pi / 180.0;
+  const Eigen::Vector3d a = -model.angle.fixed_normal_out.normalized();
+  const Eigen::Vector3d d = (model.angle.bend_direction - model.angle.bend_direction.dot(a) * a).normalized();
+  const double ga = g * std::cos(phi), gd = g * std::sin(phi);
+  for (int k = 0; k < 3; ++k) {
+    const double v = ga * a[k] + gd * d[k];
+    model.gravity_m_s2[k] = std::abs(v) < 1e-12 * g ? 0.0 : v;
+  }
 }
 
 }  // namespace
@@ -598,12 +684,13 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
   model.angle.bend_direction = s.vec3("angle.bend_direction");
   if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");
-  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
-    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
   if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
-  check_angle_frame(s, model, out->warnings);
+  resolve_angle_frame(s, model, is_inp, out->warnings);
+  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
+    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
+  set_rig_gravity(s, model);
   out->stats = compute_stats(mesh);
 
   // Load.
