@@ -507,6 +507,71 @@ void resolve_angle_frame(const Scene& s, Model& model, bool from_mesh, std::vect
                        " for the usual positive convention");
 }
 
+/// The free end face of a deck: the node set mesh.tip_set; when the scene leaves that key at its
+/// default and the deck has no such set, the boundary nodes farthest from the clamp, with a note. The
+/// clamp's side is the outward normal of the clamped nodes' plane face (all three dofs fixed); the tip
+/// face is then the set of boundary nodes within 0.1 % of the body's length of the farthest one along
+/// the opposite direction, which must hold at least three nodes that are not on one line (a flat end
+/// face; a rounded end gives its cap, whose fitted plane still turns with the tip).
+std::vector<int> deck_tip_nodes(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
+  const Mesh& mesh = model.mesh;
+  const std::string name = s.string("mesh.tip_set");
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  if (s.origin("mesh.tip_set") != "default scene" || mesh.node_sets.count(name) || mesh.node_sets.count(upper))
+    return node_set(s, mesh, "mesh.tip_set");
+  auto give_up = [&](const std::string& why) -> std::vector<int> {
+    std::string avail;
+    for (const auto& [k, v] : mesh.node_sets) avail += (avail.empty() ? "" : ", ") + k;
+    s.fail("mesh.tip_set", "node set '" + name + "' not found in the mesh (available: " + (avail.empty() ? "(none)" : avail) +
+                               ") and the free end face cannot be found from the mesh: " + why +
+                               "; name the node set of the free end face in mesh.tip_set");
+  };
+  std::vector<Eigen::Vector3d> clamped;
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
+  if (clamped.size() < 3) return give_up("fewer than three clamped nodes");
+  Eigen::Vector3d c = Eigen::Vector3d::Zero(), body = Eigen::Vector3d::Zero();
+  for (const auto& x : clamped) c += x;
+  c /= static_cast<double>(clamped.size());
+  for (const auto& x : mesh.X) body += x;
+  body /= static_cast<double>(mesh.num_nodes());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& x : clamped) cov += (x - c) * (x - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);  // ascending eigenvalues
+  if (!(es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0))
+    return give_up("the clamped nodes are not one plane face");
+  Eigen::Vector3d axis = -es.eigenvectors().col(0);  // into the body, towards the tip
+  if (axis.dot(body - c) < 0.0) axis = -axis;
+  std::vector<char> on_boundary(mesh.num_nodes(), 0);
+  for (const FaceRef& f : boundary_faces(mesh)) {
+    const int* local = face_local_nodes(mesh.type, f.local_face);
+    for (int a = 0; a < nodes_per_face(mesh.type); ++a) on_boundary[mesh.element(f.element)[local[a]]] = 1;
+  }
+  double lo = INFINITY, hi = -INFINITY;
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const double t = axis.dot(mesh.X[n] - c);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  std::vector<int> tip;
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (on_boundary[n] && axis.dot(mesh.X[n] - c) >= hi - 1e-3 * (hi - lo)) tip.push_back(n);
+  Eigen::Vector3d t0 = Eigen::Vector3d::Zero();
+  for (int n : tip) t0 += mesh.X[n];
+  t0 /= std::max<double>(1.0, static_cast<double>(tip.size()));
+  Eigen::Matrix3d tcov = Eigen::Matrix3d::Zero();
+  for (int n : tip) tcov += (mesh.X[n] - t0) * (mesh.X[n] - t0).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ts(tcov);
+  if (tip.size() < 3 || !(ts.eigenvalues()[1] > 1e-12 * ts.eigenvalues()[2]))
+    return give_up("the boundary nodes farthest from the clamp do not span a face");
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%zu boundary nodes at %.4g mm from the clamped face", tip.size(), hi * 1e3);
+  warnings.push_back("mesh.tip_set: the deck has no node set '" + name + "'; the free end face was taken from the mesh (" +
+                     buf + "); name a node set in mesh.tip_set to choose another");
+  return tip;
+}
+
 /// gravity.rig_angle_deg >= 0: the rig's orientation relative to the actuator, in its angle frame
 /// (so a deck in any orientation, whose frame may come from the mesh, hangs the same way):
 /// g = 9.81 (cos(phi) a + sin(phi) d), a = -angle.fixed_normal (along the actuator, away from the
@@ -661,9 +726,17 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
   } else {
     const auto* surface = find_surface(mesh, cav);
-    if (!surface)
+    if (surface) {
+      model.pressure_faces = surface->second;
+    } else if (is_inp && s.origin("mesh.cavity_surface") == "default scene" && !deck.pressure_faces.empty()) {
+      // No surface of the default name: the deck's own pressure load marks the chambers.
+      for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
+      out->warnings.push_back("mesh.cavity_surface: the deck has no surface '" + cav + "'; the faces of its pressure load (" +
+                              std::to_string(deck.pressure_faces.size()) + " *DLOAD Pn faces) are the cavity; name a " +
+                              "surface in mesh.cavity_surface to choose another");
+    } else {
       s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
-    model.pressure_faces = surface->second;
+    }
   }
   if (model.pressure_faces.empty()) s.fail("mesh.cavity_surface", "the cavity surface has no faces");
   {
@@ -680,7 +753,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   }
 
   // Bending angle.
-  model.angle.tip_nodes = node_set(s, mesh, is_inp ? "mesh.tip_set" : "mesh.tip_set");
+  model.angle.tip_nodes = is_inp ? deck_tip_nodes(s, model, out->warnings) : node_set(s, mesh, "mesh.tip_set");
   model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
   model.angle.bend_direction = s.vec3("angle.bend_direction");
   if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");

@@ -606,6 +606,48 @@ TEST_F(InpFiles, ADeckInAnyOrientationBendsAsTheBuiltInWithoutAngleKeys) {
   EXPECT_EQ(count_containing(notes, "angle.bend_direction taken from the mesh"), 1);
 }
 
+// A deck without the tip node set (and the scene leaving mesh.tip_set at its default): the free end
+// face is found from the mesh (the boundary nodes farthest from the clamped face), with a note, and
+// is exactly the built-in mesher's TIP set; a tip set named by the user must exist.
+TEST_F(InpFiles, WithoutATipSetTheFreeEndFaceIsFoundFromTheMesh) {
+  Mesh mesh = build_mesh(Scene::load("", {"geometry.chambers=2", "mesh.h_mm=6.0", "mesh.half=false"}));
+  const std::vector<int> tip = mesh.node_sets.at("TIP");
+  mesh.node_sets.erase("TIP");
+  for (Eigen::Vector3d& x : mesh.X) x = Eigen::Vector3d(x.y(), -x.x(), x.z());  // along x: no help from the defaults
+  std::ostringstream os;
+  write_inp_mesh(os, mesh, 1e-3);
+  const std::string path = write("no_tip.inp", os.str());
+  const auto bm = build_model(Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\""}));
+  EXPECT_EQ(bm->model.angle.tip_nodes, tip);
+  EXPECT_EQ(count_containing(bm->warnings, "mesh.tip_set: the deck has no node set 'TIP'; the free end face was taken from the mesh ("
+                                           + std::to_string(tip.size()) + " boundary nodes at "), 1);
+  try {
+    build_model(Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"", "mesh.tip_set=\"END\""}));
+    ADD_FAILURE() << "a missing tip set named by the user was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("node set 'END' not found in the mesh"), std::string::npos) << e.what();
+  }
+}
+
+// A deck whose chambers are marked only by their pressure load (*DLOAD Pn, no CAVITY surface) and a
+// scene leaving mesh.cavity_surface at its default: the loaded faces are the cavity, with a note.
+TEST_F(InpFiles, WithoutACavitySurfaceTheDecksPressureFacesAreTheCavity) {
+  Mesh mesh = build_mesh(Scene::load("", {"geometry.chambers=2", "mesh.h_mm=6.0"}));
+  const std::vector<FaceRef> cavity = mesh.surfaces.at("CAVITY");
+  mesh.surfaces.erase("CAVITY");
+  std::ostringstream os;
+  write_inp_mesh(os, mesh, 1e-3);
+  os << "*STEP, NLGEOM\n*STATIC\n*DLOAD\n";
+  for (const FaceRef& f : cavity) os << mesh.element_ids[f.element] << ", P" << f.local_face + 1 << ", 0.045\n";
+  os << "*END STEP\n";
+  const std::string path = write("dload_only.inp", os.str());
+  const auto bm = build_model(Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"",
+                                               "mesh.symmetry_set=\"SYMMETRY\""}));
+  EXPECT_EQ(bm->model.pressure_faces, cavity);
+  EXPECT_EQ(count_containing(bm->warnings, "mesh.cavity_surface: the deck has no surface 'CAVITY'; the faces of its pressure load (" +
+                                               std::to_string(cavity.size()) + " *DLOAD Pn faces) are the cavity"), 1);
+}
+
 TEST(InpWrite, RefusesNamesADeckCannotHold) {
   Mesh m = read_inp(data_path("tet4_two.inp"), 0.01).mesh;
   m.node_sets["two words"] = {0};
