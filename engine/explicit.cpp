@@ -102,6 +102,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
       throw PhysicsError(s.str(), e.element(), t_);
     }
     state_.swap(trial_);
+    asm_.update_nonlocal(u_, state_);  // non-local drivers (a no-op without them)
     if (opt_.adaptive_damping) {
       double num = 0.0, den = 0.0;
       for (int i = 0; i < n; ++i)

@@ -226,7 +226,8 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
   }
   if (on("fatigue")) {
     const std::string K = T + ".fatigue";
-    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail"}, "fatigue");
+    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail", "nonlocal_radius_mm"},
+                 "fatigue");
     FatigueParams f;
     const std::string driver = s.string(K + ".driver");
     if (driver == "energy")
@@ -241,6 +242,10 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
     f.q = s.number(K + ".q");
     f.n = s.number(K + ".n");
     f.d_fail = s.number(K + ".d_fail");
+    const double R_mm = s.number(K + ".nonlocal_radius_mm");
+    if (!(std::isfinite(R_mm) && R_mm >= 0.0))
+      s.fail(K + ".nonlocal_radius_mm", "must be >= 0 mm (0 = local driver; > 0: averaged over this radius)");
+    f.nonlocal_radius_m = R_mm * 1e-3;
     e.fatigue = f;
   }
   if (on("viscoelastic")) {
@@ -331,6 +336,13 @@ MaterialPtr make_material(const Scene& s, const std::string& name, double region
       s.fail(l.key, err.what());
     }
   }
+  // A non-local fatigue driver reaches the engine through every layer around it (each forwards
+  // Material::nonlocal); an effect registered in C++ that does not would silently make it local.
+  if (e.fatigue && e.fatigue->nonlocal_radius_m > 0.0 && !(m->nonlocal().radius_m > 0.0))
+    s.fail(T + ".fatigue.nonlocal_radius_mm",
+           "an effect wrapped around fatigue ('" + m->name() + "') does not forward the non-local driver "
+           "(Material::nonlocal, nonlocal_driver, set_nonlocal_driver to its base; docs/adding_an_effect.md); "
+           "set nonlocal_radius_mm = 0.0 or forward them");
   return m;
 }
 
