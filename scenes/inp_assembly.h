@@ -24,7 +24,6 @@ struct Placement {
 
   /// Assembly coordinates of the part point x.
   Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return a + R * (x + t - a); }
-  bool identity() const { return R == Eigen::Matrix3d::Identity() && t.isZero(0.0); }
 };
 
 /// Rotation by angle_deg about the unit vector k, right-handed (Rodrigues). Multiples of 90
