@@ -448,7 +448,7 @@ void Assembler::add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eige
       double W = 0.0;
       if (!membrane_triangle<NPF>(ms, g, t, ue, W, fe, K ? &Ke : nullptr)) {
         std::ostringstream msg;
-        msg << "membrane '" << ms.name << "' triangle " << t + 1 << " (first node " << model_.mesh.node_ids[n[0]]
+        msg << "membrane '" << ms.name << "' triangle " << t + 1 << " (first node " << model_.mesh.node_name(n[0])
             << ") collapsed or produced a non-finite stress at t = " << ts.time_s
             << " s. Hint: the load step is too large; reduce it (static: smaller max_increment) or check the "
                "membrane's thickness and constants.";

@@ -136,7 +136,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
         }
       std::ostringstream s;
       s << "explicit integration became unstable at t = " << t_ << " s (kinetic energy " << KE
-        << " J exceeds the work done " << budget << " J; fastest node " << asm_.model().mesh.node_ids[node]
+        << " J exceeds the work done " << budget << " J; fastest node " << asm_.model().mesh.node_name(node)
         << "), dt = " << dt << " s. Hint: use the estimated stable step (remove solver.dt_s), lower "
         << "solver.dt_safety, or enable selective mass scaling (solver.target_dt_s).";
       throw PhysicsError(s.str(), -1, t_);

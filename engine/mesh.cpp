@@ -36,9 +36,28 @@ int Mesh::find_region(const std::string& name) const {
   return -1;
 }
 
+namespace {
+/// "<scope>.<id - offset>" when the entity belongs to an id scope, else "<id>" (index + 1 without ids).
+std::string scoped_name(std::size_t i, const std::vector<long>& ids, const std::vector<std::uint16_t>& scope,
+                        const std::vector<Mesh::IdScope>& scopes, long Mesh::IdScope::*offset) {
+  const long id = i < ids.size() ? ids[i] : static_cast<long>(i) + 1;
+  if (i >= scope.size() || scope[i] >= scopes.size()) return std::to_string(id);
+  const Mesh::IdScope& s = scopes[scope[i]];
+  return s.name + "." + std::to_string(id - s.*offset);
+}
+}  // namespace
+
+std::string Mesh::node_name(int n) const {
+  return scoped_name(static_cast<std::size_t>(n), node_ids, node_scope, id_scopes, &IdScope::node_id_offset);
+}
+
+std::string Mesh::element_name(int e) const {
+  return scoped_name(static_cast<std::size_t>(e), element_ids, element_scope, id_scopes, &IdScope::element_id_offset);
+}
+
 std::string Mesh::element_label(int e) const {
   const std::size_t i = static_cast<std::size_t>(e);
-  std::string s = "element " + std::to_string(i < element_ids.size() ? element_ids[i] : static_cast<long>(e) + 1);
+  std::string s = "element " + element_name(e);
   if (i < region.size() && region[i] < region_names.size()) s += " (region '" + region_names[region[i]] + "')";
   return s;
 }

@@ -48,6 +48,19 @@ struct Mesh {
   std::vector<long> node_ids;     ///< external (1-based, as in a deck) id of each node
   std::vector<long> element_ids;  ///< external id of each element
 
+  /// A deck of several Abaqus instances numbers each instance's nodes and elements on its own.
+  /// Then node_ids / element_ids are the deck's ids plus an offset per instance (distinct ids,
+  /// as a flat deck needs) and messages name an entity "<instance>.<deck id>", as the user knows
+  /// it. Empty (plain ids) for every other mesh, a deck with one instance among them.
+  struct IdScope {
+    std::string name;  ///< instance name as written in the deck (the assembly's for its own nodes)
+    long node_id_offset = 0;
+    long element_id_offset = 0;
+  };
+  std::vector<IdScope> id_scopes;
+  std::vector<std::uint16_t> node_scope;     ///< per node: index into id_scopes (nodes added later: none)
+  std::vector<std::uint16_t> element_scope;  ///< per element: index into id_scopes
+
   std::map<std::string, std::vector<int>> node_sets;     ///< name -> sorted node indices
   std::map<std::string, std::vector<int>> element_sets;  ///< name -> sorted element indices
   std::map<std::string, std::vector<FaceRef>> surfaces;  ///< name -> element faces
@@ -65,8 +78,12 @@ struct Mesh {
   /// Fills node_ids / element_ids with 1..n when they are empty.
   void ensure_ids();
 
-  /// "element <external id> (region '<tag>')" for messages: the id the user's mesh file uses
-  /// (1-based index when the mesh has none), the region when the mesh is tagged.
+  /// The id of node n / element e as the user's mesh file writes it: "123", or "Actuator-1.123"
+  /// for a deck of several instances (id_scopes); the 1-based index when the mesh has no ids.
+  std::string node_name(int n) const;
+  std::string element_name(int e) const;
+
+  /// "element <element_name> (region '<tag>')" for messages, the region when the mesh is tagged.
   std::string element_label(int e) const;
 };
 

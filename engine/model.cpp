@@ -22,7 +22,7 @@ void validate(const Model& m) {
   if (!unassigned.empty()) {
     std::ostringstream s;
     s << unassigned.size() << " element(s) have no material, e.g. element "
-      << (m.mesh.element_ids.empty() ? unassigned[0] + 1 : m.mesh.element_ids[unassigned[0]])
+      << m.mesh.element_name(unassigned[0])
       << ": map every element set to a material in the scene's [[parts]] table";
     throw InputError(s.str());
   }

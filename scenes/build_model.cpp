@@ -21,6 +21,7 @@
 #include "materials/ogden.h"
 #include "materials/scaled.h"
 #include "scenes/inp.h"
+#include "scenes/inp_assembly.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
 
@@ -61,6 +62,19 @@ double positive(const Scene& scene, const std::string& key) {
   return v;
 }
 
+/// A name `key` gives that the mesh lacks but that several instances of a deck define (stored as
+/// "INSTANCE.NAME" each, inp_assembly.h): a failure listing the qualified names to choose from.
+template <class V>
+void reject_ambiguous(const Scene& s, const std::string& key, const std::map<std::string, V>& names,
+                      const std::string& name, const std::string& what) {
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  const std::vector<std::string> choices = inp::qualified_choices(names, upper);
+  if (choices.size() > 1)
+    s.fail(key, what + " '" + name + "' is defined by " + std::to_string(choices.size()) +
+                    " instances of the deck; name one with its instance: " + inp::join_names(choices, " or "));
+}
+
 // ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
 
 /// A surface of the mesh by its name as the scene writes it, or upper-cased (decks' names are);
@@ -99,6 +113,7 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
   const std::string name = s.string("mesh.fabric_surface");
   const auto* surface = find_surface(mesh, name);
+  if (!surface) reject_ambiguous(s, "mesh.fabric_surface", mesh.surfaces, name, "surface");
   if (!surface || surface->second.empty()) {
     std::string have;
     for (const auto& [k, v] : mesh.surfaces) have += (have.empty() ? "" : ", ") + k;
@@ -171,6 +186,7 @@ const std::vector<int>& node_set(const Scene& s, const Mesh& m, const std::strin
       return it->second;
     }
   }
+  reject_ambiguous(s, key, m.node_sets, name, "node set");
   std::string avail;
   for (const auto& [k, v] : m.node_sets) avail += (avail.empty() ? "" : ", ") + k;
   s.fail(key, "node set '" + name + "' not found in the mesh; available: " + (avail.empty() ? "(none)" : avail));
@@ -641,6 +657,12 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
     deck = read_inp(s.resolve_path(file), length_unit(s));
     out->warnings = deck.warnings;
+    if (deck.solid_instances.size() > 1)
+      s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
+                              " instances (" + inp::join_names(deck.solid_instances) +
+                              ") that share no node, so the model is not connected (ties are not applied); "
+                              "pneufem needs one conforming mesh: merge the instances in Abaqus (Merge/Cut "
+                              "Instances) so the mesh is conforming");
     model.mesh = std::move(deck.mesh);
     if (s.boolean("mesh.promote_to_tet10")) {
       if (model.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
@@ -657,8 +679,11 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
   for (const std::string& elset : s.table_keys("mesh.regions")) {
     const std::vector<int>* els = find_elset(mesh, elset);
-    if (!els) s.fail("mesh.regions." + elset, "element set '" + elset + "' not found in the mesh");
-    const std::uint16_t r = mesh.region_id(s.string("mesh.regions." + elset));
+    if (!els) {
+      reject_ambiguous(s, "mesh.regions." + elset, mesh.element_sets, elset, "element set");
+      s.fail("mesh.regions." + elset, "element set '" + elset + "' not found in the mesh");
+    }
+    const std::uint16_t r = mesh.region_id(s.string_entry("mesh.regions", elset));
     for (int e : *els) mesh.region[e] = r;
   }
 
@@ -672,6 +697,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     const std::string elset = s.string(key + ".elset"), mat = s.string(key + ".material");
     const std::vector<int>* els = find_elset(mesh, elset);
     if (!els) {
+      reject_ambiguous(s, key + ".elset", mesh.element_sets, elset, "element set");
       std::string avail;
       for (const auto& [k, v] : mesh.element_sets) avail += (avail.empty() ? "" : ", ") + k;
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
@@ -685,7 +711,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     std::map<std::uint16_t, int> region_part;
     for (int e : *els) {
       if (model.element_part[e] >= 0)
-        s.fail(key + ".elset", "element " + std::to_string(mesh.element_ids[e]) + " is in two parts ('" +
+        s.fail(key + ".elset", "element " + mesh.element_name(e) + " is in two parts ('" +
                                    model.parts[model.element_part[e]].name + "' and '" + elset + "')");
       int p = part;
       if (static_cast<std::size_t>(e) < mesh.region.size()) {
@@ -705,7 +731,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   }
   for (int e = 0; e < mesh.num_elements(); ++e)
     if (model.element_part[e] < 0)
-      s.fail("parts", "element " + std::to_string(mesh.element_ids[e]) +
+      s.fail("parts", "element " + mesh.element_name(e) +
                           " belongs to no part; add its element set to a [[parts]] entry");
 
   // Boundary conditions.
@@ -723,7 +749,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     const double L = (compute_stats(mesh).bbox_max - compute_stats(mesh).bbox_min).norm();
     for (int n : sym) {
       if (std::abs(mesh.X[n].x()) > 1e-6 * L)
-        s.fail("mesh.symmetry_set", "node " + std::to_string(mesh.node_ids[n]) +
+        s.fail("mesh.symmetry_set", "node " + mesh.node_name(n) +
                                         " is not on the plane x = 0; the symmetry plane must be x = 0");
       model.fixed[3 * n] = 1;
     }
@@ -734,17 +760,18 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   const std::string cav = is_inp ? s.string("mesh.cavity_surface") : "CAVITY";
   if (is_inp && (cav == "DLOAD" || cav == "dload")) {
     if (deck.pressure_faces.empty())
-      s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn lines");
+      s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn or *DSLOAD ..., P lines");
     for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
   } else {
     const auto* surface = find_surface(mesh, cav);
+    if (!surface) reject_ambiguous(s, "mesh.cavity_surface", mesh.surfaces, cav, "surface");
     if (surface) {
       model.pressure_faces = surface->second;
     } else if (is_inp && s.origin("mesh.cavity_surface") == "default scene" && !deck.pressure_faces.empty()) {
       // No surface of the default name: the deck's own pressure load marks the chambers.
       for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
       out->warnings.push_back("mesh.cavity_surface: the deck has no surface '" + cav + "'; the faces of its pressure load (" +
-                              std::to_string(deck.pressure_faces.size()) + " *DLOAD Pn faces) are the cavity; name a " +
+                              std::to_string(deck.pressure_faces.size()) + " *DLOAD/*DSLOAD P faces) are the cavity; name a " +
                               "surface in mesh.cavity_surface to choose another");
     } else {
       s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
@@ -759,7 +786,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     for (const FaceRef& f : model.pressure_faces)
       if (!outside.count({f.element, f.local_face}))
         s.fail("mesh.cavity_surface", "'" + cav + "' has a face inside the solid (face " + std::to_string(f.local_face + 1) +
-                                          " of element " + std::to_string(mesh.element_ids[f.element]) +
+                                          " of element " + mesh.element_name(f.element) +
                                           ", shared by two tetrahedra): the cavity must be the chambers' boundary; "
                                           "name the surface of the chamber walls");
   }
