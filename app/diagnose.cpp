@@ -47,6 +47,7 @@ Scene elastic_reference(const Scene& scene) {
     for (const std::string& sub : scene.table_keys("materials." + m))
       if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
   sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
+  sets.push_back("gravity.rig_angle_deg=-1.0");
   if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
   return scene.with(sets);
 }

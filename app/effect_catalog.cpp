@@ -129,20 +129,17 @@ std::vector<CandidateEffect> builtin_candidates() {
     e.name = "gravity";
     e.description = "the actuator's own weight, with the rig at angle phi: 0 = hanging tip-down, 90 = horizontal";
     e.signature = "an angle offset at zero pressure that changes with pressure as the tip swings, identical in every trial";
-    // Scene frame (default scene): x width, y along the actuator from the fixed end (y = 0), z up,
-    // fabric at the bottom (bend_direction -z). phi = 0: g along +y (the tip hangs below the clamp);
-    // phi = 90 deg: g = -z, towards the fabric side (horizontal actuator bending downwards). The
-    // half model (x >= 0) keeps the symmetry since g_x = 0.
+    // The rig angle phi is set in the actuator's own angle frame (gravity.rig_angle_deg, applied by
+    // scenes/build_model.cpp): 0 = g along the actuator away from the clamp (the tip hangs below it),
+    // 90 deg = g towards the bend direction (horizontal, fabric side down), 180 = tip-up. So a deck in
+    // any orientation (its frame taken from the mesh) is hung the same way; for the built-in actuator
+    // (y along it, fabric at -z) g = [0, 9.81 cos(phi), -9.81 sin(phi)], and the half model (x >= 0)
+    // keeps its symmetry since g_x = 0. A gravity vector of the scene itself is replaced.
     e.params = {{"rig_angle_deg", "deg", 0.0, 180.0, 90.0, 90.0, false}};
     e.interpolation = ParameterInterpolation::rig_angle;
     e.sets = [e](const Scene&, const std::vector<double>& v) {
       require_count(e, v);
-      constexpr double g = 9.81, kPi = 3.14159265358979323846;
-      const double phi = v[0] * kPi / 180.0;
-      // cos(90 deg) is 6e-17, not 0: round components below 1e-12 g to exactly 0.
-      auto clean = [](double x) { return std::abs(x) < 1e-12 * g ? 0.0 : x; };
-      return std::vector<std::string>{"gravity.g_m_s2=[0.0, " + fmt(clean(g * std::cos(phi))) + ", " +
-                                      fmt(clean(-g * std::sin(phi))) + "]"};
+      return std::vector<std::string>{"gravity.g_m_s2=[0.0, 0.0, 0.0]", "gravity.rig_angle_deg=" + fmt(v[0])};
     };
     c.push_back(e);
   }

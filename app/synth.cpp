@@ -92,9 +92,11 @@ std::string key_of(const std::string& set) { return set.substr(0, set.find('='))
 /// `user_keys`) may override a hidden effect's constant, so each parameter is read back from the
 /// resolved scene where it maps to one scalar key (found by perturbing the parameter and seeing
 /// which override changes); otherwise, when one of its keys was overridden, the value is unknown to
-/// the catalog and written as null rather than wrong.
+/// the catalog and written as null rather than wrong; so is a parameter whose key was replaced by
+/// another representation (`replaced_keys`: a hidden rig angle under a --set gravity vector).
 std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::string>& sets, const Scene& base,
-                              const Scene& resolved, const std::set<std::string>& user_keys) {
+                              const Scene& resolved, const std::set<std::string>& user_keys,
+                              const std::set<std::string>& replaced_keys) {
   json::Object params;
   std::vector<double> truth;
   for (const CandidateParameter& p : c.params) truth.push_back(p.truth);
@@ -105,8 +107,9 @@ std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::s
     std::vector<std::string> keys;
     for (std::size_t j = 0; j < sets.size() && j < other.size(); ++j)
       if (sets[j] != other[j]) keys.push_back(key_of(sets[j]));
-    bool overridden = false;
+    bool overridden = false, replaced = false;
     for (const std::string& k : keys) overridden = overridden || user_keys.count(k) > 0;
+    for (const std::string& k : keys) replaced = replaced || replaced_keys.count(k) > 0;
     // The parameter is the key's value itself when one key changes and it holds exactly truth[i].
     bool direct = false;
     if (keys.size() == 1)
@@ -117,7 +120,9 @@ std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::s
           const double x = std::strtod(v.c_str(), &end);
           direct = end && *end == '\0' && std::abs(x - truth[i]) <= 1e-12 * std::abs(truth[i]);
         }
-    if (!overridden)
+    if (replaced)
+      params.add(c.params[i].name, std::string("null"));
+    else if (!overridden)
       params.add(c.params[i].name, truth[i]);
     else if (direct)
       params.add(c.params[i].name, resolved.number(keys[0]));
@@ -197,11 +202,20 @@ SynthResult run_synth(const SynthOptions& o) {
     effect_sets.emplace_back(&c, c.sets(base, values));
     res.hidden_sets.insert(res.hidden_sets.end(), effect_sets.back().second.begin(), effect_sets.back().second.end());
   }
-  const Scene scene = base.with(res.hidden_sets).with(o.sets);
-  json::Object effects;
   std::set<std::string> user_keys;
   for (const std::string& set : o.sets) user_keys.insert(key_of(set));
-  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys));
+  // Hidden gravity is a rig angle (in the actuator's frame); a gravity vector given with --set replaces
+  // it, as any --set replaces a hidden effect's constant (the two cannot be combined in a scene), and
+  // its angle is then unknown to the catalog (null in truth.json).
+  std::vector<std::string> user_sets = o.sets;
+  std::set<std::string> replaced_keys;
+  if (user_keys.count("gravity.g_m_s2") && !user_keys.count("gravity.rig_angle_deg")) {
+    user_sets.push_back("gravity.rig_angle_deg=-1.0");
+    replaced_keys.insert("gravity.rig_angle_deg");
+  }
+  const Scene scene = base.with(res.hidden_sets).with(user_sets);
+  json::Object effects;
+  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys, replaced_keys));
   if (scene.string("load.protocol") != "staircase")
     scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
   if (scene.string("solver.mode") != "quasi_static")

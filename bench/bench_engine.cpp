@@ -25,6 +25,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <Eigen/CholmodSupport>
+
 #include "engine/assembly.h"
 #include "engine/linear_solver.h"
 #include "engine/quasi_static.h"
@@ -196,6 +198,42 @@ void one_trial(double h_mm, int threads) {
       std::printf("    %5.1f  %9.3f\n", r.pressure_Pa * 1e-3, r.angle_deg);
 }
 
+/// Fill-reducing orderings of the Newton tangent (default mesh at h, unloaded: u = 0, no pressure):
+/// for CHOLMOD's default choice and each single method, the analysis time, nnz(L), the flop count
+/// and the median numeric factorisation time (serial BLAS, as LinearSolver runs it).
+void orderings(double h_mm, int threads, int reps) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
+  SparseMatrix K = A.tangent_pattern();
+  A.internal(u, {}, {}, {}, &f, &K, nullptr);
+  Eigen::VectorXd fe = Eigen::VectorXd::Zero(u.size());
+    A.apply_constraints(K, 1.0);
+  { LinearSolver warm; warm.factorize(K); }  // process settings (serial BLAS / OpenMP) as in a run
+  struct Try { const char* name; int nmethods; int ordering; };
+  const Try tries[] = {{"default (CHOLMOD's choice)", 0, -1}, {"AMD", 1, CHOLMOD_AMD}, {"METIS", 1, CHOLMOD_METIS},
+                       {"NESDIS", 1, CHOLMOD_NESDIS}};
+  std::printf("  tangent: %d dofs, nnz(K) = %ld\n", bm->model.num_dofs(), static_cast<long>(K.nonZeros()));
+  for (const Try& t : tries) {
+    Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
+    llt.cholmod().print = 0;
+    if (t.nmethods > 0) {
+      llt.cholmod().nmethods = 1;
+      llt.cholmod().method[0].ordering = t.ordering;
+    }
+    const auto t0 = Clock::now();
+    llt.analyzePattern(K);
+    const double ta = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double tf = median_seconds(reps, [&] { llt.factorize(K); });
+    const auto& c = llt.cholmod();
+    std::printf("  %-28s analysis %6.2f s  selected ordering %d  nnz(L) %.3g  flops %.3g  factorisation %.3f s  (%s)\n",
+                t.name, ta, c.method[c.selected].ordering, c.lnz, c.fl, tf,
+                llt.info() == Eigen::Success ? "ok" : "not positive definite");
+  }
+}
+
 /// The quasi-static protocol of `file` (its own mesh unless --h-mm is given, its own trials unless
 /// trials > 0), timed as a whole and per trial, with the solver's breakdown.
 void protocol(const std::string& file, double h_mm, bool set_h, int trials, int threads) {
@@ -248,7 +286,7 @@ int main(int argc, char** argv) {
   int reps = 7;
   std::string only_element;  // "" = both
   std::string scene_file, protocol_file;
-  bool set_h = false;
+  bool set_h = false, do_orderings = false;
   int trials = 0;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]), set_h = true;
@@ -261,6 +299,12 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--scene-force") && i + 1 < argc) scene_file = argv[++i];
     else if (!std::strcmp(argv[i], "--protocol") && i + 1 < argc) protocol_file = argv[++i];
     else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--orderings")) do_orderings = true;
+  }
+  if (do_orderings) {
+    std::printf("fill-reducing orderings of the tangent (h=%.2f mm):\n", h);
+    orderings(h, threads, reps);
+    return 0;
   }
   if (!protocol_file.empty()) {
     protocol(protocol_file, h, set_h, trials, threads);

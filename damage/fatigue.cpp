@@ -113,12 +113,13 @@ double max_principal_stretch(const Mat3& F) {
   return std::sqrt(eig.eigenvalues()(2));  // eigenvalues ascending
 }
 
-/// g of one point for a force-only evaluation: F and the base's isochoric energy W0 of the point;
-/// `below` = stretch_surely_below(F) when already known.
-double force_only_growth(const Mat3& F, double W0, const FatigueParams& p, bool below) {
-  if (p.driver == FatigueDriver::energy) return growth_factor(W0, p);
+/// g of one point for a force-only evaluation: F and the base's isochoric energy W0 of the point,
+/// the non-local ratio rho (1 when local); `below` = stretch_surely_below(F, lambda_th / rho) when
+/// already known. (rho = 1 multiplies exactly: the local law's bits.)
+double force_only_growth(const Mat3& F, double W0, double rho, const FatigueParams& p, bool below) {
+  if (p.driver == FatigueDriver::energy) return growth_factor(rho * W0, p);
   if (below) return 0.0;
-  return growth_factor(max_principal_stretch(F), p);
+  return growth_factor(rho * max_principal_stretch(F), p);
 }
 }  // namespace
 
@@ -160,13 +161,39 @@ FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(s
 
 void FatigueDamage::init_state(std::span<double> state) const {
   state[0] = 1.0;  // integrity 1 - d
-  base_->init_state(state.subspan(kOwnState));
+  if (own_state_size() > 1) state[1] = 1.0;  // rho: no average known yet
+  base_->init_state(state.subspan(static_cast<std::size_t>(own_state_size())));
+}
+
+Material::NonlocalSpec FatigueDamage::nonlocal() const {
+  if (!(p_.nonlocal_radius_m > 0.0)) return base_->nonlocal();
+  return {p_.nonlocal_radius_m, p_.driver == FatigueDriver::energy ? "fatigue:energy" : "fatigue:stretch"};
+}
+
+double FatigueDamage::nonlocal_driver(const Mat3& F, std::span<const double> state) const {
+  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  if (!(p_.nonlocal_radius_m > 0.0)) return base_->nonlocal_driver(F, state.subspan(own));
+  if (p_.driver == FatigueDriver::max_principal_stretch) return max_principal_stretch(F);
+  // W0: the base's isochoric energy at its committed state (as evaluate() sees it at dt = 0).
+  PointResponse r;
+  detail::evaluate_base(*base_, F, TimeStep{}, detail::PointState{{}, {}, state.subspan(own), {}}, r, false);
+  return r.psi_iso;
+}
+
+void FatigueDamage::set_nonlocal_driver(std::span<double> state, double local, double average) const {
+  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  if (!(p_.nonlocal_radius_m > 0.0)) return base_->set_nonlocal_driver(state.subspan(own), local, average);
+  // rho = average / local; 1 where the local driver is ~0 (an unloaded point of the energy driver:
+  // below any threshold either way) or not finite.
+  const double scale = p_.driver == FatigueDriver::energy ? p_.W_th_Pa : 1.0;
+  const double rho = local > 1e-9 * scale ? average / local : 1.0;
+  state[1] = std::isfinite(rho) && rho > 0.0 ? rho : 1.0;
 }
 
 void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                              std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
   const double dt_over_tau = step.dt_s / p_.tau_s;
   const bool by_energy = p_.driver == FatigueDriver::energy;
   for (std::size_t q = 0; q < F.size(); ++q) {
@@ -174,25 +201,30 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
     PointResponse& r = out[q];
     detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
     const double s_old = ps.own_old.empty() ? 1.0 : ps.own_old[0];
+    const double rho = own > 1 && !ps.own_old.empty() ? ps.own_old[1] : 1.0;  // non-local ratio (1: local)
 
-    // Driver X, its rate factor g and dX/dF (the tangent's). Below the threshold g = dg/dX = 0, and
-    // dX/dF then drops out of the tangent (ds/dX = 0).
+    // Driver X (rho times the local one), its rate factor g and dX/dF (the tangent's). Below the
+    // threshold g = dg/dX = 0, and dX/dF then drops out of the tangent (ds/dX = 0).
     FatigueRate rate;
-    Mat3 dX_dF = r.P_iso;
+    Mat3 dX_dF = rho * r.P_iso;
     if (!tangent) {
-      const bool below = !by_energy && stretch_surely_below(F[q], p_.lambda_th);
-      rate.g = force_only_growth(F[q], r.psi_iso, p_, below);
+      const bool below = !by_energy && stretch_surely_below(F[q], p_.lambda_th / rho);
+      rate.g = force_only_growth(F[q], r.psi_iso, rho, p_, below);
     } else if (by_energy) {
-      rate = fatigue_rate(r.psi_iso, p_);
-    } else if (!stretch_surely_below(F[q], p_.lambda_th)) {
+      rate = fatigue_rate(rho * r.psi_iso, p_);
+    } else if (!stretch_surely_below(F[q], p_.lambda_th / rho)) {
       const Eigen::SelfAdjointEigenSolver<Mat3> eig(F[q].transpose() * F[q]);
       const Vec3 n = eig.eigenvectors().col(2);  // eigenvalues ascending
-      rate = fatigue_rate(std::sqrt(eig.eigenvalues()(2)), p_);
-      dX_dF = F[q] * n * n.transpose() / rate.X;
+      const double lambda = std::sqrt(eig.eigenvalues()(2));
+      rate = fatigue_rate(rho * lambda, p_);
+      dX_dF = rho * (F[q] * n * n.transpose() / lambda);
     }
     const IntegrityUpdate upd = update_integrity(s_old, rate.g, dt_over_tau, p_);
     const double s_new = upd.s;
-    if (!ps.own_new.empty()) ps.own_new[0] = s_new;
+    if (!ps.own_new.empty()) {
+      ps.own_new[0] = s_new;
+      if (own > 1) ps.own_new[1] = rho;
+    }
     if (tangent) {
       // d s_new / dF = ds/da (dt / tau) g'(X) dX/dF
       const double ds_da = upd.at_floor ? 0.0 : integrity_rate(s_new, s_old, upd.a, p_.n);
@@ -208,28 +240,34 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
 void FatigueDamage::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
                            std::span<double> state_new) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
   if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
     return Material::stress(b, step, state_old, state_new);
   const double dt_over_tau = step.dt_s / p_.tau_s;
   const bool by_energy = p_.driver == FatigueDriver::energy;
+  double rho[StressBatch::kLanes];  // non-local ratio per lane (1: local, and for the padding lanes)
+  for (int l = 0; l < StressBatch::kLanes; ++l)
+    rho[l] = own > 1 && !state_old.empty() && l < b.n ? state_old[static_cast<std::size_t>(l) * (own + nb) + 1] : 1.0;
   bool below[StressBatch::kLanes] = {};  // the stretch driver's bound, all lanes at once
   if (!by_energy)
     for (int l = 0; l < StressBatch::kLanes; ++l)
-      below[l] = stretch_surely_below([&b, l](int k) { return b.F[k][l]; }, p_.lambda_th);
+      below[l] = stretch_surely_below([&b, l](int k) { return b.F[k][l]; }, p_.lambda_th / rho[l]);
   for (int l = 0; l < b.n; ++l) {
     const detail::PointState ps = detail::point_state(state_old, state_new, static_cast<std::size_t>(l), own, nb);
     const double s_old = ps.own_old.empty() ? 1.0 : ps.own_old[0];
-    const double g = force_only_growth(b.F_of(l), b.psi_iso[l], p_, below[l]);
+    const double g = force_only_growth(b.F_of(l), b.psi_iso[l], rho[l], p_, below[l]);
     const double s_new = update_integrity(s_old, g, dt_over_tau, p_).s;
-    if (!ps.own_new.empty()) ps.own_new[0] = s_new;
+    if (!ps.own_new.empty()) {
+      ps.own_new[0] = s_new;
+      if (own > 1) ps.own_new[1] = rho[l];
+    }
     for (int k = 0; k < 9; ++k) b.P_iso[k][l] *= s_new;
     b.psi_iso[l] *= s_new;
   }
 }
 
 PointFields FatigueDamage::fields(std::span<const double> state) const {
-  PointFields f = base_->fields(state.subspan(kOwnState));
+  PointFields f = base_->fields(state.subspan(static_cast<std::size_t>(own_state_size())));
   const double d = 1.0 - state[0];
   f.damage = detail::combine_damage(d, f.damage);
   f.failed = f.failed || state[0] <= 1.0 - p_.d_fail;  // the integrity floor, bit for bit (evaluate)

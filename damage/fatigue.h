@@ -49,7 +49,17 @@
 // psi_iso = (1 - d_new) W0 is the stored energy of the damaged solid. It is not a potential of P_iso
 // within an increment with dt > 0 (d_new depends on F), only at dt = 0.
 //
-// State per point: [1 - d].
+// Non-local driver (nonlocal_radius_m > 0; engine/nonlocal.h). X is replaced by rho X, where rho =
+// X_bar / X is the ratio of the averaged to the local driver at the last committed state (kept in the
+// state; 1 when the local driver is ~0, e.g. an unloaded energy driver). This is the integral non-local
+// model with the spatial averaging lagged by one physical step (an operator split): the law stays
+// local and implicit within a step, with the consistent tangent of rho X, and it is the non-local
+// model when the driver's spatial shape changes little over a step (exact for proportional
+// loading), which the physical step control keeps so. Where the driver is singular (a re-entrant
+// corner) rho < 1 caps it at the average over the radius, so damage no longer concentrates in the
+// one element at the corner, whose size would then set the result.
+//
+// State per point: [1 - d] (local) or [1 - d, rho] (non-local).
 #include <string>
 
 #include "materials/material.h"
@@ -72,6 +82,7 @@ struct FatigueParams {
   FatigueDriver driver = FatigueDriver::energy;
   double lambda_th = 0.0;
   double n = 1.0;
+  double nonlocal_radius_m = 0.0;  ///< > 0: the driver is averaged over this radius (m); 0 = local
 };
 
 /// Driver excess and damage rate at one point, dd/dt = (g / tau) (1 - d)^n.
@@ -84,14 +95,15 @@ FatigueRate fatigue_rate(double X, const FatigueParams& p);
 
 class FatigueDamage final : public Material {
  public:
-  static constexpr int kOwnState = 1;  ///< [1 - d]
 
   /// Throws InputError for bad parameters or a base that is not split or whose energy is not a
   /// potential of its stress (a viscoelastic base: wrap viscoelastic around fatigue instead).
   FatigueDamage(MaterialPtr base, const FatigueParams& p);
 
   std::string name() const override { return "fatigue(" + base_->name() + ")"; }
-  int state_size() const override { return kOwnState + base_->state_size(); }
+  /// [1 - d] or, with a non-local driver, [1 - d, rho].
+  int own_state_size() const { return p_.nonlocal_radius_m > 0.0 ? 2 : 1; }
+  int state_size() const override { return own_state_size() + base_->state_size(); }
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
@@ -102,6 +114,11 @@ class FatigueDamage final : public Material {
   PointFields fields(std::span<const double> state) const override;
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// With nonlocal_radius_m > 0: kind "fatigue:energy" or "fatigue:stretch"; the driver X at the
+  /// committed state; rho = average / X stored for the next increments.
+  NonlocalSpec nonlocal() const override;
+  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override;
+  void set_nonlocal_driver(std::span<double> state, double local, double average) const override;
 
   const FatigueParams& params() const { return p_; }
   const MaterialPtr& base() const { return base_; }

@@ -70,6 +70,14 @@ class Mullins final : public Material {
   PointFields fields(std::span<const double> state) const override;
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// Forwarded to the base (its slice of the state).
+  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
+  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
+    return base_->nonlocal_driver(F, state.subspan(kOwnState));
+  }
+  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
+    base_->set_nonlocal_driver(state.subspan(kOwnState), local, average);
+  }
 
   const MullinsParams& params() const { return p_; }
   const MaterialPtr& base() const { return base_; }

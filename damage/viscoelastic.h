@@ -71,6 +71,14 @@ class Viscoelastic final : public Material {
   /// The INSTANTANEOUS shear modulus (1 + sum gamma) mu_inf: stable-step estimates need the stiffest response.
   double initial_shear_modulus() const override { return (1.0 + gamma_sum_) * mu_inf_; }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// Forwarded to the base (its slice of the state): a fatigue law inside keeps its non-local driver.
+  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
+  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
+    return base_->nonlocal_driver(F, state.subspan(static_cast<std::size_t>(own_state_size())));
+  }
+  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
+    base_->set_nonlocal_driver(state.subspan(static_cast<std::size_t>(own_state_size())), local, average);
+  }
 
   int terms() const { return n_; }
   const MaterialPtr& base() const { return base_; }

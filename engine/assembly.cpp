@@ -5,12 +5,16 @@
 #include <atomic>
 #include <climits>
 #include <cmath>
+#include <map>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
 
+#include "engine/nonlocal.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -83,6 +87,7 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
   state_offset_.assign(ne + 1, 0);
   for (int e = 0; e < ne; ++e)
     state_offset_[e + 1] = state_offset_[e] + static_cast<std::size_t>(geom_.nqp) * model.material_of(e).state_size();
+  build_nonlocal();
 
   mass_ = Eigen::VectorXd::Zero(nn);
   const auto frac = lumped_mass_fractions(mesh.type);
@@ -443,7 +448,7 @@ void Assembler::add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eige
       double W = 0.0;
       if (!membrane_triangle<NPF>(ms, g, t, ue, W, fe, K ? &Ke : nullptr)) {
         std::ostringstream msg;
-        msg << "membrane '" << ms.name << "' triangle " << t + 1 << " (first node " << model_.mesh.node_ids[n[0]]
+        msg << "membrane '" << ms.name << "' triangle " << t + 1 << " (first node " << model_.mesh.node_name(n[0])
             << ") collapsed or produced a non-finite stress at t = " << ts.time_s
             << " s. Hint: the load step is too large; reduce it (static: smaller max_increment) or check the "
                "membrane's thickness and constants.";
@@ -499,6 +504,71 @@ Assembler::RegionFailures Assembler::failed_points(std::span<const double> state
       if (mat.fields(state.subspan(state_offset_[e] + q * ss, ss)).failed) ++r.failed[reg];
   }
   return r;
+}
+
+void Assembler::build_nonlocal() {
+  const Mesh& mesh = model_.mesh;
+  const int ne = mesh.num_elements(), nqp = geom_.nqp, npe = mesh.npe();
+  nl_element_.assign(ne, 0);
+  // One group per (kind, radius): points of the same driver and length are averaged together,
+  // across parts (the silicone's regions with their own stiffness scales are one material).
+  std::map<std::pair<std::string, double>, int> group_of;
+  std::vector<double> radius;
+  std::vector<int> element_group(ne, -1);
+  for (std::size_t p = 0; p < model_.parts.size(); ++p) {
+    const Material::NonlocalSpec spec = model_.parts[p].material->nonlocal();
+    if (!(spec.radius_m > 0.0)) continue;
+    const auto [it, added] = group_of.emplace(std::make_pair(spec.kind, spec.radius_m), static_cast<int>(radius.size()));
+    if (added) radius.push_back(spec.radius_m);
+    for (int e = 0; e < ne; ++e)
+      if (model_.element_part[e] == static_cast<int>(p)) element_group[e] = it->second;
+  }
+  if (radius.empty()) return;
+  std::vector<NonlocalAverage::Point> points(static_cast<std::size_t>(ne) * nqp);
+  const auto rule = tet_rule(mesh.type);
+  std::array<double, 10> N{};
+  std::array<double, 30> dN{};
+  for (int e = 0; e < ne; ++e) {
+    if (element_group[e] < 0) continue;
+    nl_element_[e] = 1;
+    for (int q = 0; q < nqp; ++q) {
+      tet_shape(mesh.type, rule[q].xi, rule[q].eta, rule[q].zeta, N.data(), dN.data());
+      NonlocalAverage::Point& pt = points[static_cast<std::size_t>(e) * nqp + q];
+      for (int a = 0; a < npe; ++a) pt.X += N[a] * mesh.X[mesh.element(e)[a]];
+      pt.volume_m3 = geom_.w(e, q);
+      pt.group = element_group[e];
+    }
+  }
+  nonlocal_ = std::make_shared<const NonlocalAverage>(points, radius);
+}
+
+void Assembler::update_nonlocal(const Eigen::VectorXd& u, std::span<double> state) const {
+  if (!nonlocal_) return;
+  const Mesh& mesh = model_.mesh;
+  const int ne = mesh.num_elements(), nqp = geom_.nqp, npe = mesh.npe();
+  std::vector<double> X(static_cast<std::size_t>(ne) * nqp, 0.0), Xbar(X.size(), 0.0);
+  auto point_state = [&](int e, int q) {
+    const std::size_t ss = static_cast<std::size_t>(model_.material_of(e).state_size());
+    return state.subspan(state_offset_[e] + q * ss, ss);
+  };
+  tbb::parallel_for(0, ne, [&](int e) {
+    if (!nl_element_[e]) return;
+    const int* n = mesh.element(e);
+    for (int q = 0; q < nqp; ++q) {
+      const double* g = geom_.grad(e, q);
+      Mat3 F = Mat3::Identity();
+      for (int a = 0; a < npe; ++a) F += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+      X[static_cast<std::size_t>(e) * nqp + q] = model_.material_of(e).nonlocal_driver(F, point_state(e, q));
+    }
+  });
+  nonlocal_->average(X, Xbar);
+  tbb::parallel_for(0, ne, [&](int e) {
+    if (!nl_element_[e]) return;
+    for (int q = 0; q < nqp; ++q) {
+      const std::size_t i = static_cast<std::size_t>(e) * nqp + q;
+      model_.material_of(e).set_nonlocal_driver(point_state(e, q), X[i], Xbar[i]);
+    }
+  });
 }
 
 void Assembler::point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,

@@ -9,6 +9,7 @@
 // results are bit-for-bit identical for 1 and N threads, without atomics or per-thread buffers.
 // Membrane layers (Model::membranes) are few triangles and are added serially after the
 // coloured loop, so they keep this property.
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -21,6 +22,7 @@
 namespace pneufem {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+class NonlocalAverage;
 
 class Assembler {
  public:
@@ -86,11 +88,21 @@ class Assembler {
   };
   RegionFailures failed_points(std::span<const double> state) const;
 
+  /// Non-local drivers (Material::nonlocal, engine/nonlocal.h): true when some material averages
+  /// its driver over a radius. update_nonlocal() then reads every such point's driver at the
+  /// committed state (u, state), averages it over the points of the same kind within the radius,
+  /// and stores the average into `state` for the next increments; every driver calls it after each
+  /// committed state (a no-op without non-local materials). Deterministic for any thread count.
+  bool has_nonlocal() const { return nonlocal_ != nullptr; }
+  void update_nonlocal(const Eigen::VectorXd& u, std::span<double> state) const;
+  const NonlocalAverage* nonlocal_average() const { return nonlocal_.get(); }
+
   /// Deformation gradients and responses at the element's quadrature points (for output).
   void point_responses(const Eigen::VectorXd& u, int e, std::span<const double> state, std::span<Mat3> F,
                        std::span<PointResponse> out) const;
 
  private:
+  void build_nonlocal();  ///< sets nonlocal_ / nl_element_ (constructor)
   template <int NPE, int NQP>
   void internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
                      std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
@@ -125,6 +137,10 @@ class Assembler {
   // [(t * npf + a) * npf + b], as pair_slot_).
   std::vector<MembraneGeometry> mgeom_;
   std::vector<std::vector<std::uint16_t>> mslot_;
+  // Non-local averaging over the points (element-major, nqp each) of elements whose material has a
+  // non-local driver (nl_element_[e]); null when there are none.
+  std::shared_ptr<const NonlocalAverage> nonlocal_;
+  std::vector<char> nl_element_;
 };
 
 }  // namespace pneufem

@@ -102,6 +102,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
       throw PhysicsError(s.str(), e.element(), t_);
     }
     state_.swap(trial_);
+    asm_.update_nonlocal(u_, state_);  // non-local drivers (a no-op without them)
     if (opt_.adaptive_damping) {
       double num = 0.0, den = 0.0;
       for (int i = 0; i < n; ++i)
@@ -135,7 +136,7 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
         }
       std::ostringstream s;
       s << "explicit integration became unstable at t = " << t_ << " s (kinetic energy " << KE
-        << " J exceeds the work done " << budget << " J; fastest node " << asm_.model().mesh.node_ids[node]
+        << " J exceeds the work done " << budget << " J; fastest node " << asm_.model().mesh.node_name(node)
         << "), dt = " << dt << " s. Hint: use the estimated stable step (remove solver.dt_s), lower "
         << "solver.dt_safety, or enable selective mass scaling (solver.target_dt_s).";
       throw PhysicsError(s.str(), -1, t_);

@@ -79,7 +79,7 @@ MembraneGeometry compute_membrane_geometry(const Mesh& mesh, const MembraneSet& 
       const double jac = c.norm();
       if (!(jac > 1e-12 * G1.norm() * G2.norm()))
         throw InputError("membrane '" + set.name + "': triangle " + std::to_string(t + 1) + " (first node " +
-                         std::to_string(mesh.node_ids.empty() ? n[0] + 1 : mesh.node_ids[n[0]]) +
+                         mesh.node_name(n[0]) +
                          ") is degenerate (zero area at an integration point); check its node order");
       Eigen::Matrix<double, 3, 2> T;
       T.col(0) = G1.normalized();

@@ -36,16 +36,43 @@ int Mesh::find_region(const std::string& name) const {
   return -1;
 }
 
+namespace {
+/// "<scope>.<id - offset>" when entity i belongs to an id scope, else "<id>".
+std::string scoped_name(long id, std::size_t i, const std::vector<std::uint16_t>& scope,
+                        const std::vector<Mesh::IdScope>& scopes, long Mesh::IdScope::*offset) {
+  if (i >= scope.size() || scope[i] >= scopes.size()) return std::to_string(id);
+  const Mesh::IdScope& s = scopes[scope[i]];
+  return s.name + "." + std::to_string(id - s.*offset);
+}
+
+/// The external id of entity i (index + 1 without ids).
+long external_id(std::size_t i, const std::vector<long>& ids) {
+  return i < ids.size() ? ids[i] : static_cast<long>(i) + 1;
+}
+}  // namespace
+
+std::string Mesh::node_name(int n) const {
+  const std::size_t i = static_cast<std::size_t>(n);
+  return scoped_name(external_id(i, node_ids), i, node_scope, id_scopes, &IdScope::node_id_offset);
+}
+
+std::string Mesh::element_name(int e) const {
+  const std::size_t i = static_cast<std::size_t>(e);
+  return scoped_name(external_id(i, element_ids), i, element_scope, id_scopes, &IdScope::element_id_offset);
+}
+
 std::string Mesh::element_label(int e) const {
   const std::size_t i = static_cast<std::size_t>(e);
-  std::string s = "element " + std::to_string(i < element_ids.size() ? element_ids[i] : static_cast<long>(e) + 1);
   std::string detail;
   if (element_sources.size() == static_cast<std::size_t>(num_elements()) && element_sources[i].piece > 0) {
+    // The deck element it was split from shares its id scope.
     const ElementSource& src = element_sources[i];
-    detail = "tet " + std::to_string(src.piece) + " of " + std::string(src.type.data()) + " " + std::to_string(src.id);
+    detail = "tet " + std::to_string(src.piece) + " of " + std::string(src.type.data()) + " " +
+             scoped_name(src.id, i, element_scope, id_scopes, &IdScope::element_id_offset);
   }
   if (i < region.size() && region[i] < region_names.size())
     detail += (detail.empty() ? "region '" : ", region '") + region_names[region[i]] + "'";
+  const std::string s = "element " + element_name(e);
   return detail.empty() ? s : s + " (" + detail + ")";
 }
 

@@ -42,7 +42,7 @@ inline constexpr const char* kFabric = "fabric";
 /// deck's elements are split into tetrahedra (scenes/solid_split.h), and messages should still lead
 /// the user to the element of their mesh file.
 struct ElementSource {
-  long id = 0;                ///< the deck's element id
+  long id = 0;                ///< the deck's element id, as element_ids (offset by its id scope)
   std::uint8_t piece = 0;     ///< 1-based tetrahedron of that element; 0 = the deck's own tetrahedron
   std::uint8_t pieces = 0;    ///< tetrahedra it was split into
   std::array<char, 6> type{};  ///< its type, NUL-terminated ("C3D8", "C3D20")
@@ -59,6 +59,19 @@ struct Mesh {
   std::vector<long> node_ids;     ///< external (1-based, as in a deck) id of each node
   std::vector<long> element_ids;  ///< external id of each element
   std::vector<ElementSource> element_sources;  ///< per element, or empty when nothing was split
+
+  /// A deck of several Abaqus instances numbers each instance's nodes and elements on its own.
+  /// Then node_ids / element_ids are the deck's ids plus an offset per instance (distinct ids,
+  /// as a flat deck needs) and messages name an entity "<instance>.<deck id>", as the user knows
+  /// it. Empty (plain ids) for every other mesh, a deck with one instance among them.
+  struct IdScope {
+    std::string name;  ///< instance name as written in the deck (the assembly's for its own nodes)
+    long node_id_offset = 0;
+    long element_id_offset = 0;
+  };
+  std::vector<IdScope> id_scopes;
+  std::vector<std::uint16_t> node_scope;     ///< per node: index into id_scopes (nodes added later: none)
+  std::vector<std::uint16_t> element_scope;  ///< per element: index into id_scopes
 
   std::map<std::string, std::vector<int>> node_sets;     ///< name -> sorted node indices
   std::map<std::string, std::vector<int>> element_sets;  ///< name -> sorted element indices
@@ -77,9 +90,15 @@ struct Mesh {
   /// Fills node_ids / element_ids with 1..n when they are empty.
   void ensure_ids();
 
-  /// "element <external id> (region '<tag>')" for messages: the id the user's mesh file uses
-  /// (1-based index when the mesh has none), the region when the mesh is tagged, and for a
-  /// tetrahedron split from a deck's element "element 1043 (tet 3 of C3D8 57, region '<tag>')".
+  /// The id of node n / element e as the user's mesh file writes it: "123", or "Actuator-1.123"
+  /// for a deck of several instances (id_scopes); the 1-based index when the mesh has no ids.
+  std::string node_name(int n) const;
+  std::string element_name(int e) const;
+
+  /// "element <element_name> (region '<tag>')" for messages, the region when the mesh is tagged;
+  /// for a tetrahedron split from a deck's element also that element, named in the same id scope:
+  /// "element 1043 (tet 3 of C3D8 57, region '<tag>')", "element Actuator-1.1043 (tet 3 of C3D8
+  /// Actuator-1.57, region '<tag>')". Every message that names an element of a mesh uses it.
   std::string element_label(int e) const;
 };
 

@@ -21,8 +21,7 @@ void validate(const Model& m) {
   }
   if (!unassigned.empty()) {
     std::ostringstream s;
-    s << unassigned.size() << " element(s) have no material, e.g. element "
-      << (m.mesh.element_ids.empty() ? unassigned[0] + 1 : m.mesh.element_ids[unassigned[0]])
+    s << unassigned.size() << " element(s) have no material, e.g. " << m.mesh.element_label(unassigned[0])
       << ": map every element set to a material in the scene's [[parts]] table";
     throw InputError(s.str());
   }

@@ -1,12 +1,18 @@
 #include "engine/path_model.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <numeric>
 #include <string>
+#include <utility>
 
 #include "engine/angle.h"
 #include "engine/assembly.h"
+#include "engine/nonlocal.h"
+#include "engine/tet_element.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -235,6 +241,55 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
   std::vector<Mat3> Fbuf;
   std::vector<PointResponse> rbuf;
 
+  // Non-local drivers (engine/nonlocal.h) over the reduced model's own points: quadrature points or
+  // element centroids, with their (importance-sampling) weights as volumes; the same protocol as the
+  // FEM's Assembler::update_nonlocal, after every committed state.
+  std::unique_ptr<NonlocalAverage> nonlocal;
+  std::vector<std::pair<int, std::size_t>> pt_slot(np, {-1, 0});  // (group, index within it) per point
+  for (std::size_t k = 0; k < gm.material.size(); ++k)
+    for (std::size_t j = 0; j < gm.points[k].size(); ++j) pt_slot[gm.points[k][j]] = {static_cast<int>(k), j};
+  {
+    std::map<std::pair<std::string, double>, int> group_of;
+    std::vector<double> radius;
+    std::vector<NonlocalAverage::Point> pts(np);
+    const auto rule = tet_rule(ref_.mesh.type);
+    std::array<double, 10> N{};
+    std::array<double, 30> dN{};
+    for (std::size_t i = 0; i < np; ++i) {
+      const Material::NonlocalSpec spec = gm.material[pt_slot[i].first]->nonlocal();
+      if (!(spec.radius_m > 0.0)) continue;
+      const auto [it, added] = group_of.emplace(std::make_pair(spec.kind, spec.radius_m), static_cast<int>(radius.size()));
+      if (added) radius.push_back(spec.radius_m);
+      const int e = pt_element_[i], npe = ref_.mesh.npe();
+      if (pt_qp_[i] >= 0) {
+        tet_shape(ref_.mesh.type, rule[pt_qp_[i]].xi, rule[pt_qp_[i]].eta, rule[pt_qp_[i]].zeta, N.data(), dN.data());
+      } else {
+        tet_shape(ref_.mesh.type, 0.25, 0.25, 0.25, N.data(), dN.data());
+      }
+      for (int a = 0; a < npe; ++a) pts[i].X += N[a] * ref_.mesh.X[ref_.mesh.element(e)[a]];
+      pts[i].volume_m3 = pt_weight_[i];
+      pts[i].group = it->second;
+    }
+    if (!radius.empty()) nonlocal = std::make_unique<NonlocalAverage>(pts, radius);
+  }
+  auto update_nonlocal = [&](double theta) {
+    if (!nonlocal) return;
+    const int k = segment(theta);
+    const double a = (theta - theta_[k]) / (theta_[k + 1] - theta_[k]);
+    const Mat3* F0 = F_.data() + k * np;
+    const Mat3* F1 = F0 + np;
+    std::vector<double> X(np, 0.0), Xbar(np, 0.0);
+    auto point_state = [&](std::size_t i) {
+      const auto [gi, j] = pt_slot[i];
+      const std::size_t ss = static_cast<std::size_t>(gm.material[gi]->state_size());
+      return std::span<double>(state_old).subspan(gm.state_offset[gi] + j * ss, ss);
+    };
+    for (std::size_t i = 0; i < np; ++i)
+      X[i] = gm.material[pt_slot[i].first]->nonlocal_driver(F0[i] + a * (F1[i] - F0[i]), point_state(i));
+    nonlocal->average(X, Xbar);
+    for (std::size_t i = 0; i < np; ++i) gm.material[pt_slot[i].first]->set_nonlocal_driver(point_state(i), X[i], Xbar[i]);
+  };
+
   // Equilibrium residual in pressure units (Pa): p_el + (G_model - G_ref - g.S') / V' - p.
   auto residual = [&](double theta, double p, const TimeStep& ts) {
     ++st.evaluations;
@@ -327,6 +382,7 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
     theta = x0;
     if (theta > theta_.back() || theta < theta_.front()) st.beyond_path = true;
     state_old.swap(state_new);  // commit
+    update_nonlocal(theta);
     ++st.steps;
   };
 

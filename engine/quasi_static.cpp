@@ -185,6 +185,7 @@ void QuasiStaticRun::equilibrium(double p0, double p1, double t0, double t1) {
       throw PhysicsError(s.str(), -1, t1);
     }
     state_.swap(trial);
+    asm_.update_nonlocal(u_, state_);
   }
   ++stats_.states;
 }

@@ -417,6 +417,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
     }
     has_equilibrium_ = true;
     state.swap(trial);
+    asm_.update_nonlocal(u, state);
     return;
   }
   double s_done = 0.0;  // fraction of the increment completed
@@ -488,6 +489,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
     }
     u = u_try;
     state.swap(trial);
+    asm_.update_nonlocal(u, state);
     s_done += ds;
     // Aim at ~4-6 iterations per increment.
     if (r.iterations <= 4)

@@ -102,8 +102,8 @@ ElementGeometry compute_geometry(const Mesh& mesh) {
       const double detJ = Jm.determinant();
       if (!(detJ > 0.0)) {
         std::ostringstream s;
-        s << mesh.element_label(e) << " has a non-positive Jacobian (det = " << detJ << ") at integration point " << q + 1
-          << ": it is inverted or degenerate in the reference mesh. Check its node order "
+        s << mesh.element_label(e) << " has a non-positive Jacobian (det = " << detJ << ") at integration point "
+          << q + 1 << ": it is inverted or degenerate in the reference mesh. Check its node order "
              "(Abaqus C3D4/C3D10 convention) and mid-edge node positions.";
         throw InputError(s.str());
       }

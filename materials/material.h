@@ -132,6 +132,29 @@ class Material {
   virtual double initial_bulk_modulus() const = 0;
   /// True when the response is split as P_iso (isochoric) + P_vol (volumetric).
   virtual bool is_split() const { return true; }
+
+  /// Non-local regularisation (engine/nonlocal.h). A law whose history is driven by a local quantity
+  /// (the fatigue law's stretch or energy) may have it averaged over a ball of radius radius_m > 0
+  /// around each point; only points of the same `kind` and radius are averaged together. After every
+  /// committed state the engine reads each point's driver (nonlocal_driver, from the committed state
+  /// and its F) and hands back the average (set_nonlocal_driver), which the law keeps in its state
+  /// for the following increments. Decorators forward the three calls to their base (with the base's
+  /// slice of the state). Default: local (radius 0), and the calls do nothing.
+  struct NonlocalSpec {
+    double radius_m = 0.0;
+    std::string kind;
+  };
+  virtual NonlocalSpec nonlocal() const { return {}; }
+  virtual double nonlocal_driver(const Mat3& F, std::span<const double> state) const {
+    (void)F;
+    (void)state;
+    return 0.0;
+  }
+  virtual void set_nonlocal_driver(std::span<double> state, double local, double average) const {
+    (void)state;
+    (void)local;
+    (void)average;
+  }
 };
 
 using MaterialPtr = std::shared_ptr<const Material>;

@@ -31,6 +31,14 @@ class ScaledMaterial final : public Material {
   double initial_shear_modulus() const override { return scale_ * base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return scale_ * base_->initial_bulk_modulus(); }
   bool is_split() const override { return base_->is_split(); }
+  /// Forwarded to the base.
+  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
+  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
+    return base_->nonlocal_driver(F, state);
+  }
+  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
+    base_->set_nonlocal_driver(state, local, average);
+  }
 
   double scale() const { return scale_; }
   const MaterialPtr& base() const { return base_; }

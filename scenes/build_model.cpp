@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <optional>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -20,6 +21,7 @@
 #include "materials/ogden.h"
 #include "materials/scaled.h"
 #include "scenes/inp.h"
+#include "scenes/inp_assembly.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
 #include "scenes/solid_split.h"
@@ -61,6 +63,19 @@ double positive(const Scene& scene, const std::string& key) {
   return v;
 }
 
+/// A name `key` gives that the mesh lacks but that several instances of a deck define (stored as
+/// "INSTANCE.NAME" each, inp_assembly.h): a failure listing the qualified names to choose from.
+template <class V>
+void reject_ambiguous(const Scene& s, const std::string& key, const std::map<std::string, V>& names,
+                      const std::string& name, const std::string& what) {
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  const std::vector<std::string> choices = inp::qualified_choices(names, upper);
+  if (choices.size() > 1)
+    s.fail(key, what + " '" + name + "' is defined by " + std::to_string(choices.size()) +
+                    " instances of the deck; name one with its instance: " + inp::join_names(choices, " or "));
+}
+
 // ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
 
 /// A surface of the mesh by its name as the scene writes it, or upper-cased (decks' names are);
@@ -99,6 +114,7 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   if (!svk) s.fail(T + ".model", "internal: linear_elastic did not build a St Venant-Kirchhoff law");
   const std::string name = s.string("mesh.fabric_surface");
   const auto* surface = find_surface(mesh, name);
+  if (!surface) reject_ambiguous(s, "mesh.fabric_surface", mesh.surfaces, name, "surface");
   if (!surface || surface->second.empty()) {
     std::string have;
     for (const auto& [k, v] : mesh.surfaces) have += (have.empty() ? "" : ", ") + k;
@@ -171,6 +187,7 @@ const std::vector<int>& node_set(const Scene& s, const Mesh& m, const std::strin
       return it->second;
     }
   }
+  reject_ambiguous(s, key, m.node_sets, name, "node set");
   std::string avail;
   for (const auto& [k, v] : m.node_sets) avail += (avail.empty() ? "" : ", ") + k;
   s.fail(key, "node set '" + name + "' not found in the mesh; available: " + (avail.empty() ? "(none)" : avail));
@@ -226,7 +243,8 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
   }
   if (on("fatigue")) {
     const std::string K = T + ".fatigue";
-    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail"}, "fatigue");
+    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail", "nonlocal_radius_mm"},
+                 "fatigue");
     FatigueParams f;
     const std::string driver = s.string(K + ".driver");
     if (driver == "energy")
@@ -241,6 +259,10 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
     f.q = s.number(K + ".q");
     f.n = s.number(K + ".n");
     f.d_fail = s.number(K + ".d_fail");
+    const double R_mm = s.number(K + ".nonlocal_radius_mm");
+    if (!(std::isfinite(R_mm) && R_mm >= 0.0))
+      s.fail(K + ".nonlocal_radius_mm", "must be >= 0 mm (0 = local driver; > 0: averaged over this radius)");
+    f.nonlocal_radius_m = R_mm * 1e-3;
     e.fatigue = f;
   }
   if (on("viscoelastic")) {
@@ -331,6 +353,13 @@ MaterialPtr make_material(const Scene& s, const std::string& name, double region
       s.fail(l.key, err.what());
     }
   }
+  // A non-local fatigue driver reaches the engine through every layer around it (each forwards
+  // Material::nonlocal); an effect registered in C++ that does not would silently make it local.
+  if (e.fatigue && e.fatigue->nonlocal_radius_m > 0.0 && !(m->nonlocal().radius_m > 0.0))
+    s.fail(T + ".fatigue.nonlocal_radius_mm",
+           "an effect wrapped around fatigue ('" + m->name() + "') does not forward the non-local driver "
+           "(Material::nonlocal, nonlocal_driver, set_nonlocal_driver to its base; docs/adding_an_effect.md); "
+           "set nonlocal_radius_mm = 0.0 or forward them");
   return m;
 }
 
@@ -395,21 +424,31 @@ std::string vec_text(const Eigen::Vector3d& v) {
   return buf;
 }
 
-/// The angle's frame against the mesh, for decks oriented otherwise than the built-in actuator
-/// (whose defaults the scene keys are). The clamped nodes (all three dofs fixed) of a plane end
-/// face give its outward normal: angle.fixed_normal more than ~25 deg off it would measure the
-/// rotation in a wrong plane, so that is an error naming the normal to use. The inextensible
-/// (stiffest, 100x the softest) part lies on the side the actuator curls to: a bend_direction
-/// pointing away from it only flips the angle's sign, so that is a warning.
-void check_angle_frame(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
+/// The angle's frame from the mesh, for decks oriented otherwise than the built-in actuator (whose
+/// defaults the scene keys are). Two facts of the mesh fix it:
+///  * the clamped nodes (all three dofs fixed) of a plane end face give the face's outward normal;
+///    when they are not one plane face (a clamp over a length of the body), the direction from the
+///    tip face's centroid to the clamped nodes' does;
+///  * the inextensible (stiffest, 100x the softest) part lies on the side the actuator curls to.
+/// With `from_mesh` (a deck whose scene leaves angle.fixed_normal / angle.bend_direction at their
+/// defaults) the keys left at their defaults are taken from these, with a note naming the values (so a
+/// deck along x, or tilted, needs no angle keys). Keys the user set are checked instead: a fixed normal
+/// more than ~25 deg off the clamped face's would measure the rotation in a wrong plane, an error
+/// naming the normal to use; a bend direction pointing away from the layer only flips the angle's
+/// sign, a warning.
+void resolve_angle_frame(const Scene& s, Model& model, bool from_mesh, std::vector<std::string>& warnings) {
   const Mesh& mesh = model.mesh;
+  const bool normal_free = from_mesh && s.origin("angle.fixed_normal") == "default scene";
+  const bool bend_free = from_mesh && s.origin("angle.bend_direction") == "default scene";
   Eigen::Vector3d body = Eigen::Vector3d::Zero();
   for (const auto& x : mesh.X) body += x;
   body /= static_cast<double>(mesh.num_nodes());
   std::vector<Eigen::Vector3d> clamped;
   for (int n = 0; n < mesh.num_nodes(); ++n)
     if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
-  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
+  // n_face: outward normal of the clamped plane face (or 0); n_axis: the body's axis at the clamp,
+  // pointing out of it, from the tip face (or 0).
+  Eigen::Vector3d n_face = Eigen::Vector3d::Zero(), n_axis = Eigen::Vector3d::Zero();
   if (clamped.size() >= 3) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (const auto& x : clamped) c += x;
@@ -420,30 +459,170 @@ void check_angle_frame(const Scene& s, const Model& model, std::vector<std::stri
     const bool planar = es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0;
     Eigen::Vector3d n_fit = es.eigenvectors().col(0);
     if (n_fit.dot(c - body) < 0.0) n_fit = -n_fit;  // outward: away from the body
-    if (planar && (c - body).norm() > 0.0 && n_fit.dot(n_given) < 0.9)
-      s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
-                                   "normal is " + vec_text(n_fit) + ": set angle.fixed_normal = " + vec_text(n_fit) +
-                                   " and angle.bend_direction perpendicular to it, towards the inextensible layer");
+    if (planar && (c - body).norm() > 0.0) n_face = n_fit;
+    if (!model.angle.tip_nodes.empty()) {
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      for (int n : model.angle.tip_nodes) t += mesh.X[n];
+      t /= static_cast<double>(model.angle.tip_nodes.size());
+      if ((c - t).norm() > 0.0) n_axis = (c - t).normalized();
+    }
   }
+  const Eigen::Vector3d n_mesh = n_face.norm() > 0.0 ? n_face : n_axis;
+  if (normal_free && n_mesh.norm() > 0.0 && n_mesh.dot(model.angle.fixed_normal_out.normalized()) < 1.0 - 1e-9) {
+    model.angle.fixed_normal_out = n_mesh;
+    warnings.push_back("angle.fixed_normal taken from the mesh: " + vec_text(n_mesh) + " (the outward normal of " +
+                       (n_face.norm() > 0.0 ? std::string("the clamped end face")
+                                            : std::string("the clamped end, from the tip face's centroid to the clamped nodes'")) +
+                       "); set angle.fixed_normal to choose another");
+  }
+  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
+  if (!normal_free && n_face.norm() > 0.0 && n_face.dot(n_given) < 0.9)
+    s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
+                                 "normal is " + vec_text(n_face) + ": set angle.fixed_normal = " + vec_text(n_face) +
+                                 " and angle.bend_direction perpendicular to it, towards the inextensible layer");
+  // The side of the stiff layer, across the actuator (0 when no part is 100x stiffer than another).
+  Eigen::Vector3d side = Eigen::Vector3d::Zero();
   double mu_min = INFINITY, mu_max = 0.0;
   for (const Part& p : model.parts) {
     mu_min = std::min(mu_min, p.material->initial_shear_modulus());
     mu_max = std::max(mu_max, p.material->initial_shear_modulus());
   }
-  if (!(mu_max > 100.0 * mu_min)) return;
   Eigen::Vector3d layer = Eigen::Vector3d::Zero();
   double count = 0.0;
-  for (int e = 0; e < mesh.num_elements(); ++e)
-    if (model.material_of(e).initial_shear_modulus() == mu_max)
-      for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
-  Eigen::Vector3d side = layer / count - body;
-  side -= side.dot(n_given) * n_given;  // across the actuator, not along it
+  if (mu_max > 100.0 * mu_min) {
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      if (model.material_of(e).initial_shear_modulus() == mu_max)
+        for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
+  } else {  // a membrane fabric (mesh.fabric_model = "membrane") is the layer
+    for (const MembraneSet& m : model.membranes)
+      for (int n : m.nodes) layer += mesh.X[n], count += 1.0;
+  }
+  if (count > 0.0) {
+    side = layer / count - body;
+    side -= side.dot(n_given) * n_given;  // across the actuator, not along it
+  }
+  if (model.angle.mirror_axis >= 0) side[model.angle.mirror_axis] = 0.0;  // a half model bends in its symmetry plane
+  if (bend_free) {
+    // The default direction made perpendicular to the normal is kept when it points within 10 deg of
+    // the layer's side (a translated deck keeps the built-in's exact axes: the centroid of an
+    // asymmetric section is a little off its bending plane); otherwise the side of the layer; without
+    // a stiff layer the default, else the coordinate axis most perpendicular to the normal.
+    Eigen::Vector3d d0 = model.angle.bend_direction - model.angle.bend_direction.dot(n_given) * n_given;
+    const bool d0_ok = d0.norm() >= 1e-3 * model.angle.bend_direction.norm();
+    Eigen::Vector3d d = side;
+    if (d0_ok && (side.norm() == 0.0 || d0.normalized().dot(side.normalized()) > std::cos(10.0 * std::numbers::pi / 180.0))) {
+      d = d0;
+    } else if (side.norm() == 0.0) {
+      Eigen::Index k = 0;
+      n_given.cwiseAbs().minCoeff(&k);
+      d = Eigen::Vector3d::Unit(k) - n_given[k] * n_given;
+    }
+    d.normalize();
+    if (d.dot(model.angle.bend_direction.normalized()) < 1.0 - 1e-9) {
+      model.angle.bend_direction = d;
+      warnings.push_back("angle.bend_direction taken from the mesh: " + vec_text(d) +
+                         (side.norm() > 0.0 ? std::string(" (towards the inextensible layer, so angles are positive)")
+                                            : std::string(" (no part is 100x stiffer than another, so the side the actuator "
+                                                          "bends to is not known from the mesh: check the sign of the angles)")) +
+                         "; set angle.bend_direction to choose another");
+    }
+    return;
+  }
   const Eigen::Vector3d d = model.angle.bend_direction.normalized();
   if (side.norm() > 0.0 && d.dot(side.normalized()) < -0.5)
     warnings.push_back("angle.bend_direction " + vec_text(d) + " points away from the inextensible layer (towards " +
                        vec_text(-side.normalized()) + "), to which the actuator curls: its angles will come out "
                        "negative; set angle.bend_direction = " + vec_text(side.normalized()) +
                        " for the usual positive convention");
+}
+
+/// The free end face of a deck: the node set mesh.tip_set; when the scene leaves that key at its
+/// default and the deck has no such set, the boundary nodes farthest from the clamp, with a note. The
+/// clamp's side is the outward normal of the clamped nodes' plane face (all three dofs fixed); the tip
+/// face is then the set of boundary nodes within 0.1 % of the body's length of the farthest one along
+/// the opposite direction, which must hold at least three nodes that are not on one line (a flat end
+/// face; a rounded end gives its cap, whose fitted plane still turns with the tip).
+std::vector<int> deck_tip_nodes(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
+  const Mesh& mesh = model.mesh;
+  const std::string name = s.string("mesh.tip_set");
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+  if (s.origin("mesh.tip_set") != "default scene" || mesh.node_sets.count(name) || mesh.node_sets.count(upper))
+    return node_set(s, mesh, "mesh.tip_set");
+  auto give_up = [&](const std::string& why) -> std::vector<int> {
+    std::string avail;
+    for (const auto& [k, v] : mesh.node_sets) avail += (avail.empty() ? "" : ", ") + k;
+    s.fail("mesh.tip_set", "node set '" + name + "' not found in the mesh (available: " + (avail.empty() ? "(none)" : avail) +
+                               ") and the free end face cannot be found from the mesh: " + why +
+                               "; name the node set of the free end face in mesh.tip_set");
+  };
+  std::vector<Eigen::Vector3d> clamped;
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
+  if (clamped.size() < 3) return give_up("fewer than three clamped nodes");
+  Eigen::Vector3d c = Eigen::Vector3d::Zero(), body = Eigen::Vector3d::Zero();
+  for (const auto& x : clamped) c += x;
+  c /= static_cast<double>(clamped.size());
+  for (const auto& x : mesh.X) body += x;
+  body /= static_cast<double>(mesh.num_nodes());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& x : clamped) cov += (x - c) * (x - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);  // ascending eigenvalues
+  if (!(es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0))
+    return give_up("the clamped nodes are not one plane face");
+  Eigen::Vector3d axis = -es.eigenvectors().col(0);  // into the body, towards the tip
+  if (axis.dot(body - c) < 0.0) axis = -axis;
+  std::vector<char> on_boundary(mesh.num_nodes(), 0);
+  for (const FaceRef& f : boundary_faces(mesh)) {
+    const int* local = face_local_nodes(mesh.type, f.local_face);
+    for (int a = 0; a < nodes_per_face(mesh.type); ++a) on_boundary[mesh.element(f.element)[local[a]]] = 1;
+  }
+  double lo = INFINITY, hi = -INFINITY;
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const double t = axis.dot(mesh.X[n] - c);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  std::vector<int> tip;
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (on_boundary[n] && axis.dot(mesh.X[n] - c) >= hi - 1e-3 * (hi - lo)) tip.push_back(n);
+  Eigen::Vector3d t0 = Eigen::Vector3d::Zero();
+  for (int n : tip) t0 += mesh.X[n];
+  t0 /= std::max<double>(1.0, static_cast<double>(tip.size()));
+  Eigen::Matrix3d tcov = Eigen::Matrix3d::Zero();
+  for (int n : tip) tcov += (mesh.X[n] - t0) * (mesh.X[n] - t0).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ts(tcov);
+  if (tip.size() < 3 || !(ts.eigenvalues()[1] > 1e-12 * ts.eigenvalues()[2]))
+    return give_up("the boundary nodes farthest from the clamp do not span a face");
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%zu boundary nodes at %.4g mm from the clamped face", tip.size(), hi * 1e3);
+  warnings.push_back("mesh.tip_set: the deck has no node set '" + name + "'; the free end face was taken from the mesh (" +
+                     buf + "); name a node set in mesh.tip_set to choose another");
+  return tip;
+}
+
+/// gravity.rig_angle_deg >= 0: the rig's orientation relative to the actuator, in its angle frame
+/// (so a deck in any orientation, whose frame may come from the mesh, hangs the same way):
+/// g = 9.81 (cos(phi) a + sin(phi) d), a = -angle.fixed_normal (along the actuator, away from the
+/// clamp), d = the bend direction made perpendicular to a. For the built-in frame a = +y, d = -z, so
+/// g = [0, 9.81 cos(phi), -9.81 sin(phi)] to the bit (components below 1e-12 g are exactly 0).
+void set_rig_gravity(const Scene& s, Model& model) {
+  const double phi_deg = s.number("gravity.rig_angle_deg");
+  if (!std::isfinite(phi_deg)) s.fail("gravity.rig_angle_deg", "must be a number (< 0: off)");
+  if (phi_deg < 0.0) return;
+  if (phi_deg > 180.0) s.fail("gravity.rig_angle_deg", "must lie in [0, 180] deg (or < 0: off)");
+  if (model.gravity_m_s2.norm() > 0.0)
+    s.fail("gravity.rig_angle_deg", "and gravity.g_m_s2 both give gravity: set g_m_s2 = [0.0, 0.0, 0.0] or "
+                                    "rig_angle_deg = -1.0");
+  constexpr double g = 9.81;
+  const double phi = phi_deg * std::numbers::pi / 180.0;
+  const Eigen::Vector3d a = -model.angle.fixed_normal_out.normalized();
+  const Eigen::Vector3d d = (model.angle.bend_direction - model.angle.bend_direction.dot(a) * a).normalized();
+  const double ga = g * std::cos(phi), gd = g * std::sin(phi);
+  for (int k = 0; k < 3; ++k) {
+    const double v = ga * a[k] + gd * d[k];
+    model.gravity_m_s2[k] = std::abs(v) < 1e-12 * g ? 0.0 : v;
+  }
 }
 
 }  // namespace
@@ -479,6 +658,12 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
     deck = read_inp(s.resolve_path(file), length_unit(s));
     out->warnings = deck.warnings;
+    if (deck.solid_instances.size() > 1)
+      s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
+                              " instances (" + inp::join_names(deck.solid_instances) +
+                              ") that share no node, so the model is not connected (ties are not applied); "
+                              "pneufem needs one conforming mesh: merge the instances in Abaqus (Merge/Cut "
+                              "Instances) so the mesh is conforming");
     if (s.boolean("mesh.promote_to_tet10")) {
       if (deck.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
         out->warnings.push_back("mesh.promote_to_tet10: *DLOAD faces are kept (faces map one to one)");
@@ -495,8 +680,11 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
   for (const std::string& elset : s.table_keys("mesh.regions")) {
     const std::vector<int>* els = find_elset(mesh, elset);
-    if (!els) s.fail("mesh.regions." + elset, "element set '" + elset + "' not found in the mesh");
-    const std::uint16_t r = mesh.region_id(s.string("mesh.regions." + elset));
+    if (!els) {
+      reject_ambiguous(s, "mesh.regions." + elset, mesh.element_sets, elset, "element set");
+      s.fail("mesh.regions." + elset, "element set '" + elset + "' not found in the mesh");
+    }
+    const std::uint16_t r = mesh.region_id(s.string_entry("mesh.regions", elset));
     for (int e : *els) mesh.region[e] = r;
   }
 
@@ -510,6 +698,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     const std::string elset = s.string(key + ".elset"), mat = s.string(key + ".material");
     const std::vector<int>* els = find_elset(mesh, elset);
     if (!els) {
+      reject_ambiguous(s, key + ".elset", mesh.element_sets, elset, "element set");
       std::string avail;
       for (const auto& [k, v] : mesh.element_sets) avail += (avail.empty() ? "" : ", ") + k;
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
@@ -523,7 +712,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     std::map<std::uint16_t, int> region_part;
     for (int e : *els) {
       if (model.element_part[e] >= 0)
-        s.fail(key + ".elset", "element " + std::to_string(mesh.element_ids[e]) + " is in two parts ('" +
+        s.fail(key + ".elset", mesh.element_label(e) + " is in two parts ('" +
                                    model.parts[model.element_part[e]].name + "' and '" + elset + "')");
       int p = part;
       if (static_cast<std::size_t>(e) < mesh.region.size()) {
@@ -543,8 +732,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   }
   for (int e = 0; e < mesh.num_elements(); ++e)
     if (model.element_part[e] < 0)
-      s.fail("parts", "element " + std::to_string(mesh.element_ids[e]) +
-                          " belongs to no part; add its element set to a [[parts]] entry");
+      s.fail("parts", mesh.element_label(e) + " belongs to no part; add its element set to a [[parts]] entry");
 
   // Boundary conditions.
   model.fixed.assign(3 * mesh.num_nodes(), 0);
@@ -561,7 +749,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     const double L = (compute_stats(mesh).bbox_max - compute_stats(mesh).bbox_min).norm();
     for (int n : sym) {
       if (std::abs(mesh.X[n].x()) > 1e-6 * L)
-        s.fail("mesh.symmetry_set", "node " + std::to_string(mesh.node_ids[n]) +
+        s.fail("mesh.symmetry_set", "node " + mesh.node_name(n) +
                                         " is not on the plane x = 0; the symmetry plane must be x = 0");
       model.fixed[3 * n] = 1;
     }
@@ -572,13 +760,22 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   const std::string cav = is_inp ? s.string("mesh.cavity_surface") : "CAVITY";
   if (is_inp && (cav == "DLOAD" || cav == "dload")) {
     if (deck.pressure_faces.empty())
-      s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn lines");
+      s.fail("mesh.cavity_surface", "\"DLOAD\" was given but the deck has no *DLOAD ... Pn or *DSLOAD ..., P lines");
     for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
   } else {
     const auto* surface = find_surface(mesh, cav);
-    if (!surface)
+    if (!surface) reject_ambiguous(s, "mesh.cavity_surface", mesh.surfaces, cav, "surface");
+    if (surface) {
+      model.pressure_faces = surface->second;
+    } else if (is_inp && s.origin("mesh.cavity_surface") == "default scene" && !deck.pressure_faces.empty()) {
+      // No surface of the default name: the deck's own pressure load marks the chambers.
+      for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
+      out->warnings.push_back("mesh.cavity_surface: the deck has no surface '" + cav + "'; the faces of its pressure load (" +
+                              std::to_string(deck.pressure_faces.size()) + " *DLOAD/*DSLOAD P faces) are the cavity; name a " +
+                              "surface in mesh.cavity_surface to choose another");
+    } else {
       s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
-    model.pressure_faces = surface->second;
+    }
   }
   if (model.pressure_faces.empty()) s.fail("mesh.cavity_surface", "the cavity surface has no faces");
   {
@@ -595,16 +792,17 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   }
 
   // Bending angle.
-  model.angle.tip_nodes = node_set(s, mesh, is_inp ? "mesh.tip_set" : "mesh.tip_set");
+  model.angle.tip_nodes = is_inp ? deck_tip_nodes(s, model, out->warnings) : node_set(s, mesh, "mesh.tip_set");
   model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
   model.angle.bend_direction = s.vec3("angle.bend_direction");
   if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");
-  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
-    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
   if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
-  check_angle_frame(s, model, out->warnings);
+  resolve_angle_frame(s, model, is_inp, out->warnings);
+  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
+    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
+  set_rig_gravity(s, model);
   out->stats = compute_stats(mesh);
 
   // Load.

@@ -15,6 +15,7 @@
 #include <unordered_set>
 
 #include "materials/errors.h"
+#include "scenes/inp_assembly.h"
 #include "scenes/solid_split.h"
 
 namespace pneufem {
@@ -141,7 +142,13 @@ struct Loc {
   int line = 0;  ///< 1-based
 };
 
-enum class Block { None, Skip, Node, Element, SurfaceElement, NodeSet, ElementSet, Surface, Dload, Boundary };
+enum class Block {
+  None, Skip, Node, Element, SurfaceElement, NodeSet, ElementSet, Surface, Dload, Dsload, Boundary, Placement
+};
+
+/// Where a keyword stands in an Abaqus model: a flat deck and the history data after the
+/// assembly are at Model level.
+enum class Level { Model, Part, Assembly, Instance };
 
 /// Nodes of a triangular surface/shell/membrane/plane element type, or 0. Meshers (Gmsh among
 /// them) write a deck's named boundary surfaces as such elements; pneufem reads them as faces of
@@ -166,15 +173,31 @@ bool skipped_element_type(const std::string& type) {
 
 constexpr int kMaxIncludeDepth = 32;
 constexpr std::size_t kMaxRegions = 65535;  // Mesh::region holds std::uint16_t
+constexpr std::size_t kMaxScopes = 65535;   // Mesh::node_scope holds std::uint16_t
+
+/// Keywords that join surfaces or nodes (ties, couplings, equations, contact): pneufem applies
+/// none of them, it needs one conforming mesh.
+bool constraint_keyword(const std::string& name) {
+  static const std::set<std::string> constraints = {
+      "TIE", "COUPLING", "KINEMATIC COUPLING", "DISTRIBUTING COUPLING", "MPC", "EQUATION", "RIGID BODY",
+      "CONTACT PAIR", "CONTACT", "CONTACT INCLUSIONS", "EMBEDDED ELEMENT", "SHELL TO SOLID COUPLING"};
+  return constraints.count(name) != 0;
+}
 
 /// Single pass over the deck. *INCLUDE is textual (as in CalculiX): the included lines are read in
 /// place of the *INCLUDE line, so a data block may continue into an included file.
+///
+/// Parts and instances (decks as Abaqus/CAE writes them): the lines of a *PART block are recorded
+/// and read again for every *INSTANCE of it, in the instance's id scope and placement, so each
+/// instance gets its own nodes, elements, sets and surfaces (the deck's ids are per instance);
+/// lines inside an *INSTANCE block (an independent instance's mesh) add to that instance.
 class DeckReader {
  public:
   explicit DeckReader(double length_to_m) : length_to_m_(length_to_m) {}
 
   InpDeck read(const std::string& path) {
     push_file(path, std::nullopt);
+    scopes_.emplace_back();  // the model / assembly level
     std::string_view text;
     Loc loc;
     bool any_line = false;
@@ -189,23 +212,52 @@ class DeckReader {
     if (!any_line)
       fail(Loc{0, std::max(1, last_line_of_top_)}, "the deck is empty (no keyword or data lines)",
            "give a deck with *NODE and *ELEMENT, TYPE=C3D4 or C3D10 blocks");
+    end_of_structure();
     finish();
     return std::move(deck_);
   }
 
  private:
+  /// An id scope: the model/assembly level (scopes_[0]) or one instance. Ids, set and surface
+  /// names are the deck's own within it; sets hold Mesh indices.
+  struct Scope {
+    std::string name;  // instance name as written; the assembly's name for scopes_[0]
+    std::string part;  // upper-case part name (instances)
+    Loc loc;           // its *INSTANCE line
+    inp::Placement placement;
+    std::unordered_map<long, int> node_index, element_index;  // deck id -> Mesh index
+    std::map<std::string, std::vector<int>> node_sets, element_sets;
+    std::map<std::string, std::vector<FaceRef>> surfaces;
+    std::set<std::string> internal_node_sets, internal_element_sets, internal_surfaces;
+    long max_node_id = 0, max_element_id = 0;
+    int nodes = 0;
+  };
+  struct RecordedLine {
+    std::string_view text;
+    Loc loc;
+  };
+  struct PartDef {
+    std::string name;  // as written
+    Loc loc;
+    std::vector<RecordedLine> lines;  // read again for each instance
+    bool instanced = false;
+  };
+
   // ---- errors and warnings ------------------------------------------------------------------
   std::string where(const Loc& loc) const {
     return file_names_[static_cast<std::size_t>(loc.file)] + ":" + std::to_string(loc.line);
   }
 
+  /// "<file>:<line>: ", and the part and instance while a part's lines are read for an instance.
+  std::string at(const Loc& loc) const { return where(loc) + ": " + context_; }
+
   [[noreturn]] void fail(const Loc& loc, const std::string& what, const std::string& todo) const {
-    throw InputError(where(loc) + ": " + what + "; " + todo);
+    throw InputError(at(loc) + what + "; " + todo);
   }
 
   /// Adds `message` to the warnings unless a warning with the same key was already given.
   void warn_once(const std::string& key, const Loc& loc, const std::string& message) {
-    if (warned_.insert(key).second) deck_.warnings.push_back(where(loc) + ": " + message);
+    if (warned_.insert(key).second) deck_.warnings.push_back(at(loc) + message);
   }
 
   // ---- line source --------------------------------------------------------------------------
@@ -281,6 +333,8 @@ class DeckReader {
   void begin_block(std::string_view text, const Loc& loc) {
     end_block();
     const Keyword kw = parse_keyword(text);
+    if (recording_) return record_in_part(kw, text, loc);
+    if (pending_instance_ >= 0) instantiate();  // its placement lines are read: now its part
     block_ = Block::Skip;
     if (kw.name == "NODE")
       begin_nodes(kw, loc);
@@ -292,8 +346,28 @@ class DeckReader {
       begin_surface(kw, loc);
     else if (kw.name == "DLOAD")
       block_ = Block::Dload;
+    else if (kw.name == "DSLOAD")
+      block_ = Block::Dsload;
     else if (kw.name == "BOUNDARY")
       block_ = Block::Boundary;
+    else if (kw.name == "PART")
+      begin_part(kw, loc);
+    else if (kw.name == "END PART")
+      fail(loc, "*End Part without *Part", "remove it, or add *Part, name=<name> where the part begins");
+    else if (kw.name == "ASSEMBLY")
+      begin_assembly(kw, loc);
+    else if (kw.name == "END ASSEMBLY")
+      end_assembly(loc);
+    else if (kw.name == "INSTANCE")
+      begin_instance(kw, loc);
+    else if (kw.name == "END INSTANCE")
+      end_instance(loc);
+    else if (constraint_keyword(kw.name))
+      warn_once("constraint " + kw.name, loc,
+                "*" + kw.name + (kw.has("NAME") ? " " + kw.get("NAME") : std::string()) +
+                    " ignored: pneufem applies no ties, couplings, equations or contact and needs one conforming "
+                    "mesh; if it joins instances, merge the instances in Abaqus (Merge/Cut Instances) so the mesh "
+                    "is conforming");
     else if (kw.name == "MEMBRANE SECTION" || kw.name == "SHELL SECTION")
       // A fabric modelled as membrane or shell elements: its triangles are read as a surface, so
       // say how to give it stiffness, since a solid-fabric scene would silently leave it out.
@@ -305,7 +379,7 @@ class DeckReader {
     else
       warn_once("keyword " + kw.name, loc,
                 "*" + kw.name +
-                    " skipped (only the mesh, sets, surfaces, *DLOAD Pn and *BOUNDARY are read; "
+                    " skipped (only the mesh, sets, surfaces, *DLOAD Pn, *DSLOAD P and *BOUNDARY are read; "
                     "materials and steps come from the scene)");
   }
 
@@ -319,10 +393,15 @@ class DeckReader {
     if (open_members_) unsorted_.insert(open_members_);
     open_members_ = nullptr;
     open_set_.clear();
+    member_scope_ = -1;
     block_ = Block::None;
   }
 
   void data_line(std::string_view text, const Loc& loc) {
+    if (recording_) {
+      recording_->lines.push_back(RecordedLine{text, loc});
+      return;
+    }
     split_fields(text, fields_, trailing_comma_);
     switch (block_) {
       case Block::None:
@@ -342,9 +421,173 @@ class DeckReader {
         return surface_line(loc);
       case Block::Dload:
         return dload_line(loc);
+      case Block::Dsload:
+        return dsload_line(loc);
       case Block::Boundary:
         return boundary_line(loc);
+      case Block::Placement:
+        return placement_line(loc);
     }
+  }
+
+  // ---- *PART, *ASSEMBLY, *INSTANCE ------------------------------------------------------------
+  void begin_part(const Keyword& kw, const Loc& loc) {
+    if (level_ != Level::Model)
+      fail(loc, "*Part inside *Assembly", "define the parts before *Assembly (close the assembly with *End Assembly)");
+    const std::string name = kw.get("NAME");
+    if (name.empty()) fail(loc, "*Part without NAME=", "add NAME=<part name>");
+    const auto [it, fresh] = parts_.try_emplace(upper(name), PartDef{name, loc, {}, false});
+    if (!fresh)
+      fail(loc, "part '" + name + "' is defined twice (first at " + where(it->second.loc) + ")",
+           "rename one of them (part names are case-insensitive)");
+    recording_ = &it->second;
+    level_ = Level::Part;
+  }
+
+  /// A line of the part being recorded; *END PART ends it. Parts do not nest.
+  void record_in_part(const Keyword& kw, std::string_view text, const Loc& loc) {
+    if (kw.name == "END PART") {
+      recording_ = nullptr;
+      level_ = Level::Model;
+      return;
+    }
+    if (kw.name == "PART" || kw.name == "ASSEMBLY" || kw.name == "END ASSEMBLY" || kw.name == "INSTANCE" ||
+        kw.name == "END INSTANCE")
+      fail(loc, "*" + kw.name + " inside *Part '" + recording_->name + "' (" + where(recording_->loc) + ")",
+           "close the part with *End Part first");
+    recording_->lines.push_back(RecordedLine{text, loc});
+  }
+
+  void begin_assembly(const Keyword& kw, const Loc& loc) {
+    if (assembly_loc_)
+      fail(loc, "a second *Assembly (the first is at " + where(*assembly_loc_) + ")",
+           "a deck has one assembly: put every *Instance into it");
+    if (level_ != Level::Model) fail(loc, "*Assembly inside another block", "close that block first");
+    assembly_loc_ = loc;
+    scopes_[0].name = kw.get("NAME").empty() ? std::string("Assembly") : kw.get("NAME");
+    level_ = Level::Assembly;
+  }
+
+  void end_assembly(const Loc& loc) {
+    if (level_ == Level::Instance)
+      fail(loc, "*End Assembly inside *Instance '" + scope().name + "' (" + where(scope().loc) + ")",
+           "close the instance with *End Instance first");
+    if (level_ != Level::Assembly)
+      fail(loc, "*End Assembly without *Assembly", "remove it, or add *Assembly, name=Assembly before the instances");
+    level_ = Level::Model;
+  }
+
+  void begin_instance(const Keyword& kw, const Loc& loc) {
+    if (level_ == Level::Instance)
+      fail(loc, "*Instance inside *Instance '" + scope().name + "' (" + where(scope().loc) + ")",
+           "close that instance with *End Instance first");
+    if (level_ != Level::Assembly)
+      fail(loc, "*Instance outside *Assembly", "put the instances between *Assembly, name=Assembly and *End Assembly");
+    if (kw.has("INSTANCE") || kw.has("LIBRARY"))
+      fail(loc, "*Instance imported from a previous analysis (INSTANCE=, LIBRARY=) is not supported",
+           "write the part into the deck (*Part ... *End Part) and instance it with PART=");
+    const std::string name = kw.get("NAME"), part = kw.get("PART");
+    if (name.empty() || part.empty())
+      fail(loc, "*Instance without " + std::string(name.empty() ? "NAME=" : "PART="),
+           "write *Instance, name=<instance>, part=<part>");
+    if (name.find('.') != std::string::npos)
+      fail(loc, "instance name '" + name + "' contains a '.'",
+           "rename the instance: '.' separates an instance from its sets and ids ('Actuator-1.Set-1')");
+    const auto p = parts_.find(upper(part));
+    if (p == parts_.end())
+      fail(loc, "instance '" + name + "' refers to part '" + part + "', which is not defined above",
+           "define *Part, name=" + part + " ... *End Part before the assembly (part names are case-insensitive)");
+    const auto [it, fresh] = instance_index_.try_emplace(upper(name), static_cast<int>(scopes_.size()));
+    if (!fresh)
+      fail(loc, "instance '" + name + "' is defined twice (first at " + where(scopes_[static_cast<std::size_t>(it->second)].loc) + ")",
+           "rename one of them (instance names are case-insensitive)");
+    if (scopes_.size() > kMaxScopes)
+      fail(loc, "more than " + std::to_string(kMaxScopes) + " instances", "merge instances in Abaqus");
+    p->second.instanced = true;
+    Scope& s = scopes_.emplace_back();
+    s.name = name;
+    s.part = p->first;
+    s.loc = loc;
+    pending_instance_ = it->second;
+    placement_lines_ = 0;
+    level_ = Level::Instance;
+    block_ = Block::Placement;
+  }
+
+  /// The data lines of *INSTANCE: a translation "dx, dy, dz", then optionally a rotation
+  /// "xa, ya, za, xb, yb, zb, angle" (degrees about the axis a -> b, applied after the translation).
+  void placement_line(const Loc& loc) {
+    Scope& s = scopes_[static_cast<std::size_t>(pending_instance_)];
+    const std::string what = "*Instance '" + s.name + "'";
+    const std::size_t need = ++placement_lines_ == 1 ? 3 : 7;
+    if (placement_lines_ > 2)
+      fail(loc, what + " has a third data line",
+           "an instance has a translation line (3 numbers) and optionally a rotation line (7 numbers: two "
+           "points on the axis and the angle in degrees)");
+    const char* form = need == 3 ? "'dx, dy, dz'" : "'xa, ya, za, xb, yb, zb, angle_deg' (two points on the axis, the angle in degrees)";
+    if (fields_.size() != need)
+      fail(loc, "the " + std::string(need == 3 ? "translation" : "rotation") + " line of " + what + " has " +
+                    std::to_string(fields_.size()) + " values",
+           "write " + std::string(form));
+    std::array<double, 7> v{};
+    for (std::size_t k = 0; k < need; ++k) {
+      const std::optional<double> x = fields_[k].empty() ? std::optional<double>(0.0) : parse_double(fields_[k]);
+      if (!x) fail(loc, what + ": '" + std::string(fields_[k]) + "' is not a finite number", "write " + std::string(form));
+      v[k] = *x;
+    }
+    if (need == 3) {
+      s.placement.t = Eigen::Vector3d(v[0], v[1], v[2]) * length_to_m_;
+      return;
+    }
+    const Eigen::Vector3d a(v[0], v[1], v[2]), b(v[3], v[4], v[5]);
+    if (v[6] == 0.0) return;
+    if ((b - a).norm() == 0.0)
+      fail(loc, what + ": the rotation axis has two equal points", "give two distinct points a, b on the axis");
+    s.placement.a = a * length_to_m_;
+    s.placement.R = inp::rotation_deg((b - a).normalized(), v[6]);
+  }
+
+  /// "part 'P' (instance 'I')": messages about a part's line read for instance s say so.
+  std::string part_context(const Scope& s) const {
+    return "part '" + parts_.at(s.part).name + "' (instance '" + s.name + "')";
+  }
+
+  /// Reads the instance's part: its recorded lines in the instance's scope and placement.
+  void instantiate() {
+    const int index = pending_instance_;
+    pending_instance_ = -1;
+    const Scope& s = scopes_[static_cast<std::size_t>(index)];
+    const PartDef& part = parts_.at(s.part);
+    scope_ = index;
+    context_ = part_context(s) + ": ";
+    for (const RecordedLine& l : part.lines) {
+      if (l.text.front() == '*')
+        begin_block(l.text, l.loc);
+      else
+        data_line(l.text, l.loc);
+    }
+    end_block();
+    context_.clear();
+  }
+
+  void end_instance(const Loc& loc) {
+    if (level_ != Level::Instance)
+      fail(loc, "*End Instance without *Instance", "remove it, or add *Instance, name=<instance>, part=<part> above");
+    level_ = Level::Assembly;
+    scope_ = 0;
+  }
+
+  /// At the end of the deck: every *PART, *INSTANCE and *ASSEMBLY must be closed.
+  void end_of_structure() {
+    if (recording_)
+      fail(recording_->loc, "*Part '" + recording_->name + "' has no *End Part", "close the part with *End Part");
+    if (level_ == Level::Instance) {
+      const Scope& s = scopes_[static_cast<std::size_t>(pending_instance_ >= 0 ? pending_instance_ : scope_)];
+      fail(s.loc, "*Instance '" + s.name + "' has no *End Instance", "close it with *End Instance");
+    }
+    if (level_ == Level::Assembly)
+      fail(*assembly_loc_, "*Assembly has no *End Assembly",
+           "close it with *End Assembly after the instances and the assembly's sets and surfaces");
   }
 
   // ---- *NODE --------------------------------------------------------------------------------
@@ -355,7 +598,7 @@ class DeckReader {
       fail(loc, "*NODE, SYSTEM=" + system + " (non-Cartesian coordinates) is not supported",
            "write Cartesian coordinates (SYSTEM=R)");
     block_ = Block::Node;
-    open_set(deck_.mesh.node_sets, kw.get("NSET"));
+    open_set(scope().node_sets, kw.get("NSET"));
   }
 
   void node_line(const Loc& loc) {
@@ -379,11 +622,15 @@ class DeckReader {
              "fix the value");
       x[k] = *v * length_to_m_;
     }
+    Scope& s = scope();
     const int index = deck_.mesh.num_nodes();
-    if (!node_index_.try_emplace(*id, index).second)
+    if (!s.node_index.try_emplace(*id, index).second)
       fail(loc, "node " + std::to_string(*id) + " is defined twice", "node ids must be unique: renumber or remove one");
-    deck_.mesh.X.push_back(x);
+    deck_.mesh.X.push_back(s.placement.apply(x));
     deck_.mesh.node_ids.push_back(*id);
+    deck_.mesh.node_scope.push_back(static_cast<std::uint16_t>(scope_));
+    s.max_node_id = std::max(s.max_node_id, *id);
+    ++s.nodes;
     if (open_members_) open_members_->push_back(index);
   }
 
@@ -428,7 +675,7 @@ class DeckReader {
     npe_ = solid_nodes(solid_);
     block_ = Block::Element;
     const std::string elset = kw.get("ELSET");
-    open_set(deck_.mesh.element_sets, elset);
+    open_set(scope().element_sets, elset);
     const std::string region = elset.empty() ? std::string("default") : lower(elset);
     if (deck_.mesh.find_region(region) < 0 && deck_.mesh.region_names.size() > kMaxRegions)
       fail(loc, "more than " + std::to_string(kMaxRegions + 1) + " distinct ELSET= names on *ELEMENT",
@@ -464,8 +711,9 @@ class DeckReader {
 
   /// Index of node `node` of the element being read (pending_[0]); fails if it is not defined.
   int element_node(long node) const {
-    const auto it = node_index_.find(node);
-    if (it == node_index_.end())
+    const auto& ids = scopes_[static_cast<std::size_t>(scope_)].node_index;
+    const auto it = ids.find(node);
+    if (it == ids.end())
       fail(pending_loc_,
            "element " + std::to_string(pending_[0]) + " refers to node " + std::to_string(node) +
                ", which is not defined",
@@ -480,14 +728,18 @@ class DeckReader {
     const long id = pending_[0];
     if (id <= 0) fail(pending_loc_, "element id " + std::to_string(id) + " is not positive", "use ids >= 1");
     const int index = solids_.size();
-    if (!element_index_.try_emplace(id, index).second)
+    Scope& s = scope();
+    if (!s.element_index.try_emplace(id, index).second)
       fail(pending_loc_, "element " + std::to_string(id) + " is defined twice",
            "element ids must be unique: renumber or remove one");
     element_nodes_.clear();
     for (std::size_t k = 1; k < need; ++k) element_nodes_.push_back(element_node(pending_[k]));
     solids_.add(solid_, element_nodes_);
     solid_loc_.push_back(pending_loc_);
+    solid_part_instance_.push_back(static_cast<std::uint16_t>(context_.empty() ? 0 : scope_));
     mesh.element_ids.push_back(id);
+    mesh.element_scope.push_back(static_cast<std::uint16_t>(scope_));
+    s.max_element_id = std::max(s.max_element_id, id);
     mesh.region.push_back(region_);
     if (open_members_) open_members_->push_back(index);
     pending_.clear();
@@ -512,7 +764,7 @@ class DeckReader {
     if (!gather_element(loc)) return;
     SurfaceTriangle t{pending_[0], pending_loc_, {}};
     for (std::size_t k = 0; k < 3; ++k) t.corners[k] = element_node(pending_[k + 1]);
-    surface_elements_[surface_set_].push_back(t);
+    surface_elements_[{scope_, surface_set_}].push_back(t);
     pending_.clear();
   }
 
@@ -535,8 +787,10 @@ class DeckReader {
         ++it->second.second;
       }
     const int npf = nodes_per_face(mesh.type);
-    for (const auto& [name, tris] : surface_elements_) {
-      std::vector<FaceRef>& surface = mesh.surfaces[name];
+    for (const auto& [where_named, tris] : surface_elements_) {
+      const auto& [scope_index, name] = where_named;
+      Scope& s = scopes_[static_cast<std::size_t>(scope_index)];
+      std::vector<FaceRef>& surface = s.surfaces[name];
       std::vector<int> nodes;
       std::size_t inside = 0;
       for (const SurfaceTriangle& t : tris) {
@@ -545,15 +799,18 @@ class DeckReader {
         const auto it = faces.find(key);
         if (it == faces.end())
           fail(t.loc, "surface element " + std::to_string(t.id) + " (ELSET=" + name + ") matches no face of the tetrahedra",
-               "its first three nodes must be the corners of a tetrahedron's face (export the surface from the same mesh)");
+               "its first three nodes must be the corners of a tetrahedron's face (export the surface from the same mesh" +
+                   std::string(scopes_.size() > 1 ? "; in an assembly, from the same instance: merge the instances in "
+                                                    "Abaqus (Merge/Cut Instances) so the mesh is conforming)"
+                                                  : ")"));
         if (it->second.second > 1) ++inside;  // an embedded sheet: only a membrane may use it
         surface.push_back(it->second.first);
         const int* ln = face_local_nodes(mesh.type, it->second.first.local_face);
         for (int a = 0; a < npf; ++a) nodes.push_back(mesh.element(it->second.first.element)[ln[a]]);
       }
-      if (!mesh.node_sets.count(name)) {
+      if (!s.node_sets.count(name)) {
         normalise(nodes);
-        mesh.node_sets[name] = std::move(nodes);
+        s.node_sets[name] = std::move(nodes);
       }
       if (inside > 0)
         deck_.warnings.push_back(where(tris.front().loc) + ": " + std::to_string(inside) + " of the " + std::to_string(tris.size()) +
@@ -572,17 +829,37 @@ class DeckReader {
     if (nodes && kw.has("ELSET"))
       fail(loc, "*NSET, ELSET= (nodes of an element set) is not supported", "list the nodes or node sets instead");
     if (kw.has("INPUT")) fail(loc, "*" + key + ", INPUT= is not supported", "use *INCLUDE for the member lines");
+    int members_in = -1;
+    if (kw.has("INSTANCE")) {
+      // An assembly-level set of one instance's nodes or elements: its data lines use that
+      // instance's ids and set names.
+      const std::string instance = kw.get("INSTANCE");
+      if (scope_ != 0)
+        fail(loc, "*" + key + ", INSTANCE= inside a part or an instance",
+             "use INSTANCE= on assembly-level sets only (between the instances and *End Assembly)");
+      const auto it = instance_index_.find(upper(instance));
+      if (it == instance_index_.end())
+        fail(loc, "*" + key + ", INSTANCE=" + instance + ": no such instance above",
+             instance_index_.empty() ? std::string("define it with *Instance, name=" + instance + ", part=<part>")
+                                     : "use one of " + inp::join_names(instance_names()));
+      members_in = it->second;
+    }
     block_ = nodes ? Block::NodeSet : Block::ElementSet;
     generate_ = kw.has("GENERATE");
-    open_set(nodes ? deck_.mesh.node_sets : deck_.mesh.element_sets, name);
+    Scope& s = scope();
+    open_set(nodes ? s.node_sets : s.element_sets, name);
+    // CAE's INTERNAL sets (the element sets behind a *SURFACE, picked regions) are the deck's
+    // plumbing: used while reading, not offered to the scene.
+    if (kw.has("INTERNAL")) (nodes ? s.internal_node_sets : s.internal_element_sets).insert(open_set_);
+    member_scope_ = members_in;
   }
 
   void set_line(const Loc& loc) {
     const bool nodes = block_ == Block::NodeSet;
     const char* kind = nodes ? "node" : "element";
-    auto& ids = nodes ? node_index_ : element_index_;
     std::vector<int>& members = *open_members_;
     if (generate_) {
+      const auto& ids = nodes ? home().node_index : home().element_index;
       std::array<long, 3> g{0, 0, 1};
       const std::size_t n = fields_.size();
       if (n < 2 || n > 3) fail(loc, "a GENERATE data line needs 'first, last[, step]'", "write e.g. '1, 100, 1'");
@@ -618,19 +895,16 @@ class DeckReader {
       }
       const long missing = count - found;
       if (missing > 0)
-        deck_.warnings.push_back(where(loc) + ": GENERATE " + std::to_string(first) + ", " + std::to_string(last) +
+        deck_.warnings.push_back(at(loc) + "GENERATE " + std::to_string(first) + ", " + std::to_string(last) +
                                  ", " + std::to_string(step) + " of " + open_set_ + ": " + std::to_string(missing) +
                                  " undefined " + kind + " id(s) skipped");
       return;
     }
     for (const std::string_view f : fields_) {
       if (f.empty()) continue;
-      if (const std::optional<long> id = parse_long(f)) {
-        const auto it = ids.find(*id);
-        if (it == ids.end())
-          fail(loc, std::string(kind) + " " + std::to_string(*id) + " in set " + open_set_ + " is not defined",
-               std::string("define it before this line or remove it from the set"));
-        members.push_back(it->second);
+      if (const int index = find_id(nodes, f, loc, "set " + open_set_, "define it before this line or remove it from the set");
+          index >= 0) {
+        members.push_back(index);
       } else {
         const std::vector<int> other = named_set(nodes, f, loc, nodes ? "*NSET" : "*ELSET");  // copy: may be `members`
         members.insert(members.end(), other.begin(), other.end());
@@ -638,36 +912,120 @@ class DeckReader {
     }
   }
 
+  // ---- names and ids in data lines ------------------------------------------------------------
+  // A data line names nodes, elements, sets and surfaces of its own scope: a part's (read for an
+  // instance), an instance's, or the model/assembly level's. At the model/assembly level, as in
+  // Abaqus, "Actuator-1.Set-1" and "Actuator-1.123" name an instance's set and id; a bare name
+  // the assembly does not define is accepted for the one instance that defines it (several: an
+  // error listing the choices), as the names the reader stores allow too (inp_assembly.h).
+
+  Scope& scope() { return scopes_[static_cast<std::size_t>(scope_)]; }
+  const Scope& scope() const { return scopes_[static_cast<std::size_t>(scope_)]; }
+  /// The scope whose ids and names a data line uses: the instance of a set with INSTANCE=.
+  int home_index() const { return member_scope_ >= 0 ? member_scope_ : scope_; }
+  Scope& home() { return scopes_[static_cast<std::size_t>(home_index())]; }
+
+  std::vector<std::string> instance_names() const {
+    std::vector<std::string> out;
+    for (std::size_t i = 1; i < scopes_.size(); ++i) out.push_back(scopes_[i].name);
+    return out;
+  }
+
+  /// The instance named by the qualifier of "INSTANCE.REST" (at the model/assembly level), with
+  /// `rest` set to REST; -1 if the token is not qualified by an instance.
+  int qualifier(std::string_view token, std::string_view& rest) const {
+    if (scope_ != 0 || instance_index_.empty()) return -1;
+    const auto [instance, r] = inp::split_qualified(token);
+    if (instance.empty()) return -1;
+    const auto it = instance_index_.find(upper(instance));
+    if (it == instance_index_.end()) return -1;
+    rest = r;
+    return it->second;
+  }
+
+  /// "123", or "Actuator-1.123" for an id of another scope than the line's own.
+  std::string id_text(int scope, long id) const {
+    return scope == scope_ ? std::to_string(id) : scopes_[static_cast<std::size_t>(scope)].name + "." + std::to_string(id);
+  }
+
+  /// Index of the node (or element) that `token` names by id ("123", or "Actuator-1.123"); -1 if
+  /// the token is not an id. An undefined id is an error naming `context` and `todo`.
+  int find_id(bool nodes, std::string_view token, const Loc& loc, const std::string& context, const std::string& todo) {
+    int s = home_index();
+    std::string_view rest = token;
+    if (const int q = qualifier(token, rest); q >= 0) s = q;
+    const std::optional<long> id = parse_long(rest);
+    if (!id) return -1;
+    const Scope& sc = scopes_[static_cast<std::size_t>(s)];
+    const auto& ids = nodes ? sc.node_index : sc.element_index;
+    const auto it = ids.find(*id);
+    if (it != ids.end()) return it->second;
+    std::string hint = todo;
+    if (s == 0 && !instance_index_.empty())
+      hint += "; at the assembly level a bare id names an assembly-level " + std::string(nodes ? "node" : "element") +
+              ": write <instance>." + std::to_string(*id) + " (e.g. " + scopes_[1].name + "." + std::to_string(*id) +
+              ") or put INSTANCE= on the set";
+    fail(loc, std::string(nodes ? "node " : "element ") + id_text(s, *id) + " in " + context + " is not defined", hint);
+  }
+
+  /// The set (or surface) of `names` that `token` names, or nullptr; an ambiguous bare name is
+  /// an error listing the qualified choices.
+  template <class V>
+  V* find_named(std::map<std::string, V> Scope::*names, std::string_view token, const Loc& loc,
+                const std::string& context, const std::string& kind) {
+    std::string_view rest;
+    if (const int q = qualifier(token, rest); q >= 0) {
+      auto& m = scopes_[static_cast<std::size_t>(q)].*names;
+      const auto it = m.find(upper(rest));
+      return it == m.end() ? nullptr : &it->second;
+    }
+    const std::string key = upper(token);
+    const int h = home_index();
+    auto& own = scopes_[static_cast<std::size_t>(h)].*names;
+    if (const auto it = own.find(key); it != own.end()) return &it->second;
+    if (h != 0) return nullptr;
+    std::vector<std::size_t> in;
+    for (std::size_t i = 1; i < scopes_.size(); ++i)
+      if ((scopes_[i].*names).count(key)) in.push_back(i);
+    if (in.empty()) return nullptr;
+    if (in.size() > 1) {
+      std::vector<std::string> instances, choices;
+      for (std::size_t i : in) {
+        instances.push_back(scopes_[i].name);
+        choices.push_back(scopes_[i].name + "." + std::string(token));
+      }
+      fail(loc, kind + " '" + std::string(token) + "' in " + context + " is ambiguous: instances " +
+                    inp::join_names(instances) + " each define one",
+           "name one with its instance: " + inp::join_names(choices, " or "));
+    }
+    return &(scopes_[in[0]].*names).at(key);
+  }
+
   /// Members of the node (or element) set named `name`; error naming `context` when unknown.
   const std::vector<int>& named_set(bool nodes, std::string_view name, const Loc& loc, const std::string& context) {
-    const std::string key = upper(name);
-    auto& sets = nodes ? deck_.mesh.node_sets : deck_.mesh.element_sets;
-    const auto it = sets.find(key);
-    if (it != sets.end()) {
-      if (unsorted_.erase(&it->second) != 0) normalise(it->second);
-      return it->second;
-    }
-    const auto& others = nodes ? deck_.mesh.element_sets : deck_.mesh.node_sets;
     const std::string kind = nodes ? "node" : "element";
-    if (others.count(key))
+    if (std::vector<int>* set = find_named(nodes ? &Scope::node_sets : &Scope::element_sets, name, loc, context,
+                                           kind + " set")) {
+      if (unsorted_.erase(set) != 0) normalise(*set);
+      return *set;
+    }
+    if (find_named(nodes ? &Scope::element_sets : &Scope::node_sets, name, loc, context, kind + " set"))
       fail(loc,
            "'" + std::string(name) + "' in " + context +
                (nodes ? " is an element set, not a node set" : " is a node set, not an element set"),
            "use a " + kind + " set here");
     fail(loc, "unknown " + kind + " set '" + std::string(name) + "' in " + context,
          "define it with *" + std::string(nodes ? "NSET" : "ELSET") + (nodes ? "" : " (or ELSET= on *ELEMENT)") +
-             " before this line; set names are case-insensitive");
+             " before this line; set names are case-insensitive" +
+             (instance_index_.empty() || scope_ != 0 ? "" : "; an instance's set is <instance>.<set> here"));
   }
 
   /// Calls f(index) for the element id or element set named by `token`.
   template <class F>
   void for_elements(std::string_view token, const Loc& loc, const std::string& context, F&& f) {
-    if (const std::optional<long> id = parse_long(token)) {
-      const auto it = element_index_.find(*id);
-      if (it == element_index_.end())
-        fail(loc, "element " + std::to_string(*id) + " in " + context + " is not defined",
-             "define it under *ELEMENT before this line or fix the id");
-      f(it->second);
+    if (const int e = find_id(false, token, loc, context, "define it under *ELEMENT before this line or fix the id");
+        e >= 0) {
+      f(e);
       return;
     }
     for (int e : named_set(false, token, loc, context)) f(e);
@@ -675,12 +1033,8 @@ class DeckReader {
 
   template <class F>
   void for_nodes(std::string_view token, const Loc& loc, const std::string& context, F&& f) {
-    if (const std::optional<long> id = parse_long(token)) {
-      const auto it = node_index_.find(*id);
-      if (it == node_index_.end())
-        fail(loc, "node " + std::to_string(*id) + " in " + context + " is not defined",
-             "define it under *NODE before this line or fix the id");
-      f(it->second);
+    if (const int n = find_id(true, token, loc, context, "define it under *NODE before this line or fix the id"); n >= 0) {
+      f(n);
       return;
     }
     for (int n : named_set(true, token, loc, context)) f(n);
@@ -704,25 +1058,36 @@ class DeckReader {
     if (name.empty()) fail(loc, "*SURFACE without NAME=", "add NAME=<surface name>");
     const std::string type = upper(kw.get("TYPE"));
     if (!type.empty() && type != "ELEMENT") {
-      deck_.warnings.push_back(where(loc) + ": *SURFACE " + name + " of TYPE=" + type +
+      deck_.warnings.push_back(at(loc) + "*SURFACE " + name + " of TYPE=" + type +
                                " skipped (only element-face surfaces are read)");
       return;  // stays Block::Skip
     }
     block_ = Block::Surface;
     surface_ = name;
-    deck_.mesh.surfaces[surface_];
+    scope().surfaces[surface_];
+    if (kw.has("INTERNAL")) scope().internal_surfaces.insert(name);
   }
 
+  /// "elset_or_element, Sn" (CAE: "_Surf-1_S3, S3", the internal element set of the faces S3),
+  /// or a line naming another surface, whose faces are added (a surface made of others).
   void surface_line(const Loc& loc) {
-    if (fields_.size() < 2 || fields_[1].empty())
+    if (fields_.size() < 2 || fields_[1].empty()) {
+      if (const std::vector<FaceRef>* other =
+              find_named(&Scope::surfaces, fields_[0], loc, "*SURFACE " + surface_, "surface")) {
+        const std::vector<FaceRef> copy = *other;  // may be this surface
+        std::vector<FaceRef>& faces = scope().surfaces[surface_];
+        faces.insert(faces.end(), copy.begin(), copy.end());
+        return;
+      }
       fail(loc, "a *SURFACE data line needs a face label", "write 'element_or_elset, S1' (faces S1..S6)");
+    }
     const std::string label = upper(fields_[1]);
     int face = -1;
     if (label.size() == 2 && label[0] == 'S' && label[1] >= '1' && label[1] <= '6') face = label[1] - '1';
     if (face < 0)
       fail(loc, "'" + std::string(fields_[1]) + "' is not an element face",
            "use S1..S4 (tetrahedra), S1..S5 (wedges, pyramids) or S1..S6 (hexahedra)");
-    std::vector<FaceRef>& faces = deck_.mesh.surfaces[surface_];
+    std::vector<FaceRef>& faces = scope().surfaces[surface_];
     for_elements(fields_[0], loc, "*SURFACE " + surface_, [&](int e) {
       check_face(e, face, label, loc);
       faces.push_back(FaceRef{e, face});
@@ -735,9 +1100,8 @@ class DeckReader {
     const int faces = solid_faces(t);
     if (face >= faces)
       fail(loc,
-           label + " names face " + std::to_string(face + 1) + " of element " +
-               std::to_string(deck_.mesh.element_ids[static_cast<std::size_t>(e)]) + ", a " + solid_name(t) +
-               " with faces 1-" + std::to_string(faces),
+           label + " names face " + std::to_string(face + 1) + " of element " + element_name(e) + ", a " +
+               solid_name(t) + " with faces 1-" + std::to_string(faces),
            "use " + label.substr(0, 1) + "1.." + label.substr(0, 1) + std::to_string(faces) + " for that element");
   }
 
@@ -752,25 +1116,57 @@ class DeckReader {
       return;
     }
     const int face = label[1] - '1';
-    if (fields_.size() < 3 || fields_[2].empty())
-      fail(loc, "*DLOAD " + label + " without a magnitude", "write 'element_or_elset, " + label + ", magnitude'");
-    const std::optional<double> p = parse_double(fields_[2]);
-    if (!p) fail(loc, "*DLOAD magnitude '" + std::string(fields_[2]) + "' is not a finite number", "fix the value");
+    const std::optional<double> p = magnitude("*DLOAD", label, "element_or_elset", loc);
     for_elements(fields_[0], loc, "*DLOAD", [&](int e) {
       check_face(e, face, label, loc);
-      const long long key = static_cast<long long>(e) * 8 + face;
-      const auto [it, inserted] = load_index_.try_emplace(key, deck_.pressure_faces.size());
-      if (inserted) {
-        deck_.pressure_faces.push_back(InpPressure{FaceRef{e, face}, *p});
-      } else if (deck_.pressure_faces[it->second].magnitude != *p) {
-        std::ostringstream msg;
-        msg.precision(17);
-        msg << "element " << deck_.mesh.element_ids[static_cast<std::size_t>(e)] << " face " << label
-            << " loaded again with " << *p << "; keeping the first magnitude "
-            << deck_.pressure_faces[it->second].magnitude;
-        deck_.warnings.push_back(where(loc) + ": " + msg.str());
-      }
+      add_pressure(FaceRef{e, face}, *p, label, loc);
     });
+  }
+
+  /// The magnitude field of a *DLOAD / *DSLOAD line.
+  std::optional<double> magnitude(const std::string& keyword, const std::string& label, const std::string& first,
+                                  const Loc& loc) const {
+    if (fields_.size() < 3 || fields_[2].empty())
+      fail(loc, keyword + " " + label + " without a magnitude", "write '" + first + ", " + label + ", magnitude'");
+    const std::optional<double> p = parse_double(fields_[2]);
+    if (!p) fail(loc, keyword + " magnitude '" + std::string(fields_[2]) + "' is not a finite number", "fix the value");
+    return p;
+  }
+
+  /// Each (element, face) once, the first magnitude kept (a differing repeat warns).
+  void add_pressure(const FaceRef& f, double p, const std::string& label, const Loc& loc) {
+    const long long key = static_cast<long long>(f.element) * 8 + f.local_face;  // faces of solids: up to 6
+    const auto [it, inserted] = load_index_.try_emplace(key, deck_.pressure_faces.size());
+    if (inserted) {
+      deck_.pressure_faces.push_back(InpPressure{f, p});
+    } else if (deck_.pressure_faces[it->second].magnitude != p) {
+      std::ostringstream msg;
+      msg.precision(17);
+      msg << "element " << element_name(f.element) << " face " << label << " loaded again with " << p
+          << "; keeping the first magnitude " << deck_.pressure_faces[it->second].magnitude;
+      deck_.warnings.push_back(at(loc) + msg.str());
+    }
+  }
+
+  // ---- *DSLOAD ------------------------------------------------------------------------------
+  /// "surface, P, magnitude": how Abaqus/CAE writes a pressure load on a surface (the chamber
+  /// pressure of a pneu-net); its faces join the *DLOAD Pn faces.
+  void dsload_line(const Loc& loc) {
+    if (fields_.size() < 2 || fields_[1].empty())
+      fail(loc, "a *DSLOAD data line needs a load label", "write 'surface, P, magnitude'");
+    const std::string label = upper(fields_[1]);
+    if (label != "P") {
+      warn_once("dsload " + label, loc, "*DSLOAD load type " + label + " skipped (only the pressure P is read)");
+      return;
+    }
+    const std::optional<double> p = magnitude("*DSLOAD", label, "surface", loc);
+    const std::vector<FaceRef>* faces = find_named(&Scope::surfaces, fields_[0], loc, "*DSLOAD", "surface");
+    if (!faces)
+      fail(loc, "unknown surface '" + std::string(fields_[0]) + "' in *DSLOAD",
+           "define it with *SURFACE, TYPE=ELEMENT, NAME=" + std::string(fields_[0]) + " before this line" +
+               (instance_index_.empty() ? std::string() : " (an instance's surface is <instance>.<surface> here)"));
+    const std::vector<FaceRef> copy = *faces;
+    for (const FaceRef& f : copy) add_pressure(f, *p, "S" + std::to_string(f.local_face + 1), loc);
   }
 
   // ---- *BOUNDARY ----------------------------------------------------------------------------
@@ -827,19 +1223,37 @@ class DeckReader {
   void finish() {
     Mesh& mesh = deck_.mesh;
     const Loc end{0, std::max(1, last_line_of_top_)};
+    std::vector<std::string> unused_parts;
+    for (const auto& [key, part] : parts_)
+      if (!part.instanced) unused_parts.push_back(part.name);
+    if (!unused_parts.empty() && instance_index_.empty() && solids_.size() == 0) {
+      const PartDef& p = parts_.begin()->second;
+      fail(p.loc, "part '" + p.name + "' is defined but never instanced, so the deck has no mesh",
+           "instance it: *Assembly, name=Assembly / *Instance, name=" + p.name + "-1, part=" + p.name +
+               " / *End Instance / *End Assembly");
+    }
+    if (!unused_parts.empty())
+      deck_.warnings.push_back(file_names_[0] + ": part(s) " + inp::join_names(unused_parts) +
+                               " never instanced: their mesh is not read");
     if (mesh.num_nodes() == 0) fail(end, "the deck defines no nodes", "add a *NODE block with 'id, x, y, z' lines");
     if (solids_.size() == 0)
       fail(end, "the deck defines no elements", "add an *ELEMENT, TYPE=C3D4 or TYPE=C3D10 block");
-    for (auto& [name, v] : mesh.node_sets) normalise(v);
-    for (auto& [name, v] : mesh.element_sets) normalise(v);
-    split_solids(solids_, deck_, [&](int s) { return where(solid_loc_[static_cast<std::size_t>(s)]); });
-    resolve_surface_elements();
-    for (auto& [name, faces] : mesh.surfaces) {  // a face listed twice would be loaded twice
-      std::unordered_set<long long> seen;
-      std::erase_if(faces, [&](const FaceRef& f) {
-        return !seen.insert(static_cast<long long>(f.element) * 4 + f.local_face).second;
-      });
+    for (Scope& s : scopes_) {
+      for (auto& [name, v] : s.node_sets) normalise(v);
+      for (auto& [name, v] : s.element_sets) normalise(v);
     }
+    split();
+    resolve_surface_elements();
+    for (Scope& s : scopes_)
+      for (auto& [name, faces] : s.surfaces) {  // a face listed twice would be loaded twice
+        std::unordered_set<long long> seen;
+        std::erase_if(faces, [&](const FaceRef& f) {
+          return !seen.insert(static_cast<long long>(f.element) * 4 + f.local_face).second;
+        });
+      }
+    export_names();
+    check_instances();
+    number_scopes();
     // Advice the solver would otherwise give far less clearly.
     std::vector<char> used(static_cast<std::size_t>(mesh.num_nodes()), 0);
     for (int n : mesh.conn) used[static_cast<std::size_t>(n)] = 1;
@@ -848,15 +1262,114 @@ class DeckReader {
       deck_.warnings.push_back(file_names_[0] + ": " + std::to_string(unused) +
                                " node(s) belong to no element (they carry no stiffness)");
     int inverted = 0;
-    long first_inverted = 0;
+    int first_inverted = 0;
     for (int e = 0; e < mesh.num_elements(); ++e)
-      if (corner_volume(mesh, e) <= 0.0 && inverted++ == 0)
-        first_inverted = mesh.element_ids[static_cast<std::size_t>(e)];
+      if (corner_volume(mesh, e) <= 0.0 && inverted++ == 0) first_inverted = e;
     if (inverted > 0)
       deck_.warnings.push_back(file_names_[0] + ": " + std::to_string(inverted) +
                                " element(s) have zero or negative volume (first: element " +
-                               std::to_string(first_inverted) + "); check the node order");
+                               mesh.element_name(first_inverted) + "); check the node order");
     mesh.ensure_ids();
+  }
+
+  /// Hexahedra, wedges and pyramids -> tetrahedra (solid_split.h), those of every instance and of
+  /// the model/assembly level at once, so the sets and surfaces of every scope and the pressure
+  /// faces follow the split. New ids continue each scope's own (number_scopes offsets them later).
+  void split() {
+    SplitSets sets;
+    for (Scope& s : scopes_) {
+      sets.node_sets.push_back(&s.node_sets);
+      sets.element_sets.push_back(&s.element_sets);
+      sets.surfaces.push_back(&s.surfaces);
+    }
+    split_solids(solids_, deck_, [&](int s) { return solid_where(s); }, sets);
+    const Mesh& mesh = deck_.mesh;
+    for (std::size_t e = 0; e < mesh.element_ids.size(); ++e) {
+      long& last = scopes_[mesh.element_scope[e]].max_element_id;
+      last = std::max(last, mesh.element_ids[e]);
+    }
+    for (std::size_t n = 0; n < mesh.node_ids.size(); ++n) {
+      long& last = scopes_[mesh.node_scope[n]].max_node_id;
+      last = std::max(last, mesh.node_ids[n]);
+    }
+  }
+
+  /// Where solid element s was read, "<file>:<line>", and the part and instance when it is a
+  /// part's line read for an instance.
+  std::string solid_where(int s) const {
+    const std::size_t i = static_cast<std::size_t>(s);
+    const std::string w = where(solid_loc_[i]);
+    const std::uint16_t instance = solid_part_instance_[i];
+    return instance == 0 ? w : w + ": " + part_context(scopes_[instance]);
+  }
+
+  /// The Mesh's set and surface names (inp_assembly.h): the model/assembly level's as they are,
+  /// an instance's qualified and, when unambiguous, bare; INTERNAL ones not at all.
+  void export_names() {
+    std::vector<inp::ScopedNames<std::vector<int>>> nsets, elsets;
+    std::vector<inp::ScopedNames<std::vector<FaceRef>>> surfaces;
+    for (std::size_t i = 0; i < scopes_.size(); ++i) {
+      const Scope& s = scopes_[i];
+      const std::string prefix = i == 0 ? std::string() : upper(s.name) + ".";
+      nsets.push_back({prefix, &s.node_sets, &s.internal_node_sets});
+      elsets.push_back({prefix, &s.element_sets, &s.internal_element_sets});
+      surfaces.push_back({prefix, &s.surfaces, &s.internal_surfaces});
+    }
+    deck_.mesh.node_sets = inp::export_names(nsets);
+    deck_.mesh.element_sets = inp::export_names(elsets);
+    deck_.mesh.surfaces = inp::export_names(surfaces);
+  }
+
+  /// Scopes that hold nodes or elements.
+  int scopes_with_mesh() const {
+    return static_cast<int>(std::count_if(scopes_.begin(), scopes_.end(), [](const Scope& s) { return s.nodes > 0; }));
+  }
+
+  /// Element e as the user knows it: "123", or "Actuator-1.123" once the deck has more than one
+  /// id scope with a mesh so far (as Mesh::element_name will name it; ids are still the deck's).
+  std::string element_name(int e) const {
+    const Mesh& mesh = deck_.mesh;
+    const long id = mesh.element_ids[static_cast<std::size_t>(e)];
+    if (scopes_with_mesh() <= 1) return std::to_string(id);
+    return scopes_[mesh.element_scope[static_cast<std::size_t>(e)]].name + "." + std::to_string(id);
+  }
+
+  /// Ids are per instance in a deck: with several scopes holding a mesh, each gets an offset
+  /// (the largest ids of the scopes before it) so the Mesh's ids are distinct, and the Mesh
+  /// keeps the scopes for its labels; with one, the deck's ids stay as they are.
+  void number_scopes() {
+    Mesh& mesh = deck_.mesh;
+    if (scopes_with_mesh() <= 1) {
+      mesh.node_scope.clear();
+      mesh.element_scope.clear();
+      return;
+    }
+    long node_offset = 0, element_offset = 0;
+    for (const Scope& s : scopes_) {
+      mesh.id_scopes.push_back(Mesh::IdScope{s.name, node_offset, element_offset});
+      node_offset += s.max_node_id;
+      element_offset += s.max_element_id;
+    }
+    for (std::size_t n = 0; n < mesh.node_ids.size(); ++n) mesh.node_ids[n] += mesh.id_scopes[mesh.node_scope[n]].node_id_offset;
+    for (std::size_t e = 0; e < mesh.element_ids.size(); ++e)
+      mesh.element_ids[e] += mesh.id_scopes[mesh.element_scope[e]].element_id_offset;
+    for (std::size_t e = 0; e < mesh.element_sources.size(); ++e)  // a split element's id, in the same scope
+      mesh.element_sources[e].id += mesh.id_scopes[mesh.element_scope[e]].element_id_offset;
+  }
+
+  /// Instances never share nodes: several holding solid elements are separate bodies, which a
+  /// *TIE in Abaqus may join but pneufem cannot (build_model refuses such a model).
+  void check_instances() {
+    std::vector<char> solid(scopes_.size(), 0);
+    for (std::uint16_t s : deck_.mesh.element_scope) solid[s] = 1;
+    for (std::size_t i = 0; i < scopes_.size(); ++i)
+      if (solid[i] && (i > 0 || !instance_index_.empty())) deck_.solid_instances.push_back(scopes_[i].name);
+    if (deck_.solid_instances.size() > 1)
+      deck_.warnings.push_back(file_names_[0] + ": the solid elements are in " +
+                               std::to_string(deck_.solid_instances.size()) + " instances (" +
+                               inp::join_names(deck_.solid_instances) +
+                               ") that share no node, so the mesh is not connected and pneufem cannot simulate it; "
+                               "merge the instances in Abaqus (Merge/Cut Instances) so the mesh is conforming");
   }
 
   // ---- state --------------------------------------------------------------------------------
@@ -885,6 +1398,7 @@ class DeckReader {
   SolidType solid_ = SolidType::C3D4;  // of the current *ELEMENT block
   SolidElements solids_;      // the deck's solid elements, split into tetrahedra by finish()
   std::vector<Loc> solid_loc_;
+  std::vector<std::uint16_t> solid_part_instance_;  // its instance if read from a part (solid_where), else 0
   std::vector<int> element_nodes_;
   std::string type_name_;
   int npe_ = 0;
@@ -895,12 +1409,23 @@ class DeckReader {
     Loc loc;
     std::array<int, 3> corners;  // node indices
   };
-  std::map<std::string, std::vector<SurfaceTriangle>> surface_elements_;  // ELSET -> triangles
+  std::map<std::pair<int, std::string>, std::vector<SurfaceTriangle>> surface_elements_;  // (scope, ELSET) -> triangles
   std::string surface_set_;  // ELSET of the surface element block being read
   Loc pending_loc_;
 
-  std::unordered_map<long, int> node_index_;
-  std::unordered_map<long, int> element_index_;
+  std::deque<Scope> scopes_;  // a deque: open_members_ points into a Scope's sets
+  int scope_ = 0;             // scope of the line being read
+  int member_scope_ = -1;     // scope of the members of a set with INSTANCE=, or -1
+
+  std::map<std::string, PartDef> parts_;   // upper-case name -> part
+  PartDef* recording_ = nullptr;           // the *PART block being recorded
+  std::map<std::string, int> instance_index_;  // upper-case instance name -> scope
+  Level level_ = Level::Model;
+  std::optional<Loc> assembly_loc_;
+  int pending_instance_ = -1;  // instance whose placement lines are being read (its part follows)
+  int placement_lines_ = 0;
+  std::string context_;        // "part 'P' (instance 'I'): " while a part is read for an instance
+
   std::unordered_map<long long, std::size_t> load_index_;
   std::unordered_set<long long> fixed_;
   std::set<std::string> warned_;

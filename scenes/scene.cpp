@@ -280,6 +280,15 @@ std::vector<std::string> Scene::table_keys(const std::string& key) const {
   return out;
 }
 
+std::string Scene::string_entry(const std::string& table, const std::string& name) const {
+  const std::string key = table + "." + name;
+  const toml::node* t = impl_->table.at_path(table).node();
+  const toml::node* n = t && t->is_table() ? t->as_table()->get(name) : nullptr;
+  if (!n) fail(key, "missing");
+  if (!n->is_string()) fail(key, "expected a string (in quotes)");
+  return *n->value<std::string>();
+}
+
 int Scene::array_size(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
   if (!n || !n->is_array()) return 0;

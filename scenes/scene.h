@@ -33,6 +33,9 @@ class Scene {
   bool has(const std::string& key) const;
   /// Names of the sub-tables of `key` (e.g. the materials).
   std::vector<std::string> table_keys(const std::string& key) const;
+  /// The string of entry `name` of table `table`, `name` taken literally: it may hold dots (a
+  /// deck's "Actuator-1.Set-1" in mesh.regions), which string() would read as a path.
+  std::string string_entry(const std::string& table, const std::string& name) const;
   /// Number of entries of an array of tables (e.g. "parts").
   int array_size(const std::string& key) const;
   /// Where a key was set: "scene.toml:12", "--set", or "default scene".

@@ -259,7 +259,8 @@ Eigen::Vector3d solid_point(SolidType t, const int* nodes, const std::vector<Eig
   return x;
 }
 
-void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where) {
+void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where,
+                  const SplitSets& also) {
   Mesh& mesh = deck.mesh;
   const int ns = solids.size();
   const bool quadratic = mesh.type == ElementType::Tet10;
@@ -271,9 +272,24 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   std::vector<long> ids;
   std::vector<std::uint16_t> region;
   std::vector<ElementSource> sources;
-  long next_element_id = 0, next_node_id = 0;
-  for (long id : mesh.element_ids) next_element_id = std::max(next_element_id, id);
-  for (long id : mesh.node_ids) next_node_id = std::max(next_node_id, id);
+  std::vector<std::uint16_t> element_scope;
+
+  // New ids continue the largest of their id scope (one scope when the mesh has none).
+  const bool element_scoped = mesh.element_scope.size() == static_cast<std::size_t>(ns);
+  const bool node_scoped = mesh.node_scope.size() == static_cast<std::size_t>(n_original);
+  std::vector<long> last_element_id, last_node_id;  // per scope
+  auto last_id = [](std::vector<long>& last, std::size_t scope) -> long& {
+    if (scope >= last.size()) last.resize(scope + 1, 0);
+    return last[scope];
+  };
+  for (std::size_t e = 0; e < mesh.element_ids.size(); ++e) {
+    long& last = last_id(last_element_id, element_scoped ? mesh.element_scope[e] : 0);
+    last = std::max(last, mesh.element_ids[e]);
+  }
+  for (std::size_t n = 0; n < mesh.node_ids.size(); ++n) {
+    long& last = last_id(last_node_id, node_scoped ? mesh.node_scope[n] : 0);
+    last = std::max(last, mesh.node_ids[n]);
+  }
 
   // New mid-nodes on cut diagonals, keyed by the diagonal's corner nodes, and the nodes of the face
   // (or element) each lies on, which decide its sets and boundary dofs.
@@ -287,6 +303,7 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
     const ShapeTables& sh = *ti.shape;
     const int* n = solids.element(s);
     const long id = mesh.element_ids[static_cast<std::size_t>(s)];
+    const std::uint16_t scope = element_scoped ? mesh.element_scope[static_cast<std::size_t>(s)] : 0;
     auto label = [&] { return "element " + std::to_string(id) + " (" + ti.name + ")"; };
     for (int a = 0; a < ti.nodes; ++a)
       for (int b = a + 1; b < ti.nodes; ++b)
@@ -301,6 +318,7 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
       conn.insert(conn.end(), n, n + npe);
       ids.push_back(id);
       region.push_back(r);
+      element_scope.push_back(scope);
       sources.push_back(ElementSource{id, 0, 0, {}});
       continue;
     }
@@ -337,7 +355,9 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
           auto [it, fresh] = diagonal_node.try_emplace(key, mesh.num_nodes());
           if (fresh) {
             mesh.X.push_back(solid_point(t, n, mesh.X, 0.5 * (ref(sh, a) + ref(sh, b))));
-            mesh.node_ids.push_back(++next_node_id);
+            const std::uint16_t node_scope = node_scoped ? mesh.node_scope[static_cast<std::size_t>(n[0])] : 0;
+            mesh.node_ids.push_back(++last_id(last_node_id, node_scope));
+            if (node_scoped) mesh.node_scope.push_back(node_scope);
             std::vector<int> on;
             int f = 0;
             while (f < sh.faces && !(face_has(sh, f, a) && face_has(sh, f, b))) ++f;
@@ -354,8 +374,9 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
           }
           conn.push_back(it->second);
         }
-      ids.push_back(k == 0 ? id : ++next_element_id);
+      ids.push_back(k == 0 ? id : ++last_id(last_element_id, scope));
       region.push_back(r);
+      element_scope.push_back(scope);
       ElementSource src{id, static_cast<std::uint8_t>(k + 1), static_cast<std::uint8_t>(nt), {}};
       std::strncpy(src.type.data(), ti.name, src.type.size() - 1);
       sources.push_back(src);
@@ -368,13 +389,17 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
 
   // Node sets and boundary dofs reach the new nodes whose face lies wholly in them.
   const int n_new = mesh.num_nodes() - n_original;
-  for (auto& [name, nodes] : mesh.node_sets) {
+  auto remap_node_set = [&](std::vector<int>& nodes) {
+    if (n_new == 0) return;
     std::vector<char> in(static_cast<std::size_t>(n_original), 0);
     for (int i : nodes) in[static_cast<std::size_t>(i)] = 1;
     for (int k = 0; k < n_new; ++k)
       if (std::all_of(support[k].begin(), support[k].end(), [&](int i) { return in[static_cast<std::size_t>(i)] != 0; }))
         nodes.push_back(n_original + k);
-  }
+  };
+  for (auto& [name, nodes] : mesh.node_sets) remap_node_set(nodes);
+  for (auto* sets : also.node_sets)
+    for (auto& [name, nodes] : *sets) remap_node_set(nodes);
   if (n_new > 0 && !deck.fixed_dofs.empty()) {
     std::vector<std::array<char, 3>> fixed(static_cast<std::size_t>(n_original), {0, 0, 0});
     for (const auto& [node, dof] : deck.fixed_dofs) fixed[static_cast<std::size_t>(node)][static_cast<std::size_t>(dof)] = 1;
@@ -385,13 +410,16 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   }
 
   // Element sets, surfaces and pressure faces move to the tetrahedra.
-  for (auto& [name, members] : mesh.element_sets) {
+  auto remap_element_set = [&](std::vector<int>& members) {
     std::vector<int> tets;
     for (int s : members)
       for (int e = first_tet[static_cast<std::size_t>(s)]; e < first_tet[static_cast<std::size_t>(s) + 1]; ++e)
         tets.push_back(e);
     members = std::move(tets);
-  }
+  };
+  for (auto& [name, members] : mesh.element_sets) remap_element_set(members);
+  for (auto* sets : also.element_sets)
+    for (auto& [name, members] : *sets) remap_element_set(members);
   // The tetrahedron faces that tile face f of solid s: those with all three corners on it.
   auto tile = [&](const FaceRef& face, auto&& emit) {
     const int s = face.element;
@@ -411,11 +439,14 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
           emit(FaceRef{e, lf});
       }
   };
-  for (auto& [name, faces] : mesh.surfaces) {
+  auto remap_surface = [&](std::vector<FaceRef>& faces) {
     std::vector<FaceRef> out;
     for (const FaceRef& f : faces) tile(f, [&](const FaceRef& g) { out.push_back(g); });
     faces = std::move(out);
-  }
+  };
+  for (auto& [name, faces] : mesh.surfaces) remap_surface(faces);
+  for (auto* surfaces : also.surfaces)
+    for (auto& [name, faces] : *surfaces) remap_surface(faces);
   std::vector<InpPressure> pressure;
   for (const InpPressure& p : deck.pressure_faces)
     tile(p.face, [&](const FaceRef& g) { pressure.push_back(InpPressure{g, p.magnitude}); });
@@ -424,6 +455,7 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   mesh.conn = std::move(conn);
   mesh.element_ids = std::move(ids);
   mesh.region = std::move(region);
+  if (element_scoped) mesh.element_scope = std::move(element_scope);
   if (split_count.empty()) return;
   mesh.element_sources = std::move(sources);
 

@@ -41,6 +41,7 @@
 // body diagonal) has it: a fixed face stays fixed.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -88,17 +89,30 @@ struct SolidElements {
   }
 };
 
+/// Sets that a split carries over besides those of deck.mesh: a deck reader keeps the sets and
+/// surfaces of each id scope (the assembly, every instance) apart until the deck is read.
+struct SplitSets {
+  std::vector<std::map<std::string, std::vector<int>>*> node_sets, element_sets;
+  std::vector<std::map<std::string, std::vector<FaceRef>>*> surfaces;
+};
+
 /// Replaces the solid elements by tetrahedra in `deck`, whose mesh so far holds the nodes, node sets,
 /// and per solid element its external id and region, and whose element sets, surfaces and
-/// pressure_faces refer to solid elements (FaceRef::local_face = Abaqus face number - 1). Afterwards
-/// they refer to the tetrahedra: an element set holds every tetrahedron of its elements, a face maps
-/// to the 2 (quadrilateral) or 1 (triangle) tetrahedron faces that tile it, in order. mesh.type must
-/// be the deck's order (Tet4 for linear, Tet10 for quadratic elements). The first tetrahedron of an
-/// element keeps its id, the others get ids above the deck's largest; mesh.element_sources says
-/// where each came from when anything was split. A note (warning) counts what was split.
+/// pressure_faces refer to solid elements (FaceRef::local_face = Abaqus face number - 1); so do
+/// those of `also`. Afterwards they refer to the tetrahedra: an element set holds every tetrahedron
+/// of its elements, a face maps to the 2 (quadrilateral) or 1 (triangle) tetrahedron faces that
+/// tile it, in order. mesh.type must be the deck's order (Tet4 for linear, Tet10 for quadratic
+/// elements). The first tetrahedron of an element keeps its id, the others get ids above the
+/// largest of the element's id scope, new nodes above the largest node id of theirs: with
+/// mesh.element_scope / node_scope filled per element / node (the instances of a deck, which number
+/// their ids each on its own, before the reader numbers them apart) ids stay distinct per scope and
+/// the tetrahedra and new nodes join their element's scope; without, the deck is one scope.
+/// mesh.element_sources says where each tetrahedron came from when anything was split. A note
+/// (warning) counts what was split. `where(s)` locates solid s's data line for messages.
 /// Throws InputError(where(s) + ": ...") for an element that repeats a node or whose split has a
 /// tetrahedron of zero or negative volume (inverted, wrongly numbered or degenerate).
-void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where);
+void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where,
+                  const SplitSets& also = {});
 
 /// mesh.promote_to_tet10 for a deck: promote_to_tet10 of the mesh, and its *BOUNDARY dofs extended
 /// to the new mid-edge nodes whose two corners both have the dof fixed (as promote_to_tet10 does

@@ -239,8 +239,7 @@ StateFields compute_fields(const Assembler& assembler, const Eigen::VectorXd& u,
     }
   });
   if (const int e = first_inverted.load(); e != INT_MAX) {
-    const long id = mesh.element_ids.empty() ? e + 1 : mesh.element_ids[e];
-    throw PhysicsError("output: element " + std::to_string(id) +
+    throw PhysicsError("output: " + mesh.element_label(e) +
                            " is inverted (det F <= 0) in the state to be written; the state was not a valid "
                            "equilibrium (check the solver's convergence for this step)",
                        e);

@@ -95,14 +95,22 @@ TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRight
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.tau_s"), 2000.0);
   EXPECT_EQ(s.string("materials.silicone.fatigue.driver"), base.string("materials.silicone.fatigue.driver"));
   EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5}).number("load.pressure_lag_s"), 0.5);
-  // Gravity: phi = 0 hangs the tip down along +y, 90 deg is horizontal with g towards the fabric (-z).
-  const Eigen::Vector3d g0 = with("gravity", {0.0}).vec3("gravity.g_m_s2"), g90 = with("gravity", {90.0}).vec3("gravity.g_m_s2"),
-                        g180 = with("gravity", {180.0}).vec3("gravity.g_m_s2");
-  EXPECT_EQ(g0, Eigen::Vector3d(0.0, 9.81, 0.0));
-  EXPECT_EQ(g90, Eigen::Vector3d(0.0, 0.0, -9.81));
-  EXPECT_NEAR((g180 - Eigen::Vector3d(0.0, -9.81, 0.0)).norm(), 0.0, 1e-12);
+  // Gravity: the rig angle in the actuator's frame; on the built-in actuator phi = 0 hangs the tip
+  // down along +y, 90 deg is horizontal with g towards the fabric (-z), bit for bit the vectors the
+  // hidden-effect datasets were made with (g_m_s2 = [0, 9.81 cos(phi), -9.81 sin(phi)]).
+  EXPECT_DOUBLE_EQ(with("gravity", {37.5}).number("gravity.rig_angle_deg"), 37.5);
+  auto g_of = [&](double phi) { return build_model(with("gravity", {phi}))->model.gravity_m_s2; };
+  EXPECT_EQ(g_of(0.0), Eigen::Vector3d(0.0, 9.81, 0.0));
+  EXPECT_EQ(g_of(90.0), Eigen::Vector3d(0.0, 0.0, -9.81));
+  const double phi = 37.5 * 3.14159265358979323846 / 180.0;
+  EXPECT_EQ(g_of(37.5), Eigen::Vector3d(0.0, 9.81 * std::cos(phi), -9.81 * std::sin(phi)));
+  EXPECT_NEAR((g_of(180.0) - Eigen::Vector3d(0.0, -9.81, 0.0)).norm(), 0.0, 1e-12);
   // g90 points the way the actuator bends (angle.bend_direction), i.e. to the fabric side.
-  EXPECT_GT(g90.dot(base.vec3("angle.bend_direction")), 0.0);
+  EXPECT_GT(g_of(90.0).dot(base.vec3("angle.bend_direction")), 0.0);
+  // A gravity vector of the scene is replaced, not added to.
+  EXPECT_EQ(build_model(base.with({"gravity.g_m_s2=[0.0, 0.0, -9.81]"}).with(candidate_effect("gravity").sets(base, {0.0})))
+                ->model.gravity_m_s2,
+            Eigen::Vector3d(0.0, 9.81, 0.0));
 }
 
 TEST(EffectCatalog, RegisteredMaterialEffectsBecomeCandidates) {

@@ -115,6 +115,19 @@ const FatigueParams kFatigueInStack{2e3, 50.0, 2.0, 0.95};  // d_fail above the 
 // Saturating law (integrity exponent n = 3): the tangent goes through the scalar Newton's ds/da.
 const FatigueParams kFatigueSaturating{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2, 3.0};
 
+// Non-local drivers (radius 1 mm): the law multiplies its driver by rho = average / local, which
+// the engine stores in the committed state; the cases below set rho != 1 both ways.
+FatigueParams nonlocal(FatigueParams p) {
+  p.nonlocal_radius_m = 1e-3;
+  return p;
+}
+/// Sets rho = average / local in mp's committed state through the material's own protocol.
+void set_rho(MaterialPoint& mp, double rho) {
+  std::vector<double> s(mp.committed_state().begin(), mp.committed_state().end());
+  mp.material().set_nonlocal_driver(s, 1.0, rho);
+  mp.set_committed_state(s);
+}
+
 MaterialPtr stack() {
   return make_viscoelastic(make_fatigue(make_mullins(ecoflex(), kMullins), kFatigueInStack), kVisco);
 }
@@ -166,6 +179,18 @@ std::vector<Case> cases() {
       {"fatigue_stretch_saturating", [] { return make_fatigue(ecoflex(), kFatigueSaturating); },
        [](MaterialPoint& mp) {
          for (int n = 0; n < 3; ++n) mp.advance(uniaxial(1.8), 10.0);
+       },
+       10.0, false, nullptr},
+      {"fatigue_energy_nonlocal_below_average", [] { return make_fatigue(ecoflex(), nonlocal(kFatigue)); },
+       [](MaterialPoint& mp) {
+         mp.advance(uniaxial(1.8), 0.5);
+         set_rho(mp, 1.25);  // a point below its neighbourhood: damage driven harder
+       },
+       1.0, false, scaled_extra},
+      {"fatigue_stretch_nonlocal_above_average", [] { return make_fatigue(ecoflex(), nonlocal(kFatigueStretch)); },
+       [](MaterialPoint& mp) {
+         for (int n = 0; n < 3; ++n) mp.advance(uniaxial(1.8), 10.0);
+         set_rho(mp, 0.9);  // a hot spot: capped at its neighbourhood's average
        },
        10.0, false, nullptr},
       {"viscoelastic", [] { return make_viscoelastic(ecoflex(), kVisco); },
@@ -438,6 +463,8 @@ std::vector<BatchCase> batch_cases() {
       {"story_stack", story(yeoh, kFatigueStory)},
       {"story_stack_scaled", story(scaled, kFatigueStory)},
       {"story_stack_mooney_rivlin", story(mooney, kFatigueStory)},  // a base law of I2b: no batched kernel
+      {"story_stack_nonlocal", story(yeoh, nonlocal(kFatigueStory))},  // rho != 1 in the committed states
+      {"fatigue_energy_nonlocal", make_fatigue(yeoh, nonlocal(kFatigue))},
       // The outer base's state (2 x 24 doubles) exceeds stress_base's buffers: the point-by-point path.
       {"viscoelastic_nested_deep",
        make_viscoelastic(make_viscoelastic(make_viscoelastic(yeoh, visco3), visco3), visco3)},
@@ -495,6 +522,14 @@ std::vector<std::vector<double>> committed_states(const MaterialPtr& m, const st
     MaterialPoint mp(m);
     for (int n = 0; n < 3; ++n) mp.advance(Fs[pick(rng)], dts[(h + n) % 4]);
     keep(mp);
+  }
+  if (m->nonlocal().radius_m > 0.0) {  // each history also with rho below and above 1
+    const std::size_t n = out.size();
+    for (std::size_t i = 0; i < n; ++i)
+      for (double rho : {0.8, 1.2}) {
+        out.push_back(out[i]);
+        m->set_nonlocal_driver(out.back(), 1.0, rho);
+      }
   }
   return out;
 }

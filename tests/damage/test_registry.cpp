@@ -250,5 +250,47 @@ TEST(Registry, SceneOrdersEffectsAndRejectsBadParameters) {
   EXPECT_NE(e.find("constant_softening"), std::string::npos) << e;  // the unknown table lists the effects
 }
 
+// A non-local fatigue driver (materials.NAME.fatigue.nonlocal_radius_mm) reaches the engine through
+// every layer wrapped around fatigue: the built-ins forward it; an effect registered in C++ that does
+// not (ConstantSoftening, registered here outside fatigue) is refused rather than silently local.
+TEST(Registry, ANonlocalFatigueDriverPassesThroughTheLayersOrIsRefused) {
+  const std::vector<std::string> story = {"materials.silicone.mullins.enabled=true", "materials.silicone.fatigue.enabled=true",
+                                          "materials.silicone.viscoelastic.enabled=true",
+                                          "materials.silicone.fatigue.driver=\"max_principal_stretch\"",
+                                          "materials.silicone.fatigue.nonlocal_radius_mm=1.5"};
+  const MaterialPtr m = make_material(Scene::load("", story), "silicone");
+  EXPECT_EQ(m->name(), "viscoelastic(fatigue(mullins(yeoh)))");
+  EXPECT_DOUBLE_EQ(m->nonlocal().radius_m, 1.5e-3);
+  EXPECT_EQ(m->nonlocal().kind, "fatigue:stretch");
+  EXPECT_EQ(make_material(Scene::load("", {"materials.silicone.fatigue.enabled=true"}), "silicone")->nonlocal().radius_m, 0.0);
+  std::string e = error_of([] {
+    make_material(Scene::load("", {"materials.silicone.fatigue.enabled=true", "materials.silicone.fatigue.nonlocal_radius_mm=-1.0"}),
+                  "silicone");
+  });
+  EXPECT_NE(e.find("materials.silicone.fatigue.nonlocal_radius_mm"), std::string::npos) << e;
+  EXPECT_NE(e.find("must be >= 0 mm"), std::string::npos) << e;
+  static const bool registered = [] {
+    MaterialEffect fx;
+    fx.name = "outer_softening";
+    fx.doc = "constant_softening wrapped around the history effects";
+    fx.params = {{"a", "1", "softened fraction", 0.1, 0.0, 0.9, false}};
+    fx.order = 400;
+    fx.decorate = [](MaterialPtr base, const std::map<std::string, double>& v) {
+      return std::make_shared<const ConstantSoftening>(std::move(base), v.at("a"));
+    };
+    register_material_effect(fx);
+    return true;
+  }();
+  (void)registered;
+  std::vector<std::string> outer = story;
+  outer.push_back("materials.silicone.outer_softening.enabled=true");
+  e = error_of([&] { make_material(Scene::load("", outer), "silicone"); });
+  EXPECT_NE(e.find("does not forward the non-local driver"), std::string::npos) << e;
+  EXPECT_NE(e.find("constant_softening(viscoelastic(fatigue(mullins(yeoh))))"), std::string::npos) << e;
+  outer.back() = "materials.silicone.fatigue.nonlocal_radius_mm=0.0";
+  outer.push_back("materials.silicone.outer_softening.enabled=true");
+  EXPECT_NO_THROW(make_material(Scene::load("", outer), "silicone"));  // local: nothing to forward
+}
+
 }  // namespace
 }  // namespace pneufem

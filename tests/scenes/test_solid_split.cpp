@@ -1,8 +1,9 @@
 // Decks of hexahedra, wedges and pyramids split into tetrahedra (scenes/solid_split.h): each element
 // type for every order of its corner ids, conformity between neighbours in generated blocks with
 // random node ids, surfaces/loads/sets/boundaries on the tetrahedra, curved quadratic elements,
-// messages, bad input, and two system tests (a curved C3D20 thick cylinder vs the analytic
-// solution, a C3D8 cantilever vs the same beam meshed with tetrahedra).
+// Abaqus/CAE decks (a part's elements split in each instance, in its id scope; a hexahedral actuator
+// as a CAE deck bends as its flat deck), messages, bad input, and two system tests (a curved C3D20
+// thick cylinder vs the analytic solution, a C3D8 cantilever vs the same beam meshed with tetrahedra).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -794,58 +795,229 @@ TEST_F(SolidDecks, PromotedTetrahedronDecksKeepTheirBoundaryFacesFixed) {
   EXPECT_EQ(d.fixed_dofs.size(), 3u * fixed.size());
 }
 
-// A small actuator as a deck of hexahedra, through the scene: a 3 x 6 x 3 cell beam along y with a
-// closed 1 x 4 x 1 cell cavity and a thin stiff FABRIC layer at the bottom, fixed at y = 0. As C3D20
-// (split to Tet10) and as the same corners in C3D8 with mesh.promote_to_tet10 it is the same Tet10
-// mesh (the same cuts, the same straight mid-edge nodes), numbered differently: the same angle, to
-// the equilibria's round-off. Without promotion the linear tetrahedra lock: the note says so.
-TEST_F(SolidDecks, AHexahedralActuatorDeckBendsTheSameAsC3D20AndAsPromotedC3D8) {
-  const Map mm = [](const Vec& s) {  // x 0..12, y 0..36, z: fabric 0..0.4, then two layers of 4 mm
-    const double z = s.z() <= 1.0 / 3 ? 1.2 * s.z() : 0.4 + 12.0 * (s.z() - 1.0 / 3);
-    return Vec(12.0 * s.x(), 36.0 * s.y(), z);
-  };
-  HexBlock b(3, 6, 3, true, 31, mm);
-  auto cavity = [](int i, int j, int k) { return i == 1 && k == 1 && j >= 1 && j <= 4; };
-  b.remove_cells(cavity);
-  // The cavity's walls: the faces of the cells around it that face it (S1 z-, S2 z+, S3 y-, S4 x+,
-  // S5 y+, S6 x-).
-  std::string surface = "*SURFACE, NAME=CAVITY\n";
+// A small actuator as a deck of hexahedra: a 3 x 6 x 3 cell beam along y with a closed 1 x 4 x 1
+// cell cavity and a thin stiff FABRIC layer at the bottom, fixed at y = 0 (lengths in mm).
+Vec actuator_mm(const Vec& s) {  // x 0..12, y 0..36, z: fabric 0..0.4, then two layers of 4 mm
+  const double z = s.z() <= 1.0 / 3 ? 1.2 * s.z() : 0.4 + 12.0 * (s.z() - 1.0 / 3);
+  return Vec(12.0 * s.x(), 36.0 * s.y(), z);
+}
+bool actuator_cavity(int i, int j, int k) { return i == 1 && k == 1 && j >= 1 && j <= 4; }
+
+/// The cavity's walls: (element id, face number) of the cells around it that face it (S1 z-,
+/// S2 z+, S3 y-, S4 x+, S5 y+, S6 x-).
+std::vector<std::pair<long, int>> actuator_walls(const HexBlock& b) {
+  std::vector<std::pair<long, int>> walls;
   for (int j = 1; j <= 4; ++j)
-    surface += std::to_string(b.element(0, j, 1)) + ", S4\n" + std::to_string(b.element(2, j, 1)) + ", S6\n" +
-               std::to_string(b.element(1, j, 0)) + ", S2\n" + std::to_string(b.element(1, j, 2)) + ", S1\n";
-  surface += std::to_string(b.element(1, 0, 1)) + ", S5\n" + std::to_string(b.element(1, 5, 1)) + ", S3\n";
-  std::string elsets = "*ELSET, ELSET=FABRIC\n";
-  std::string silicone = "*ELSET, ELSET=SILICONE\n";
+    walls.insert(walls.end(),
+                 {{b.element(0, j, 1), 4}, {b.element(2, j, 1), 6}, {b.element(1, j, 0), 2}, {b.element(1, j, 2), 1}});
+  walls.insert(walls.end(), {{b.element(1, 0, 1), 5}, {b.element(1, 5, 1), 3}});
+  return walls;
+}
+
+/// *ELSET FABRIC (the bottom layer of cells) and SILICONE (the others).
+std::string actuator_elsets(const HexBlock& b) {
+  std::string fabric = "*ELSET, ELSET=FABRIC\n", silicone = "*ELSET, ELSET=SILICONE\n";
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 6; ++j)
       for (int i = 0; i < 3; ++i)
-        if (!cavity(i, j, k)) (k == 0 ? elsets : silicone) += std::to_string(b.element(i, j, k)) + "\n";
+        if (!actuator_cavity(i, j, k)) (k == 0 ? fabric : silicone) += std::to_string(b.element(i, j, k)) + "\n";
+  return fabric + silicone;
+}
+
+/// The bending angle at the end of the scene's load, and the model's warnings.
+double actuator_angle(const std::string& path, std::vector<std::string> extra, std::vector<std::string>* warnings) {
+  extra.insert(extra.end(), {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"", "load.max_kPa=5.0"});
+  auto bm = build_model(Scene::load("", extra));
+  if (warnings) *warnings = bm->warnings;
+  EXPECT_EQ(bm->model.mesh.type, ElementType::Tet10);
+  // The cavity's 18 quadrilaterals, two triangles each, all on the boundary.
+  EXPECT_EQ(bm->model.pressure_faces.size(), 36u);
+  const Assembler asmb(bm->model);
+  QuasiStaticRun qs(asmb, bm->solver.quasi_static);
+  double last = 0.0;
+  qs.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { last = r.angle_deg; });
+  return last;
+}
+
+// The actuator through the scene: as C3D20 (split to Tet10) and as the same corners in C3D8 with
+// mesh.promote_to_tet10 it is the same Tet10 mesh (the same cuts, the same straight mid-edge
+// nodes), numbered differently: the same angle, to the equilibria's round-off. Without promotion
+// the linear tetrahedra lock: the note says so.
+TEST_F(SolidDecks, AHexahedralActuatorDeckBendsTheSameAsC3D20AndAsPromotedC3D8) {
+  HexBlock b(3, 6, 3, true, 31, actuator_mm);
+  b.remove_cells(actuator_cavity);
+  std::string surface = "*SURFACE, NAME=CAVITY\n";
+  for (const auto& [element, face] : actuator_walls(b))
+    surface += std::to_string(element) + ", S" + std::to_string(face) + "\n";
+  const std::string elsets = actuator_elsets(b);
   auto deck = [&](const HexBlock& g, const std::string& type) {
-    return g.nodes() + g.elements("*ELEMENT, TYPE=" + type + ", ELSET=BODY") + elsets + silicone + surface +
+    return g.nodes() + g.elements("*ELEMENT, TYPE=" + type + ", ELSET=BODY") + elsets + surface +
            g.nset("FIXED", [](const Vec& s) { return s.y() == 0.0; }) + g.nset("TIP", [](const Vec& s) { return s.y() == 1.0; });
   };
   const std::string quadratic = write("c3d20.inp", deck(b, "C3D20H")), linear = write("c3d8.inp", deck(b.corners_only(), "C3D8H"));
-  auto run = [](const std::string& path, std::vector<std::string> extra, std::vector<std::string>* warnings) {
-    extra.insert(extra.end(), {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"", "load.max_kPa=5.0"});
-    auto bm = build_model(Scene::load("", extra));
-    if (warnings) *warnings = bm->warnings;
-    EXPECT_EQ(bm->model.mesh.type, ElementType::Tet10);
-    // The cavity's 18 quadrilaterals, two triangles each, all on the boundary.
-    EXPECT_EQ(bm->model.pressure_faces.size(), 36u);
-    const Assembler asmb(bm->model);
-    QuasiStaticRun qs(asmb, bm->solver.quasi_static);
-    double last = 0.0;
-    qs.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { last = r.angle_deg; });
-    return last;
-  };
   std::vector<std::string> w20, w8;
-  const double a20 = run(quadratic, {}, &w20), a8 = run(linear, {"mesh.promote_to_tet10=true"}, &w8);
+  const double a20 = actuator_angle(quadratic, {}, &w20), a8 = actuator_angle(linear, {"mesh.promote_to_tet10=true"}, &w8);
   std::printf("hexahedral actuator at 5 kPa: C3D20 %.9f deg, C3D8 promoted %.9f deg\n", a20, a8);
   EXPECT_GT(a20, 0.05) << "the actuator curls towards its fabric";
   EXPECT_NEAR(a8, a20, 1e-6 * a20);
   EXPECT_EQ(count_containing(w20, "C3D20 into"), 1);
   EXPECT_EQ(count_containing(w8, "C3D8 into"), 1);
   EXPECT_EQ(count_containing(w8, "mesh.promote_to_tet10 = true (recommended)"), 1);
+}
+
+// The C3D20 actuator as Abaqus/CAE writes it: part Actuator (its nodes moved by -shift, the
+// element sets), one instance translated back by shift, FIXED and TIP as assembly sets with
+// INSTANCE=, the cavity walls as an assembly surface on INTERNAL element sets per face number,
+// loaded by *DSLOAD, and *BOUNDARY on the assembly set. The flat deck loads the same hexahedron
+// faces by *DLOAD. Neither names a CAVITY surface, so both scenes take the pressure faces as the
+// cavity, and the angle frame from the mesh. The instance's elements split as the flat deck's: the
+// same tetrahedra, ids, labels, sets, fixed dofs, tip nodes, cavity faces and frame, the same angle.
+TEST_F(SolidDecks, AHexahedralActuatorAsACaeDeckSplitsAndBendsAsTheFlatDeck) {
+  const Vec shift(0.0, 12.3, -4.7);  // not exact in binary: the placement shows as round-off only
+  HexBlock flat(3, 6, 3, true, 31, actuator_mm);
+  HexBlock part(3, 6, 3, true, 31, [&](const Vec& s) { return Vec(actuator_mm(s) - shift); });
+  flat.remove_cells(actuator_cavity);
+  part.remove_cells(actuator_cavity);
+  const std::vector<std::pair<long, int>> walls = actuator_walls(flat);
+  auto fixed = [](const Vec& s) { return s.y() == 0.0; };
+  auto tip = [](const Vec& s) { return s.y() == 1.0; };
+
+  std::string dload = "*DLOAD\n";
+  for (const auto& [element, face] : walls)
+    dload += std::to_string(element) + ", P" + std::to_string(face) + ", 0.005\n";
+  const std::string flat_path = write("flat.inp", flat.nodes() + flat.elements("*ELEMENT, TYPE=C3D20H, ELSET=BODY") +
+                                                      actuator_elsets(flat) + flat.nset("FIXED", fixed) +
+                                                      flat.nset("TIP", tip) + dload);
+  std::ostringstream cae;
+  cae.precision(17);
+  cae << "*Heading\n** Generated by: Abaqus/CAE 2021\n*Part, name=Actuator\n" << part.nodes()
+      << part.elements("*Element, type=C3D20H, elset=BODY") << actuator_elsets(part)
+      << "*Solid Section, elset=SILICONE, material=Ecoflex\n,\n*End Part\n"
+      << "*Assembly, name=Assembly\n*Instance, name=Actuator-1, part=Actuator\n"
+      << shift.x() << ", " << shift.y() << ", " << shift.z() << "\n*End Instance\n"
+      << part.nset("Fixed, instance=Actuator-1", fixed) << part.nset("Tip, instance=Actuator-1", tip);
+  for (int f = 1; f <= 6; ++f) {
+    cae << "*Elset, elset=_Walls_S" << f << ", internal, instance=Actuator-1\n";
+    for (const auto& [element, face] : walls)
+      if (face == f) cae << element << "\n";
+  }
+  cae << "*Surface, type=ELEMENT, name=Walls\n";
+  for (int f = 1; f <= 6; ++f) cae << "_Walls_S" << f << ", S" << f << "\n";
+  cae << "*End Assembly\n*Material, name=Ecoflex\n*Hyperelastic, yeoh\n 0.019, 0.0009, -4.75e-6\n"
+         "*Step, name=Inflate, nlgeom=YES\n*Static\n0.1, 1., 1e-05, 0.1\n*Boundary\nFixed, ENCASTRE\n"
+         "*Dsload\nWalls, P, 0.005\n*End Step\n";
+  const std::string cae_path = write("cae.inp", cae.str());
+
+  auto scene = [](const std::string& path) {
+    return Scene::load("", {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\"", "load.max_kPa=5.0"});
+  };
+  const auto f = build_model(scene(flat_path)), c = build_model(scene(cae_path));
+  const Mesh &fm = f->model.mesh, &cm = c->model.mesh;
+  ASSERT_EQ(cm.num_nodes(), fm.num_nodes());
+  ASSERT_EQ(cm.num_elements(), fm.num_elements());
+  EXPECT_EQ(cm.conn, fm.conn);
+  EXPECT_EQ(cm.node_ids, fm.node_ids);
+  EXPECT_EQ(cm.element_ids, fm.element_ids);  // one instance: the deck's ids, the split's new ones alike
+  EXPECT_TRUE(cm.id_scopes.empty());
+  double max_dx = 0.0;
+  for (int n = 0; n < fm.num_nodes(); ++n)
+    max_dx = std::max(max_dx, (cm.X[static_cast<std::size_t>(n)] - fm.X[static_cast<std::size_t>(n)]).norm());
+  EXPECT_LT(max_dx, 1e-16);  // a few ulps of the ~0.04 m coordinates, the new mid-nodes too
+  for (int e = 0; e < fm.num_elements(); ++e) ASSERT_EQ(cm.element_label(e), fm.element_label(e));
+  EXPECT_NE(cm.element_label(fm.num_elements() - 1).find(" of C3D20 "), std::string::npos);
+  for (const char* set : {"FABRIC", "SILICONE"}) EXPECT_EQ(cm.element_sets.at(set), fm.element_sets.at(set)) << set;
+  for (const char* set : {"FIXED", "TIP"}) EXPECT_EQ(cm.node_sets.at(set), fm.node_sets.at(set)) << set;
+  EXPECT_EQ(cm.element_sets.at("ACTUATOR-1.FABRIC"), fm.element_sets.at("FABRIC"));
+
+  // The *DSLOAD faces of the assembly surface are the *DLOAD faces, grouped by face number.
+  auto sorted_faces = [](std::vector<FaceRef> v) {
+    std::sort(v.begin(), v.end(), [](const FaceRef& a, const FaceRef& b) {
+      return std::pair(a.element, a.local_face) < std::pair(b.element, b.local_face);
+    });
+    return v;
+  };
+  EXPECT_EQ(f->model.pressure_faces.size(), 36u);
+  EXPECT_EQ(sorted_faces(c->model.pressure_faces), sorted_faces(f->model.pressure_faces));
+  EXPECT_EQ(c->model.fixed, f->model.fixed);
+  EXPECT_EQ(c->model.angle.tip_nodes, f->model.angle.tip_nodes);
+  EXPECT_LT((c->model.angle.fixed_normal_out - f->model.angle.fixed_normal_out).norm(), 1e-12);
+  EXPECT_LT((c->model.angle.bend_direction - f->model.angle.bend_direction).norm(), 1e-12);
+  for (const auto* bm : {f.get(), c.get()}) {
+    EXPECT_EQ(count_containing(bm->warnings, "faces of its pressure load (36 *DLOAD/*DSLOAD P faces) are the cavity"), 1);
+    EXPECT_EQ(count_containing(bm->warnings, "C3D20 into"), 1);
+  }
+  EXPECT_EQ(count_containing(c->warnings, "part 'Actuator' (instance 'Actuator-1'): split into tetrahedra"), 1);
+
+  std::vector<std::string> wf, wc;
+  const double a_flat = actuator_angle(flat_path, {}, &wf), a_cae = actuator_angle(cae_path, {}, &wc);
+  EXPECT_GT(a_flat, 0.05);
+  // The same mesh, faces and materials; the runs differ by the coordinates' round-off and the
+  // order in which the cavity faces are summed (the split amplifies nothing): 1e-10 relative
+  // leaves a wide margin, a missing face or a wrong fixed or tip node changes far more.
+  EXPECT_NEAR(a_cae, a_flat, 1e-10 * a_flat);
+  EXPECT_EQ(count_containing(wc, "instances"), 0);
+}
+
+// Two instances of a part of hexahedra: each instance's elements are split, and ids stay distinct
+// per id scope: the second instance numbers its tetrahedra and new nodes as the first (within its
+// scope), and the Mesh offsets them; labels name the instance in the element and its source. A
+// part surface, an assembly set with INSTANCE= and a *DLOAD on a qualified set follow the split.
+// An element of a part that cannot be split is reported with its part and instance.
+TEST_F(SolidDecks, TwoInstancesOfAHexahedralPartAreSplitEachInItsOwnIdScope) {
+  const HexBlock b(2, 1, 1, true, 3, [](const Vec& s) { return Vec(10.0 * s.x(), 5.0 * s.y(), 5.0 * s.z()); });
+  const std::string part = "*Part, name=Block\n" + b.nodes() + b.elements("*Element, type=C3D20, elset=BODY") +
+                           "*Elset, elset=ALL\n1, 2\n*Surface, type=ELEMENT, name=Top\nALL, S2\n*End Part\n";
+  const InpDeck d = read(part + "*Assembly, name=Assembly\n*Instance, name=B-1, part=Block\n*End Instance\n"
+                                "*Instance, name=B-2, part=Block\n0., 20., 0.\n*End Instance\n"
+                                "*Elset, elset=Right, instance=B-2\n2\n*End Assembly\n*Dload\nB-2.ALL, P1, 0.5\n");
+  const Mesh& m = d.mesh;
+  ASSERT_EQ(m.type, ElementType::Tet10);
+  const int half = m.num_elements() / 2;
+  ASSERT_EQ(m.num_elements(), 2 * half);
+  ASSERT_GE(half, 10);  // 5 or 6 per cell
+  ASSERT_EQ(m.id_scopes.size(), 3u);  // the assembly level, B-1, B-2
+  EXPECT_EQ(std::set<long>(m.element_ids.begin(), m.element_ids.end()).size(), m.element_ids.size());
+  EXPECT_EQ(std::set<long>(m.node_ids.begin(), m.node_ids.end()).size(), m.node_ids.size());
+  for (int e = 0; e < half; ++e) {
+    const std::string one = m.element_name(e), two = m.element_name(half + e);
+    ASSERT_EQ(one.rfind("B-1.", 0), 0u) << one;
+    EXPECT_EQ(two, "B-2." + one.substr(4));
+    EXPECT_EQ(m.element_label(half + e).rfind("element " + two + " (tet ", 0), 0u) << m.element_label(half + e);
+  }
+  EXPECT_EQ(m.element_label(0), "element B-1.1 (tet 1 of C3D20 B-1.1, region 'body')");
+  const ElementSource& last = m.element_sources.back();
+  EXPECT_EQ(m.element_label(m.num_elements() - 1),
+            "element " + m.element_name(m.num_elements() - 1) + " (tet " + std::to_string(last.pieces) +
+                " of C3D20 B-2.2, region 'body')");
+  for (int n = b.node_count(); n < m.num_nodes(); ++n) {  // B-2's nodes, then the cut diagonals' new ones
+    const std::string name = m.node_name(n);
+    EXPECT_TRUE(name.rfind("B-1.", 0) == 0 || name.rfind("B-2.", 0) == 0) << name;
+  }
+  EXPECT_GT(m.num_nodes(), 2 * b.node_count()) << "C3D20 cut diagonals get new nodes";
+
+  // The part's surface in each instance, the assembly set and the load: tetrahedra of B-2's elements.
+  auto in_b2 = [&](int e) { return m.element_name(e).rfind("B-2.", 0) == 0; };
+  ASSERT_EQ(m.surfaces.at("B-2.TOP").size(), 4u);  // two quadrilaterals, two triangles each
+  for (const FaceRef& f : m.surfaces.at("B-2.TOP")) {
+    EXPECT_TRUE(in_b2(f.element));
+    EXPECT_NEAR(outward(m, f).z(), 1.0, 1e-12);
+  }
+  ASSERT_EQ(m.surfaces.at("B-1.TOP").size(), 4u);
+  for (const FaceRef& f : m.surfaces.at("B-1.TOP")) EXPECT_FALSE(in_b2(f.element));
+  for (int e : m.element_sets.at("RIGHT")) EXPECT_NE(m.element_label(e).find(" of C3D20 B-2.2,"), std::string::npos);
+  EXPECT_EQ(m.element_sets.at("RIGHT").size(), static_cast<std::size_t>(last.pieces));
+  ASSERT_EQ(d.pressure_faces.size(), 4u);
+  for (const InpPressure& p : d.pressure_faces) {
+    EXPECT_TRUE(in_b2(p.face.element));
+    EXPECT_NEAR(outward(m, p.face).z(), -1.0, 1e-12);
+    EXPECT_EQ(p.magnitude, 0.5);
+  }
+
+  // A part's element that cannot be split: named with its part and instance, at its line.
+  const std::string cube = "*Part, name=P\n*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n5, 0, 0, 1\n6, 1, 0, 1\n"
+                           "7, 1, 1, 1\n8, 0, 1, 1\n*Element, type=C3D8\n57, 5, 6, 7, 8, 1, 2, 3, 4\n*End Part\n";
+  expect_error(cube + "*Assembly, name=A\n*Instance, name=P-1, part=P\n*End Instance\n*End Assembly\n", 12,
+               {"part 'P' (instance 'P-1'): element 57 (C3D8) is inverted or degenerate", "check the node order"});
 }
 
 // A scene's error about a split element names the deck's element.
