@@ -75,6 +75,10 @@
 //    assembly or another instance has that name, also as "SET-1"; INTERNAL ones not at all;
 //  * instances share no node: more than one with solid elements is a warning here and an error in
 //    build_model (InpDeck::solid_instances).
+//
+// Where the code is: the reader is DeckReader (scenes/inp_reader.h, which lists the file of each
+// group of keywords), on the text layer of scenes/inp_text.h (lines, *INCLUDE, fields, numbers);
+// the writer is scenes/inp_write.cpp; the split of solids into tetrahedra scenes/solid_split.h.
 #include <map>
 #include <ostream>
 #include <string>
