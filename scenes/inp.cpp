@@ -198,11 +198,12 @@ void DeckReader::begin_elements(const Keyword& kw, const Loc& loc) {
     fail(loc, "*ELEMENT, INPUT= is not supported", "put the element lines in a file read with *INCLUDE");
   const std::string type = upper(kw.get("TYPE"));
   if (type.empty()) fail(loc, "*ELEMENT without TYPE=", "add TYPE=C3D4 or TYPE=C3D10");
-  if (const int n = triangle_nodes(type); n > 0) return begin_surface_elements(kw, loc, type, n);
-  if (skipped_element_type(type)) {
+  if (const SurfaceShape shape = surface_element_shape(type); shape.corners > 0)
+    return begin_surface_elements(kw, loc, type, shape);
+  if (line_element_type(type)) {
     warn_once("type " + type, loc,
-              "*ELEMENT, TYPE=" + type + " skipped (line and quadrilateral elements: a tetrahedral model uses "
-              "triangles for named surfaces)");
+              "*ELEMENT, TYPE=" + type + " skipped (line elements: pneufem reads solids, and triangles and "
+              "quadrilaterals as named surfaces)");
     block_ = Block::Skip;
     return;
   }
@@ -211,8 +212,8 @@ void DeckReader::begin_elements(const Keyword& kw, const Loc& loc) {
     fail(loc,
          "element type " + type + " is not supported (pneufem reads the solid elements C3D4, C3D10, C3D5, C3D6, "
          "C3D15, C3D8 and C3D20, with the suffixes H, R, I, M, S)",
-         "convert the mesh to one of them (triangular surface elements such as CPS3/CPS6/S3 are read as named "
-         "surfaces; line and quadrilateral elements are skipped)");
+         "convert the mesh to one of them (triangular and quadrilateral surface elements such as CPS3, CPS6, "
+         "CPS4, CPS8, S3, S4R are read as named surfaces; line elements are skipped)");
   solid_ = *solid;
   type_name_ = solid_name(solid_);
   if (type != type_name_)

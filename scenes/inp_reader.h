@@ -40,10 +40,15 @@ enum class Level { Model, Part, Assembly, Instance };
 constexpr std::size_t kMaxRegions = 65535;  // Mesh::region holds std::uint16_t
 constexpr std::size_t kMaxScopes = 65535;   // Mesh::node_scope holds std::uint16_t
 
-/// Nodes of a triangular surface/shell/membrane/plane element type, or 0 (inp_surface_elements.cpp).
-int triangle_nodes(const std::string& type);
-/// Line and quadrilateral elements, skipped with a warning (inp_surface_elements.cpp).
-bool skipped_element_type(const std::string& type);
+/// A surface element type (plane, shell, membrane, rigid: how meshers write named surfaces): its
+/// corners (3 or 4) and nodes (3, 6, 4 or 8); {0, 0} for any other type (inp_surface_elements.cpp).
+struct SurfaceShape {
+  int corners = 0;
+  int nodes = 0;
+};
+SurfaceShape surface_element_shape(const std::string& type);
+/// Line elements (trusses, beams: a mesher's named curves), skipped with a warning.
+bool line_element_type(const std::string& type);
 
 /// Single pass over the deck (LineSource resolves *INCLUDE).
 ///
@@ -124,9 +129,17 @@ class DeckReader {
   void element_line(const Loc& loc);
 
   // ---- surface elements (inp_surface_elements.cpp) -----------------------------------------------
-  void begin_surface_elements(const Keyword& kw, const Loc& loc, const std::string& type, int nodes);
+  struct SurfaceElement {
+    long id;
+    Loc loc;
+    std::uint16_t part_instance;  // its instance if read from a part (as solid_part_instance_), else 0
+    int n_corners;                // 3 or 4
+    std::array<int, 4> corners;   // node indices, in the element's order
+  };
+  void begin_surface_elements(const Keyword& kw, const Loc& loc, const std::string& type, const SurfaceShape& shape);
   void surface_element_line(const Loc& loc);
   void resolve_surface_elements();
+  std::string surface_element_where(const SurfaceElement& t) const;
 
   // ---- *NSET / *ELSET, names and ids in data lines (inp_read_sets.cpp) --------------------------
   // A data line names nodes, elements, sets and surfaces of its own scope: a part's (read for an
@@ -235,13 +248,10 @@ class DeckReader {
   int npe_ = 0;
   std::uint16_t region_ = 0;
   std::vector<long> pending_;  // element id + nodes read so far (continuation lines)
-  struct SurfaceTriangle {
-    long id;
-    Loc loc;
-    std::array<int, 3> corners;  // node indices
-  };
-  std::map<std::pair<int, std::string>, std::vector<SurfaceTriangle>> surface_elements_;  // (scope, ELSET) -> triangles
+  // (scope, ELSET) -> its surface elements, resolved by finish()
+  std::map<std::pair<int, std::string>, std::vector<SurfaceElement>> surface_elements_;
   std::string surface_set_;  // ELSET of the surface element block being read
+  int surface_corners_ = 0;  // and the corners of its elements
   Loc pending_loc_;
 
   std::deque<Scope> scopes_;  // a deque: open_members_ points into a Scope's sets
