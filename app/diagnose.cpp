@@ -610,6 +610,18 @@ std::string evidence(const std::string& effect, const Signature& s) {
 
 }  // namespace
 
+std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::vector<double>& values) {
+  std::vector<std::string> out;
+  if (c.interpolation == ParameterInterpolation::rig_angle) return out;
+  for (std::size_t i = 0; i < c.params.size() && i < values.size(); ++i) {
+    const CandidateParameter& p = c.params[i];
+    const double v = std::clamp(values[i], p.lo, p.hi);
+    const double x = p.log ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
+    if (x <= 0.01 || x >= 0.99) out.push_back(p.name);
+  }
+  return out;
+}
+
 double effective_sample_size(const std::vector<double>& r, const std::vector<int>& segment) {
   const double n = static_cast<double>(r.size());
   if (r.size() < 3) return n;
@@ -823,6 +835,14 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
               fmt("%.4f", current.nrmse) + " -> " + fmt("%.4f", cmp.nrmse) + ", delta AIC " + fmt("%.1f", r.delta_aic) +
               " with " + std::to_string(c.params.size()) + " parameter(s)). Residual signature: " + evidence(c.name, sig) +
               ". " + c.signature;
+      r.at_bound = params_at_bounds(c, r.params);
+      for (const std::string& name : r.at_bound) {
+        const auto p = std::find_if(c.params.begin(), c.params.end(), [&](const CandidateParameter& q) { return q.name == name; });
+        const double v = r.params[static_cast<std::size_t>(p - c.params.begin())];
+        r.why += " Caution: " + name + " = " + fmt("%.4g", v) + " sits at the edge of its calibrated range [" + fmt("%g", p->lo) +
+                 ", " + fmt("%g", p->hi) + "]: the effect is pushed to an extreme, as when it stands in for a misfit of "
+                 "another kind (the elastic response, the mesh, an effect not in the catalog); weigh it less.";
+      }
     });
     if (opt.progress)
       std::fprintf(stderr, "diagnose: round %d done (%.1f s; %.1f s since the start)\n", round,
@@ -1046,6 +1066,9 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     o.add("sets", sets + "]").add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
     o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add("wall_s", c.wall_s);
     o.add_str("why", c.why);
+    std::string ab = "[";
+    for (std::size_t j = 0; j < c.at_bound.size(); ++j) ab += (j ? ", " : "") + json::quote(c.at_bound[j]);
+    o.add("at_bound", ab + "]");
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }

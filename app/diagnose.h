@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "analysis/measurements.h"
+#include "app/effect_catalog.h"
 #include "scenes/scene.h"
 
 namespace pneufem {
@@ -95,6 +96,7 @@ struct CandidateResult {
   std::vector<CalibrationPoint> trace;  ///< every evaluation, in order
   std::string why;
   std::string error;                    ///< non-empty when the calibration failed
+  std::vector<std::string> at_bound;    ///< parameters calibrated at the edge of their range (params_at_bounds)
 };
 
 struct DiagnosisResult {
@@ -120,6 +122,13 @@ struct DiagnosisResult {
 /// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
 /// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
 DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options);
+
+/// Names of the parameters of `c` whose calibrated `values` lie within 1 % of the calibrated range
+/// (in the calibration coordinate, log or linear) of either bound. A constant pushed to the edge of
+/// its physical range is the mark of an effect standing in for a misfit of another kind (measured:
+/// a recording made on a finer mesh than the model's, diagnosed on the coarse one, selects Mullins
+/// with r = 1.1, its lower bound, in round 2). The rig angle is exempt: 0 and 180 deg are real rigs.
+std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::vector<double>& values);
 
 /// AR(1) effective sample size of a residual sequence (segments = trials): n (1 - rho)/(1 + rho),
 /// rho the lag-1 autocorrelation within segments, clamped to [min(n, 10), n].

@@ -82,9 +82,13 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   const Scene scene = Scene::load(c.scene_path, c.sets);
   const DiagnosisResult r = run_diagnosis(scene, c.options);
   std::printf("diagnose: baseline NRMSE %.4f (noise floor %.4f)\n", r.baseline_nrmse, r.noise_floor_nrmse);
-  for (const CandidateResult& k : r.candidates)
-    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  %s\n", k.round, k.effect.c_str(), k.nrmse, k.delta_aic,
-                k.significant ? "significant" : "");
+  for (const CandidateResult& k : r.candidates) {
+    std::string bound;
+    for (const std::string& n : k.at_bound) bound += (bound.empty() ? "  (at the edge of its range: " : ", ") + n;
+    if (!bound.empty()) bound += ")";
+    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  %s%s\n", k.round, k.effect.c_str(), k.nrmse, k.delta_aic,
+                k.significant ? "significant" : "", bound.c_str());
+  }
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
   if (!r.fem_error.empty()) std::printf("full FEM: %s\n", r.fem_error.c_str());

@@ -104,6 +104,18 @@ TEST(EffectiveSampleSize, WhiteAndCorrelatedResiduals) {
 // log-scale range [0.5, 2], bracket 0.333 * 0.618^10 * 0.6 decades = 0.38 %) must bring the scale
 // within 0.5 % of the truth, closer than the reduced model, and the FEM error near zero (noise-free
 // data; 0.5 % of stiffness is ~0.3 % of the angle range).
+// A calibrated constant within 1 % (of the calibration coordinate, log here) of a bound is flagged;
+// inside the range it is not; the rig angle's ends are real rigs, never flagged.
+TEST(Diagnose, ConstantsAtTheEdgeOfTheirRangeAreFlagged) {
+  const CandidateEffect& m = candidate_effect("mullins");  // r in [1.1, 20], m in [1e-3, 0.1], both log
+  EXPECT_EQ(params_at_bounds(m, {1.1, 0.02}), std::vector<std::string>{"r"});
+  EXPECT_EQ(params_at_bounds(m, {1.1 * std::pow(20.0 / 1.1, 0.02), 0.1}), std::vector<std::string>{"m_MPa"});
+  EXPECT_EQ(params_at_bounds(m, {3.0, 0.01}), std::vector<std::string>{});
+  EXPECT_EQ(params_at_bounds(candidate_effect("fatigue"), {0.02, 1e5}), std::vector<std::string>{"tau_s"});
+  EXPECT_EQ(params_at_bounds(candidate_effect("gravity"), {180.0}), std::vector<std::string>{});
+  EXPECT_EQ(params_at_bounds(candidate_effect("gravity"), {0.0}), std::vector<std::string>{});
+}
+
 TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
   const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
                                        "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
