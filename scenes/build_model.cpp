@@ -96,7 +96,7 @@ bool fabric_is_membrane(const Scene& s) {
 }
 
 /// The membrane fabric: the faces of surface mesh.fabric_surface (the mesher's FABRIC_MEMBRANE on
-/// the layer's mid-plane, or a deck's surface: an embedded sheet of M3D3/M3D6 elements, a
+/// the layer's mid-plane, or a deck's surface: an embedded sheet of M3D3/M3D6/M3D4/M3D8 elements, a
 /// *SURFACE), thickness geometry.fabric_thickness_mm, plane-stress St Venant-Kirchhoff with E and
 /// nu of materials.fabric (which must be linear_elastic).
 MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {

@@ -9,11 +9,15 @@
 //        numbering, the split rule, curved C3D20/C3D15 stay curved); element sets, regions, surfaces,
 //        *DLOAD faces, node sets and *BOUNDARY follow the split, with a note counting it; mixed decks
 //        of these shapes are fine
-//   *ELEMENT, TYPE=<triangle>, ELSET=  (CPS3/CPS6, S3/S6, M3D3/M3D6, STRI3/STRI65, ...: how Gmsh and
-//        other meshers write named surfaces; membrane/shell sheets, also embedded in the solid, with a
-//        note) -> the surface ELSET of the tetrahedron faces they cover, matched by corner nodes (any
-//        winding), and a node set of the same name unless one exists; line and quadrilateral elements
-//        are skipped with a warning; *MEMBRANE/SHELL SECTION: a warning naming mesh.fabric_surface
+//   *ELEMENT, TYPE=<surface>, ELSET=  triangles (CPS3/CPS6, S3/S6, M3D3/M3D6, STRI3/STRI65, ...) and
+//        quadrilaterals (CPS4/CPS4R/CPS8, S4/S4R/S8R, M3D4/M3D4R/M3D8, R3D4, ...): how Gmsh and other
+//        meshers write named surfaces, of tetrahedral and hexahedral meshes; membrane/shell sheets,
+//        also embedded in the solid, with a note -> the surface ELSET of the tetrahedron faces they
+//        cover, matched by corner nodes (any winding; a quadrilateral covers the two tetrahedron
+//        faces its solid's split cut it into, its corners in order around it), and a node set of
+//        the same name unless one exists (the faces' nodes, a C3D20 face's new diagonal node
+//        included); an element on no face is an error; line elements are skipped with a warning;
+//        *MEMBRANE/SHELL SECTION: a warning naming mesh.fabric_surface
 //   *NSET, NSET= [, GENERATE] [, INSTANCE=] [, INTERNAL]   (members may name other sets)
 //   *ELSET, ELSET= [, GENERATE] [, INSTANCE=] [, INTERNAL]
 //   *SURFACE, NAME= [, TYPE=ELEMENT]  lines "elset_or_element, Sn"  (S1..S4 tetrahedra, S1..S5
@@ -33,7 +37,7 @@
 // instances in Abaqus (Merge/Cut Instances): pneufem needs one conforming mesh.
 // Not supported (an error says what to do): *INSTANCE imported from an earlier analysis
 // (INSTANCE=/LIBRARY=), *NODE/*ELEMENT/*NSET/*ELSET with INPUT=, *NSET with ELSET=, non-Cartesian
-// *NODE SYSTEM=, element types other than the solids above, triangles, lines and quadrilaterals.
+// *NODE SYSTEM=, element types other than the solids above, the surface elements and lines.
 // Errors are InputError("<file>:<line>: <what>; <what to do>").
 //
 // Conventions of the reader:
@@ -75,6 +79,10 @@
 //    assembly or another instance has that name, also as "SET-1"; INTERNAL ones not at all;
 //  * instances share no node: more than one with solid elements is a warning here and an error in
 //    build_model (InpDeck::solid_instances).
+//
+// Where the code is: the reader is DeckReader (scenes/inp_reader.h, which lists the file of each
+// group of keywords), on the text layer of scenes/inp_text.h (lines, *INCLUDE, fields, numbers);
+// the writer is scenes/inp_write.cpp; the split of solids into tetrahedra scenes/solid_split.h.
 #include <map>
 #include <ostream>
 #include <string>

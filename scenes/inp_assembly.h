@@ -1,8 +1,8 @@
 #pragma once
-// Abaqus assemblies in decks (the part of scenes/inp.cpp that is about *PART / *INSTANCE): where an
-// instance places its part, and the names under which the sets and surfaces of instances are
-// stored in a Mesh, so a scene may write a name either as the deck's assembly level would
-// ("Actuator-1.Set-1") or bare ("Set-1") when that is unambiguous.
+// Abaqus assemblies in decks (the rules the deck reader applies to *PART / *INSTANCE, in
+// scenes/inp_read_parts.cpp): where an instance places its part, and the names under which the
+// sets and surfaces of instances are stored in a Mesh, so a scene may write a name either as the
+// deck's assembly level would ("Actuator-1.Set-1") or bare ("Set-1") when that is unambiguous.
 #include <map>
 #include <set>
 #include <string>

@@ -2,8 +2,10 @@
 // type for every order of its corner ids, conformity between neighbours in generated blocks with
 // random node ids, surfaces/loads/sets/boundaries on the tetrahedra, curved quadratic elements,
 // Abaqus/CAE decks (a part's elements split in each instance, in its id scope; a hexahedral actuator
-// as a CAE deck bends as its flat deck), messages, bad input, and two system tests (a curved C3D20
-// thick cylinder vs the analytic solution, a C3D8 cantilever vs the same beam meshed with tetrahedra).
+// as a CAE deck bends as its flat deck), quadrilateral surface elements (Gmsh's named surfaces of a
+// hexahedral mesh: the faces they cover, the same actuator, an embedded membrane sheet), messages,
+// bad input, and two system tests (a curved C3D20 thick cylinder vs the analytic solution, a C3D8
+// cantilever vs the same beam meshed with tetrahedra).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -1039,11 +1041,248 @@ TEST_F(SolidDecks, SceneErrorsNameTheDeckElement) {
 }
 
 // ------------------------------------------------------------------------------------------------
-// Bad input
+// Quadrilateral surface elements (how Gmsh writes the named surfaces of a hexahedral mesh)
 // ------------------------------------------------------------------------------------------------
 
+/// The unit cube's nodes (a deck's lines 1-9).
 const std::string kCube =
     "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n";  // lines 1-9
+
+/// Corners (0-based) of the hexahedron faces S1..S6, in the Abaqus order (solid_split.h).
+constexpr int kHexFace[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1}, {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
+/// Corner pairs of the C3D20 mid-edge nodes 9..20.
+constexpr int kHexEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+
+/// Face `face` (1-based) of a hexahedron with nodes `n` (C3D8 or C3D20 order) as the data line of
+/// a quadrilateral element: its corners from the face's corner `start`, around the face in the
+/// Abaqus order or, `reversed`, the other way; for a C3D20 then the mid-edge nodes of its sides,
+/// in the same order (a CPS8: corners, then the middles of sides 1-2, 2-3, 3-4, 4-1).
+std::string quad_line(long id, const std::vector<long>& n, int face, int start, bool reversed) {
+  std::array<int, 4> c{};
+  for (int k = 0; k < 4; ++k) c[static_cast<std::size_t>(k)] = kHexFace[face - 1][(start + (reversed ? 4 - k : k)) % 4];
+  std::string out = std::to_string(id);
+  for (int a : c) out += ", " + std::to_string(n[static_cast<std::size_t>(a)]);
+  if (n.size() == 20)
+    for (int k = 0; k < 4; ++k) {
+      const int a = c[static_cast<std::size_t>(k)], b = c[static_cast<std::size_t>((k + 1) % 4)];
+      int e = 0;
+      while (!((kHexEdge[e][0] == a && kHexEdge[e][1] == b) || (kHexEdge[e][0] == b && kHexEdge[e][1] == a))) ++e;
+      out += ", " + std::to_string(n[static_cast<std::size_t>(8 + e)]);
+    }
+  return out + "\n";
+}
+
+/// Faces (element id, face number) of a block as an *ELEMENT block of quadrilaterals with ids
+/// from `first_id`, each face from another corner and every fourth the other way round (all 8
+/// node orders of a quadrilateral in turn).
+std::string quad_block(const HexBlock& b, const std::string& header, const std::vector<std::pair<long, int>>& faces,
+                       long first_id) {
+  std::string out = header + "\n";
+  int k = 0;
+  for (const auto& [element, face] : faces) {
+    const int e = static_cast<int>(element - 1), i = e % b.nx_, j = (e / b.nx_) % b.ny_, l = e / (b.nx_ * b.ny_);
+    out += quad_line(first_id++, b.cell(i, j, l), face, k % 4, (k / 4) % 2 == 1);
+    ++k;
+  }
+  return out;
+}
+
+/// The same faces as an element-face *SURFACE.
+std::string face_surface(const std::string& name, const std::vector<std::pair<long, int>>& faces) {
+  std::string out = "*SURFACE, NAME=" + name + ", TYPE=ELEMENT\n";
+  for (const auto& [element, face] : faces) out += std::to_string(element) + ", S" + std::to_string(face) + "\n";
+  return out;
+}
+
+/// Nodes of the faces of a tetrahedral mesh, sorted, each once.
+std::vector<int> nodes_of(const Mesh& m, const std::vector<FaceRef>& faces) {
+  std::vector<int> nodes;
+  for (const FaceRef& f : faces)
+    for (int a = 0; a < nodes_per_face(m.type); ++a) nodes.push_back(m.element(f.element)[face_local_nodes(m.type, f.local_face)[a]]);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+// Every face of a hexahedron (C3D8 and C3D20, node ids shuffled so the cut diagonals vary) written
+// as a quadrilateral element in each of its 8 node orders (4 first corners, 2 windings) is the
+// surface its *SURFACE face gives: the same two tetrahedron faces, in the same order. So are the
+// quadrilateral faces of a wedge, in an ELSET that holds its triangles too (other element types).
+TEST_F(SolidDecks, AQuadrilateralElementInAnyNodeOrderIsTheFaceItCovers) {
+  const Eigen::Matrix3d A = shear();
+  for (bool quadratic : {false, true})
+    for (unsigned seed = 1; seed <= 4; ++seed) {
+      const HexBlock b(1, 1, 1, quadratic, seed, [&](const Vec& s) { return Vec(A * s); });
+      std::string deck = b.nodes() + b.elements(quadratic ? "*ELEMENT, TYPE=C3D20, ELSET=BODY" : "*ELEMENT, TYPE=C3D8, ELSET=BODY");
+      long id = 100;
+      for (int face = 1; face <= 6; ++face) {
+        const std::string f = std::to_string(face);
+        deck += face_surface("S" + f, {{1, face}});
+        for (int order = 0; order < 8; ++order)
+          deck += "*ELEMENT, TYPE=" + std::string(quadratic ? "S8R" : "S4R") + ", ELSET=Q" + f + "_" +
+                  std::to_string(order) + "\n" + quad_line(++id, b.cell(0, 0, 0), face, order % 4, order >= 4);
+      }
+      const InpDeck d = read(deck);
+      for (int face = 1; face <= 6; ++face) {
+        const std::string f = std::to_string(face);
+        const std::vector<FaceRef>& want = d.mesh.surfaces.at("S" + f);
+        ASSERT_EQ(want.size(), 2u);
+        for (int order = 0; order < 8; ++order) {
+          const std::string q = "Q" + f + "_" + std::to_string(order);
+          EXPECT_EQ(d.mesh.surfaces.at(q), want) << q << ", seed " << seed << (quadratic ? ", C3D20" : ", C3D8");
+          EXPECT_EQ(d.mesh.node_sets.at(q), nodes_of(d.mesh, want)) << q;
+        }
+      }
+      EXPECT_EQ(count_containing(d.warnings, "lie inside the solid"), 0);
+    }
+  // The wedge 1-2-3 / 5-6-7 of the unit cube: quadrilaterals S3, S4, S5 (M3D4) and triangles S1,
+  // S2 (M3D3) in one ELSET, as the *SURFACE of those faces.
+  const InpDeck w = read(kCube + "*ELEMENT, TYPE=C3D6\n1, 1, 2, 3, 5, 6, 7\n*ELEMENT, TYPE=M3D4, ELSET=All\n"
+                                 "11, 1, 5, 6, 2\n12, 3, 7, 6, 2\n13, 7, 5, 1, 3\n*ELEMENT, TYPE=M3D3, ELSET=All\n"
+                                 "14, 1, 2, 3\n15, 5, 7, 6\n*SURFACE, NAME=Faces\n1, S3\n1, S4\n1, S5\n1, S1\n1, S2\n");
+  EXPECT_EQ(w.mesh.surfaces.at("ALL").size(), 8u);
+  EXPECT_EQ(w.mesh.surfaces.at("ALL"), w.mesh.surfaces.at("FACES"));
+  EXPECT_EQ(w.mesh.node_sets.at("ALL"), (std::vector<int>{0, 1, 2, 4, 5, 6}));
+  EXPECT_EQ(count_containing(w.warnings, "TYPE=M3D4, ELSET=ALL read as faces of the tetrahedra (a quadrilateral as the "
+                                         "two of its split): surface and node set ALL"), 1);
+}
+
+// Gmsh writes the physical surfaces of a hexahedral mesh as quadrilateral elements (CPS4; CPS8 for
+// a second-order mesh; shells S4R, S8R alike). The hexahedral actuator whose cavity, clamped end
+// and tip are given so, in every node order, is the model of the same deck with element-face
+// *SURFACE blocks (and *NSET for the clamped end and the tip): the same surfaces, node sets (on
+// C3D20 faces with the node the split put on their diagonal), pressure faces, fixed dofs and tip
+// nodes, and the same angle; as C3D20, and as C3D8 promoted to Tet10.
+TEST_F(SolidDecks, AHexahedralDeckWithQuadrilateralSurfacesIsItsDeckWithElementFaceSurfaces) {
+  for (bool quadratic : {true, false}) {
+    HexBlock b20(3, 6, 3, true, 31, actuator_mm);
+    b20.remove_cells(actuator_cavity);
+    const HexBlock b = quadratic ? b20 : b20.corners_only();
+    std::vector<std::pair<long, int>> fixed, tip;  // the end faces y = 0 (S3) and y = 36 mm (S5)
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) {
+        fixed.emplace_back(b.element(i, 0, k), 3);
+        tip.emplace_back(b.element(i, 5, k), 5);
+      }
+    const std::vector<std::pair<long, int>> walls = actuator_walls(b);
+    const std::string mesh = b.nodes() + b.elements(quadratic ? "*ELEMENT, TYPE=C3D20H, ELSET=BODY" : "*ELEMENT, TYPE=C3D8H, ELSET=BODY") +
+                             actuator_elsets(b);
+    const std::string faces_path =
+        write("faces.inp", mesh + face_surface("CAVITY", walls) + face_surface("FIXED", fixed) + face_surface("TIP", tip) +
+                               b.nset("FIXED", [](const Vec& s) { return s.y() == 0.0; }) +
+                               b.nset("TIP", [](const Vec& s) { return s.y() == 1.0; }));
+    const std::string quad = quadratic ? "CPS8" : "CPS4", shell = quadratic ? "S8R" : "S4R";
+    const std::string quads_path =
+        write("quads.inp", mesh + quad_block(b, "*ELEMENT, TYPE=" + quad + ", ELSET=Cavity", walls, 1001) +
+                               quad_block(b, "*Element, type=" + shell + ", elset=Fixed", fixed, 2001) +
+                               quad_block(b, "*ELEMENT, TYPE=" + quad + ", ELSET=Tip", tip, 3001));
+    SCOPED_TRACE(quadratic ? "C3D20" : "C3D8");
+
+    const InpDeck F = read_inp(faces_path, 1e-3), Q = read_inp(quads_path, 1e-3);
+    ASSERT_EQ(Q.mesh.conn, F.mesh.conn);  // the quadrilaterals are no elements
+    ASSERT_EQ(Q.mesh.X, F.mesh.X);
+    for (const char* name : {"CAVITY", "FIXED", "TIP"}) EXPECT_EQ(Q.mesh.surfaces.at(name), F.mesh.surfaces.at(name)) << name;
+    for (const char* name : {"FIXED", "TIP"}) EXPECT_EQ(Q.mesh.node_sets.at(name), F.mesh.node_sets.at(name)) << name;
+    EXPECT_EQ(Q.mesh.node_sets.at("CAVITY"), nodes_of(F.mesh, F.mesh.surfaces.at("CAVITY")));
+    const std::vector<int>& fixed_nodes = Q.mesh.node_sets.at("FIXED");
+    const auto diagonal_nodes = std::count_if(fixed_nodes.begin(), fixed_nodes.end(), [&](int n) { return n >= b.node_count(); });
+    EXPECT_EQ(diagonal_nodes, quadratic ? 9 : 0);  // one per face of the clamped end
+    EXPECT_EQ(count_containing(Q.warnings, "*ELEMENT, TYPE=" + quad + ", ELSET=CAVITY read as faces of the tetrahedra"), 1);
+    EXPECT_EQ(count_containing(Q.warnings, "*ELEMENT, TYPE=" + shell + ", ELSET=FIXED read as faces"), 1);
+    EXPECT_EQ(count_containing(Q.warnings, "inside the solid"), 0);
+    EXPECT_EQ(count_containing(Q.warnings, "skipped"), 0);
+
+    std::vector<std::string> extra = {"load.max_kPa=5.0"};
+    if (!quadratic) extra.push_back("mesh.promote_to_tet10=true");
+    auto scene = [&](const std::string& path) {
+      std::vector<std::string> o = extra;
+      o.insert(o.end(), {"mesh.source=\"inp\"", "mesh.file=\"" + path + "\""});
+      return Scene::load("", o);
+    };
+    const auto fm = build_model(scene(faces_path)), qm = build_model(scene(quads_path));
+    EXPECT_EQ(qm->model.pressure_faces, fm->model.pressure_faces);
+    EXPECT_EQ(qm->model.pressure_faces.size(), 36u);
+    EXPECT_EQ(qm->model.fixed, fm->model.fixed);
+    EXPECT_EQ(qm->model.angle.tip_nodes, fm->model.angle.tip_nodes);
+    const double a_faces = actuator_angle(faces_path, extra, nullptr), a_quads = actuator_angle(quads_path, extra, nullptr);
+    std::printf("%s actuator at 5 kPa: *SURFACE faces %.12f deg, quadrilateral elements %.12f deg\n",
+                quadratic ? "C3D20" : "C3D8 promoted", a_faces, a_quads);
+    EXPECT_GT(a_faces, 0.05);
+    EXPECT_NEAR(a_quads, a_faces, 1e-12 * a_faces);  // the same model: equal up to nothing but round-off
+  }
+}
+
+// The fabric as a membrane on a hexahedral mesh: a sheet of M3D8 elements on the interface of the
+// fabric layer and the silicone, 14 of its 18 quadrilaterals between two hexahedra (the other 4
+// are the floor of the cavity). It is the surface its *SURFACE gives, with a note that it lies
+// inside the solid; the membrane on its triangles bends the actuator as on the *SURFACE's, and the
+// sheet named as the cavity is refused at the scene's line.
+TEST_F(SolidDecks, AnEmbeddedQuadrilateralSheetCarriesTheMembraneAndIsNoCavity) {
+  HexBlock b(3, 6, 3, true, 31, actuator_mm);
+  b.remove_cells(actuator_cavity);
+  std::vector<std::pair<long, int>> sheet;  // S2 (z+) of the fabric layer's cells
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 3; ++i) sheet.emplace_back(b.element(i, j, 0), 2);
+  const std::string mesh = b.nodes() + b.elements("*ELEMENT, TYPE=C3D20H, ELSET=BODY") + actuator_elsets(b) +
+                           face_surface("CAVITY", actuator_walls(b)) +
+                           b.nset("FIXED", [](const Vec& s) { return s.y() == 0.0; }) +
+                           b.nset("TIP", [](const Vec& s) { return s.y() == 1.0; });
+  const std::string faces_path = write("faces.inp", mesh + face_surface("SHEET", sheet));
+  const std::string quads_path = write("quads.inp", mesh + quad_block(b, "*ELEMENT, TYPE=M3D8, ELSET=SHEET", sheet, 5001) +
+                                                        "*MEMBRANE SECTION, ELSET=SHEET, MATERIAL=FABRIC\n0.4\n");
+  const InpDeck F = read_inp(faces_path, 1e-3), Q = read_inp(quads_path, 1e-3);
+  EXPECT_EQ(Q.mesh.surfaces.at("SHEET"), F.mesh.surfaces.at("SHEET"));
+  EXPECT_EQ(Q.mesh.surfaces.at("SHEET").size(), 36u);
+  EXPECT_EQ(count_containing(Q.warnings, "quads.inp:" + std::to_string(std::count(mesh.begin(), mesh.end(), '\n') + 2) +
+                                             ": 14 of the 18 quadrilaterals of ELSET=SHEET lie inside the solid"),
+            1);
+  EXPECT_EQ(count_containing(Q.warnings, "*MEMBRANE SECTION, ELSET=SHEET: its elements are read as a surface"), 1);
+
+  const std::vector<std::string> membrane = {"mesh.fabric_model=\"membrane\"", "mesh.fabric_surface=\"SHEET\""};
+  std::vector<std::string> wf, wq;
+  const double a_faces = actuator_angle(faces_path, membrane, &wf), a_quads = actuator_angle(quads_path, membrane, &wq);
+  const double a_solid = actuator_angle(faces_path, {}, nullptr);
+  std::printf("actuator at 5 kPa: fabric membrane on the *SURFACE %.12f deg, on M3D8 %.12f deg; without %.12f deg\n",
+              a_faces, a_quads, a_solid);
+  EXPECT_GT(a_faces, 0.05);
+  EXPECT_NEAR(a_quads, a_faces, 1e-12 * a_faces);
+  EXPECT_GT(std::abs(a_faces - a_solid), 1e-3 * a_solid) << "the membrane carries load";
+
+  const std::string scene_path = write("scene.toml", "[mesh]\nsource = \"inp\"\nfile = \"quads.inp\"\n"
+                                                     "cavity_surface = \"SHEET\"\n");
+  try {
+    build_model(Scene::load(scene_path));
+    ADD_FAILURE() << "an embedded sheet was accepted as the cavity";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    for (const char* part : {"scene.toml:4: key 'mesh.cavity_surface': 'SHEET' has a face inside the solid (face ",
+                             " of C3D20 ", "shared by two tetrahedra", "name the surface of the chamber walls"})
+      EXPECT_NE(what.find(part), std::string::npos) << "missing '" << part << "' in: " << what;
+  }
+}
+
+// A quadrilateral that is no face: its corners out of order around the face, off the elements, or
+// in a part (named with the part and the instance).
+TEST_F(SolidDecks, QuadrilateralElementsOnNoFaceAreRefused) {
+  const std::string cube = kCube + "9, 2, 0, 0\n*ELEMENT, TYPE=C3D8\n1, 1, 2, 3, 4, 5, 6, 7, 8\n";  // lines 1-12
+  const std::string hint =
+      "its first four nodes, in order around it (either way), must be the corners of a face of a hexahedron, wedge or "
+      "pyramid (export the surface from the same mesh)";
+  expect_error(cube + "*ELEMENT, TYPE=CPS4, ELSET=Bottom\n10, 1, 3, 2, 4\n", 14,
+               {"surface element 10 (ELSET=BOTTOM) matches no quadrilateral face of the solid elements", hint});
+  expect_error(cube + "*ELEMENT, TYPE=S4R, ELSET=S\n10, 4, 3, 2, 1\n11, 2, 9, 3, 6\n", 15,
+               {"surface element 11 (ELSET=S) matches no quadrilateral face", hint});
+  std::string part = "*Part, name=P\n" + kCube + "*Element, type=C3D8\n1, 1, 2, 3, 4, 5, 6, 7, 8\n";  // lines 1-12
+  part += "*Element, type=CPS4, elset=S\n10, 1, 2, 3, 5\n*End Part\n*Assembly, name=A\n*Instance, name=P-1, part=P\n"
+          "*End Instance\n*End Assembly\n";
+  expect_error(part, 14,
+               {"part 'P' (instance 'P-1'): surface element 10 (ELSET=S) matches no quadrilateral face",
+                "export the surface from the same mesh; in an assembly, from the same instance"});
+}
+
+// ------------------------------------------------------------------------------------------------
+// Bad input
+// ------------------------------------------------------------------------------------------------
 
 TEST_F(SolidDecks, InvertedDegenerateAndCollapsedElementsAreRefused) {
   expect_error(kCube + "*ELEMENT, TYPE=C3D8\n57, 5, 6, 7, 8, 1, 2, 3, 4\n", 11,
