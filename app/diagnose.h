@@ -64,7 +64,7 @@ struct DiagnoseOptions {
   int fem_calibration_runs = 0;
   /// > 0: calibrate on the built-in mesher at this element size (mm) instead of the scene's mesh,
   /// with an elastic mesh correction from one static sweep of each mesh (see RomEvaluator in
-  /// diagnose.cpp); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh.
+  /// app/diagnose_model.h); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh.
   double calibration_h_mm = 0.0;
   int threads = 0;
   bool progress = false;

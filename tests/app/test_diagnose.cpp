@@ -145,7 +145,7 @@ TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
 }
 
 // --calibration-h: calibrate on a coarser built-in mesh, driven through the pressure map that makes
-// its elastic path the scene mesh's (app/diagnose.cpp, RomEvaluator). Case: a 3-chamber actuator
+// its elastic path the scene mesh's (app/diagnose_model.h, RomEvaluator). Case: a 3-chamber actuator
 // whose h = 8 mesh is 19 % stiffer in angle than its h = 3 mesh, data from the h = 3 FEM with the
 // silicone 20 % softer (noise-free). Measured: scene mesh baseline 0.1649 and scale 0.794; calibration
 // mesh 0.1649 and 0.785; the raw h = 8 mesh 0.2213 and 0.696. So: the baseline within 1 % (the map
