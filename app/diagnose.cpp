@@ -368,12 +368,19 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
       // small, static creep error; on recordings made on a finer mesh than the model's, Mullins
       // took the mesh misfit after stiffness (BENCHMARKS.md §8).
       r.profiled = profiled;
+      // Beyond the static remainder (which the raw excess still holds and no history effect can
+      // remove), with no constant at a bound, and without making the raw fit worse: a profiled
+      // calibration ignores the static part, and the earlier effects' constants stay fixed, so it
+      // can trade a history gain for a static loss (measured: viscoelastic after stiffness on a
+      // fatigue recording made on a finer mesh, raw NRMSE 0.017 -> 0.042); fitted.toml carries the
+      // raw model, which must not get worse.
+      const bool beyond = r.beyond_static && r.at_bound.empty() && r.delta_aic <= 0.0;
       if (round == 1)
-        r.significant = raw.pass || (profiled && r.beyond_static && r.at_bound.empty());
+        r.significant = raw.pass || (profiled && beyond);
       else if (opt.trust_elastic_model)
         r.significant = raw.pass && r.at_bound.empty();
-      else  // beyond the static remainder, which the raw excess still holds and no history effect can remove
-        r.significant = r.beyond_static && r.at_bound.empty();
+      else
+        r.significant = beyond;
       r.why = c.name + (r.significant ? " is likely missing: " : " does not explain the error: ") + "it removes " +
               fmt("%.0f", 100.0 * std::max(0.0, r.removed)) + " % of the error above the noise floor (NRMSE " +
               fmt("%.4f", current.nrmse) + " -> " + fmt("%.4f", cmp.nrmse) + ", delta AIC " + fmt("%.1f", r.delta_aic) +
