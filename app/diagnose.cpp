@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Dense>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
@@ -55,6 +56,92 @@ double effective_sample_size(const std::vector<double>& r, const std::vector<int
   const double rho = c0 > 0.0 ? std::clamp(c1 / c0, 0.0, 0.999) : 0.0;
   return std::clamp(n * (1.0 - rho) / (1.0 + rho), std::min(n, 10.0), n);
 }
+
+StaticFit fit_static_discrepancy(const std::vector<ComparedFrame>& frames) {
+  StaticFit out;
+  const Eigen::Index n = static_cast<Eigen::Index>(frames.size());
+  double scale = 0.0;
+  for (const ComparedFrame& f : frames) scale = std::max(scale, std::abs(f.model_deg));
+  constexpr int kTerms = 4;
+  out.coefficients_deg.assign(kTerms, 0.0);
+  Eigen::VectorXd r(n);
+  for (Eigen::Index i = 0; i < n; ++i) r(i) = frames[static_cast<std::size_t>(i)].model_deg - frames[static_cast<std::size_t>(i)].measured_deg;
+  if (n > kTerms && scale > 0.0) {
+    Eigen::MatrixXd B(n, kTerms);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double x = frames[static_cast<std::size_t>(i)].model_deg / scale;  // in [-1, 1]: a well-conditioned basis
+      B(i, 0) = 1.0, B(i, 1) = x, B(i, 2) = x * x, B(i, 3) = x * x * x;
+    }
+    // Minimum-norm least squares by SVD: a model angle that barely varies (a flat recording) leaves
+    // the powers dependent; the SVD drops those directions (singular values below 1e-10 of the
+    // largest) instead of returning huge cancelling coefficients, as Eigen's pivoted QR did in the
+    // test of an exactly flat model (a solution 0.3 deg^2 off the least-squares optimum).
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(B, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    svd.setThreshold(1e-10);
+    const Eigen::VectorXd a = svd.solve(r);
+    r -= B * a;
+    for (int k = 0; k < kTerms; ++k) out.coefficients_deg[static_cast<std::size_t>(k)] = a(k);
+  }
+  out.residual_deg.assign(r.data(), r.data() + n);
+  out.rss_deg2 = r.squaredNorm();
+  return out;
+}
+
+namespace {
+
+/// The three significance tests of app/diagnose.h (step 3) of a model with `k` more parameters
+/// than the current one: its residual `res` (RSS `rss`, NRMSE `nrmse`) against the current RSS and
+/// NRMSE, with the noise floor.
+struct Significance {
+  double delta_aic = 0.0, removed = 0.0;
+  bool pass = false;
+};
+Significance significance(double current_nrmse, double current_rss, double nrmse, double rss, const std::vector<double>& res,
+                          const std::vector<int>& segment, std::size_t k, double floor, const DiagnoseOptions& opt) {
+  Significance s;
+  const double n_eff = effective_sample_size(res, segment);
+  s.delta_aic = n_eff * std::log(std::max(rss, 1e-300) / std::max(current_rss, 1e-300)) + 2.0 * static_cast<double>(k);
+  const double excess = sq(current_nrmse) - sq(floor);
+  s.removed = excess > 0.0 ? (sq(current_nrmse) - sq(nrmse)) / excess : 0.0;
+  // Third condition: an absolute gain of at least a tenth of the noise floor. Near the floor the
+  // "excess" is tiny and noise-fitting can remove a large fraction of it (measured on the control
+  // dataset: 0.0098 -> 0.0097 with a floor of 0.0096 passed the first two tests).
+  s.pass = s.delta_aic <= opt.aic_threshold && s.removed >= opt.min_removed && current_nrmse - nrmse >= opt.min_gain_of_floor * floor;
+  return s;
+}
+
+/// NRMSE of a comparison whose RSS became `rss` (the normalisation, range and n, unchanged).
+double nrmse_at(const Comparison& c, double rss) { return c.rss_deg2 > 0.0 ? c.nrmse * std::sqrt(rss / c.rss_deg2) : 0.0; }
+
+/// How much of the final error is static (fit_static_discrepancy), in numbers and words.
+void describe_static_remainder(const Comparison& final_cmp, const StaticFit& st, const DiagnoseOptions& opt, DiagnosisResult& out) {
+  const double floor = out.noise_floor_nrmse;
+  out.final_nrmse_beyond_static = nrmse_at(final_cmp, st.rss_deg2);
+  const double excess = sq(final_cmp.nrmse) - sq(floor);
+  if (final_cmp.nrmse < (1.0 + opt.min_gain_of_floor) * floor || excess <= 0.0) return;  // at the noise floor: nothing left
+  out.static_share = std::clamp((sq(final_cmp.nrmse) - sq(out.final_nrmse_beyond_static)) / excess, 0.0, 1.0);
+  const std::string nums = fmt("%.0f", 100.0 * out.static_share) + " % of the error left above the noise floor is static (NRMSE " +
+                           fmt("%.4f", final_cmp.nrmse) + ", " + fmt("%.4f", out.final_nrmse_beyond_static) +
+                           " after a smooth correction of the angle as a function of the model angle, the same in every trial; noise floor " +
+                           fmt("%.4f", floor) + ")";
+  if (out.static_share >= 0.5) {
+    out.static_note = nums + ": a misfit of the elastic response (the stiffness or hyperelastic law, the geometry, the mesh, the "
+                      "weight), or the reduced model's own error (--verify runs the full FEM), rather than a missing history effect";
+    // Name the static candidates that would absorb it, but as hypotheses: this recording cannot tell them from a mesh error.
+    std::string names;
+    for (const CandidateResult& c : out.candidates)
+      if (c.round > 1 && !c.significant && !c.beyond_static && c.delta_aic <= opt.aic_threshold && c.removed >= opt.min_removed)
+        names += (names.empty() ? "" : ", ") + c.effect + " (NRMSE " + fmt("%.4f", c.nrmse) + ")";
+    if (!names.empty()) out.static_note += "; it is what " + names + " removed in the last round";
+    out.static_note += ". A quasi-static measurement of the actuator (slow pressure sweep) against `pneufem simulate` tells "
+                       "which; calibrate the elastic response first, and the fatigue constants on the mesh you run";
+  } else {
+    out.static_note = nums + ": the rest changes between holds, trials or times — an effect outside the catalog, or the "
+                      "reduced model's own error (--verify runs the full FEM)";
+  }
+}
+
+}  // namespace
 
 DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -126,6 +213,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   std::vector<std::pair<const CandidateEffect*, std::vector<double>>> chosen;  // selected, with constants
   Comparison current = base;
   double current_rss = base.rss_deg2;
+  StaticFit current_static = fit_static_discrepancy(base.frames);
   std::vector<bool> used(cands.size(), false);
   for (int round = 1; round <= opt.max_effects; ++round) {
     std::vector<CandidateResult> results(cands.size());
@@ -197,6 +285,18 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
           }
         }
       }
+      // From round 2 on a history effect is judged by what it explains beyond a static misfit, so it
+      // is calibrated on that too: the RSS with the static discrepancy profiled out (its four
+      // coefficients re-fitted at every evaluation, fit_static_discrepancy). Calibrated on the raw
+      // RSS, a damage law spends its constants on the static remainder the first effect left (a
+      // mesh misfit: measured, fatigue at its W_th bound) instead of the growth over the trials.
+      bool profiled = round > 1 && c.history && !opt.trust_elastic_model;
+      auto objective = [&](const std::vector<double>& m) {
+        if (!profiled) return rss_of(m, frames);
+        std::vector<ComparedFrame> f = frames;
+        for (std::size_t i = 0; i < f.size(); ++i) f[i].model_deg = m[i];
+        return fit_static_discrepancy(f).rss_deg2;
+      };
       auto rss = [&](const std::vector<double>& v) {
         std::vector<double> w;
         if (!node_frames.empty() && c.interpolation == ParameterInterpolation::rig_angle) {
@@ -210,57 +310,119 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
           std::vector<double> m(frames.size(), 0.0);
           for (std::size_t node = 0; node < w.size(); ++node)
             for (std::size_t i = 0; i < m.size(); ++i) m[i] += w[node] * node_frames[node][i];
-          return rss_of(m, frames);
+          return objective(m);
         }
         const Scene s = cur_scene.with(c.sets(cur_scene, v));
-        return rss_of(rom.at_frames(s), frames);
+        return objective(rom.at_frames(s));
       };
+      // Calibrates (profiled or raw, as `profiled` says), evaluates the calibrated model and runs the
+      // significance tests; false when the calibration failed (r.error says why).
+      auto run_calibration = [&]() -> bool {
       const Calibration cal = calibrate(c, rss, opt.max_evaluations);
       r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
-      r.evaluations = cal.evaluations;
-      r.trace = cal.trace;
+      r.evaluations += cal.evaluations;
+      r.trace.insert(r.trace.end(), cal.trace.begin(), cal.trace.end());
       {
         std::lock_guard<std::mutex> lock(mu);
         rom_runs += cal.evaluations;
         if (opt.progress)
-          std::fprintf(stderr, "  round %d %-14s rss %.4g deg^2 (%d runs, %.1f s)\n", round, c.name.c_str(), cal.rss,
-                       cal.evaluations, r.wall_s);
+          std::fprintf(stderr, "  round %d %-14s rss %.4g deg^2 (%d runs, %.1f s)%s\n", round, c.name.c_str(), cal.rss,
+                       cal.evaluations, r.wall_s, profiled ? " beyond a static misfit" : "");
       }
       if (!std::isfinite(cal.rss)) {
         r.error = cal.error.empty() ? "calibration failed" : cal.error;
         r.nrmse = std::numeric_limits<double>::infinity();
-        return;
+        return false;
       }
       r.params = cal.values;
       r.sets = c.sets(cur_scene, cal.values);
       const Comparison cmp = metrics(cur_scene.with(r.sets));
       r.nrmse = cmp.nrmse;
       r.rss_deg2 = cmp.rss_deg2;
+      r.nrmse_per_trial.clear();
       for (const TrialComparison& t : cmp.trials) r.nrmse_per_trial.push_back(t.nrmse);
       std::vector<double> res;
       for (const ComparedFrame& f : cmp.frames) res.push_back(f.model_deg - f.measured_deg);
-      const double n_eff = effective_sample_size(res, segment);
-      r.delta_aic = n_eff * std::log(std::max(cmp.rss_deg2, 1e-300) / std::max(current_rss, 1e-300)) +
-                    2.0 * static_cast<double>(c.params.size());
-      const double excess = sq(current.nrmse) - sq(out.noise_floor_nrmse);
-      r.removed = excess > 0.0 ? (sq(current.nrmse) - sq(cmp.nrmse)) / excess : 0.0;
-      // Third condition: an absolute gain of at least a tenth of the noise floor. Near the floor
-      // the "excess" is tiny and noise-fitting can remove a large fraction of it (measured on the
-      // control dataset: 0.0098 -> 0.0097 with a floor of 0.0096 passed the first two tests).
-      r.significant = r.delta_aic <= opt.aic_threshold && r.removed >= opt.min_removed &&
-                      current.nrmse - cmp.nrmse >= opt.min_gain_of_floor * out.noise_floor_nrmse;
+      const double floor = out.noise_floor_nrmse;
+      const Significance raw = significance(current.nrmse, current_rss, cmp.nrmse, cmp.rss_deg2, res, segment, c.params.size(), floor, opt);
+      r.delta_aic = raw.delta_aic;
+      r.removed = raw.removed;
+      // The same tests after a static correction of both models: what the effect explains beyond a
+      // smooth misfit of the angle curve (fit_static_discrepancy). Reported in every round; required
+      // from round 2 on, where the first effect has taken the large misfit and a static remainder
+      // (the mesh, the geometry, the elastic law) is the rule for recordings made by other means.
+      const StaticFit st = fit_static_discrepancy(cmp.frames);
+      const double cur_static_nrmse = nrmse_at(current, current_static.rss_deg2);
+      r.nrmse_beyond_static = nrmse_at(cmp, st.rss_deg2);
+      const Significance bs = significance(cur_static_nrmse, current_static.rss_deg2, r.nrmse_beyond_static, st.rss_deg2,
+                                           st.residual_deg, segment, c.params.size(), floor, opt);
+      r.delta_aic_beyond_static = bs.delta_aic;
+      r.removed_beyond_static = bs.removed;
+      r.beyond_static = bs.pass;
+      r.at_bound = params_at_bounds(c, r.params);
+      // From round 2 on the tests are those beyond a static misfit (the raw excess still holds the
+      // static remainder, which no history effect can remove), and a constant pushed to the edge of
+      // its range disqualifies: both are marks of a stand-in. Measured on the creep recording of
+      // tests/data/hidden diagnosed by its own generator's reduced model: round 2 took Mullins at
+      // r = 1.1, its lower bound, and gravity passed the raw tests too, for the reduced model's
+      // small, static creep error; on recordings made on a finer mesh than the model's, Mullins
+      // took the mesh misfit after stiffness (BENCHMARKS.md §8).
+      r.profiled = profiled;
+      // Beyond the static remainder (which the raw excess still holds and no history effect can
+      // remove), with no constant at a bound, and without making the raw fit worse: a profiled
+      // calibration ignores the static part, and the earlier effects' constants stay fixed, so it
+      // can trade a history gain for a static loss (measured: viscoelastic after stiffness on a
+      // fatigue recording made on a finer mesh, raw NRMSE 0.017 -> 0.042); fitted.toml carries the
+      // raw model, which must not get worse.
+      const bool beyond = r.beyond_static && r.at_bound.empty() && r.delta_aic <= 0.0;
+      if (round == 1)
+        r.significant = raw.pass || (profiled && beyond);
+      else if (opt.trust_elastic_model)
+        r.significant = raw.pass && r.at_bound.empty();
+      else
+        r.significant = beyond;
       r.why = c.name + (r.significant ? " is likely missing: " : " does not explain the error: ") + "it removes " +
               fmt("%.0f", 100.0 * std::max(0.0, r.removed)) + " % of the error above the noise floor (NRMSE " +
               fmt("%.4f", current.nrmse) + " -> " + fmt("%.4f", cmp.nrmse) + ", delta AIC " + fmt("%.1f", r.delta_aic) +
-              " with " + std::to_string(c.params.size()) + " parameter(s)). Residual signature: " + evidence(c.name, sig) +
-              ". " + c.signature;
-      r.at_bound = params_at_bounds(c, r.params);
+              " with " + std::to_string(c.params.size()) + " parameter(s)); beyond a static misfit of the angle curve " +
+              fmt("%.0f", 100.0 * std::max(0.0, r.removed_beyond_static)) + " % (" + fmt("%.4f", cur_static_nrmse) + " -> " +
+              fmt("%.4f", r.nrmse_beyond_static) + ")." + (!r.beyond_static && round > 1 && !opt.trust_elastic_model && raw.pass
+                  ? " Not selected: after the first effect, what it removes is a smooth function of the model angle, the "
+                    "same in every trial, which a misfit of the elastic response (mesh, geometry, material law) leaves too."
+                  : "") +
+              (profiled && round == 1 && r.significant
+                   ? " Selected on what it explains beyond a static misfit (calibrated with the misfit profiled out): a "
+                     "large misfit of the elastic response hides it from the raw tests."
+                   : "") +
+              " Residual signature: " + evidence(c.name, sig) + ". " + c.signature;
       for (const std::string& name : r.at_bound) {
         const auto p = std::find_if(c.params.begin(), c.params.end(), [&](const CandidateParameter& q) { return q.name == name; });
         const double v = r.params[static_cast<std::size_t>(p - c.params.begin())];
         r.why += " Caution: " + name + " = " + fmt("%.4g", v) + " sits at the edge of its calibrated range [" + fmt("%g", p->lo) +
                  ", " + fmt("%g", p->hi) + "]: the effect is pushed to an extreme, as when it stands in for a misfit of "
                  "another kind (the elastic response, the mesh, an effect not in the catalog); weigh it less.";
+      }
+      if (round > 1 && !r.at_bound.empty() && (opt.trust_elastic_model ? raw.pass : r.beyond_static))
+        r.why += " Not selected: from round 2 on, a constant at the edge of its range marks a stand-in.";
+      return true;
+      };
+      if (!run_calibration()) return;
+      // Round 1 under a large static misfit (a recording made on another mesh or by another code):
+      // the misfit's autocorrelated residual can keep a history effect below the raw tests while it
+      // explains the history structure well once the misfit is profiled out. Such a candidate is
+      // calibrated again on the profiled objective and selected when it passes the tests beyond a
+      // static misfit with no constant at a bound (measured: Mullins on a recording made at h = 4,
+      // diagnosed at h = 6, where no effect passed the raw tests; BENCHMARKS.md §8).
+      if (round == 1 && !r.significant && c.history && !opt.trust_elastic_model && !costly[todo[j]]) {
+        const CandidateResult raw_result = r;
+        profiled = true;
+        const bool ok = run_calibration();
+        if (!ok || !r.significant) {
+          const int evaluations = r.evaluations;
+          const std::vector<CalibrationPoint> trace = r.trace;
+          r = raw_result;  // report the raw calibration; keep the count and trace of both
+          r.evaluations = evaluations, r.trace = trace;
+        }
       }
     });
     if (opt.progress)
@@ -269,19 +431,28 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     std::vector<std::size_t> order = todo;
     std::sort(order.begin(), order.end());  // catalog order among equals, whatever the run order was
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return results[a].nrmse < results[b].nrmse; });
+    // Ranked by the error left; from round 2 on by the error left beyond a static misfit, the
+    // criterion of those rounds (unless the elastic model is trusted).
+    const bool by_static = round > 1 && !opt.trust_elastic_model;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return by_static ? results[a].nrmse_beyond_static < results[b].nrmse_beyond_static : results[a].nrmse < results[b].nrmse;
+    });
     for (std::size_t i : order) out.candidates.push_back(results[i]);
-    const CandidateResult& best = results[order.front()];
-    if (!best.significant) break;
-    used[order.front()] = true;
-    chosen.emplace_back(cands[order.front()], best.params);
+    // The best significant candidate (the tests of later rounds can disqualify a better-fitting one).
+    const auto pick = std::find_if(order.begin(), order.end(), [&](std::size_t i) { return results[i].significant; });
+    if (pick == order.end()) break;
+    const CandidateResult& best = results[*pick];
+    used[*pick] = true;
+    chosen.emplace_back(cands[*pick], best.params);
     out.selected.push_back(best.effect);
     if (round == 1) out.missing_effect = best.effect;
     selected_sets.insert(selected_sets.end(), best.sets.begin(), best.sets.end());
     current = metrics(cal_scene.with(selected_sets));
     current_rss = current.rss_deg2;
+    current_static = fit_static_discrepancy(current.frames);
   }
   out.final_nrmse = current.nrmse;
+  describe_static_remainder(current, current_static, opt, out);
 
   refine_with_fem(scene, cal_scene, rec, frames, rom, opt, chosen, selected_sets, rom_runs, out);
   out.rom_runs = rom_runs;

@@ -21,6 +21,12 @@
 //    constants) and the remaining candidates are tried again on top of it, up to max_effects,
 //    unless the residual is already at the noise floor (within min_gain_of_floor: the third test
 //    of 3. could then only pass by fitting noise; the discrepancy principle of inverse problems).
+//    From round 2 on the tests are applied beyond a static misfit (fit_static_discrepancy below;
+//    history effects calibrated with it profiled out) and a constant at the edge of its range
+//    disqualifies: what the first effect leaves of a recording made by other means is mostly a
+//    misfit of the elastic response, and effects fitted to it are stand-ins. In round 1 a history
+//    effect that fails the raw tests is calibrated again that way and may pass beyond the misfit.
+//    --trust-elastic-model restores the raw tests in later rounds.
 // 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
 //    trials, creep inside holds, first-trial vs later, lag after steps, offset at rest,
 //    proportional error) and the error it removes.
@@ -38,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/compare.h"
 #include "analysis/measurements.h"
 #include "app/effect_catalog.h"
 #include "scenes/scene.h"
@@ -56,6 +63,10 @@ struct DiagnoseOptions {
   /// Skip later rounds once the residual is within min_gain_of_floor of the noise floor (no effect
   /// could then be significant without fitting below the floor); false = run every round.
   bool stop_at_noise_floor = true;
+  /// From round 2 on a candidate must also explain error beyond a static misfit of the angle curve
+  /// (fit_static_discrepancy); true = the elastic response is known to be right (a converged mesh of
+  /// the measured geometry, a calibrated material), so a static remainder may be named as an effect.
+  bool trust_elastic_model = false;
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
   int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
@@ -97,6 +108,15 @@ struct CandidateResult {
   std::string why;
   std::string error;                    ///< non-empty when the calibration failed
   std::vector<std::string> at_bound;    ///< parameters calibrated at the edge of their range (params_at_bounds)
+  /// The same three tests after a static correction of both models (fit_static_discrepancy): what
+  /// the effect explains beyond a smooth misfit of the angle curve. Rounds >= 2 require it.
+  double nrmse_beyond_static = 0.0;
+  double delta_aic_beyond_static = 0.0;
+  double removed_beyond_static = 0.0;
+  bool beyond_static = false;
+  /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
+  /// always for history effects from round 2 on; in round 1 when only that calibration passes.
+  bool profiled = false;
 };
 
 struct DiagnosisResult {
@@ -108,6 +128,12 @@ struct DiagnosisResult {
   std::string missing_effect;               ///< "" = none significant
   std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
+  /// The final residual after a static correction (fit_static_discrepancy), and the share of the
+  /// final error above the noise floor that it removes (in squared NRMSE; 0 when at the floor):
+  /// near 1, what is left is a misfit of the elastic response, not a missing history effect.
+  double final_nrmse_beyond_static = 0.0;
+  double static_share = 0.0;
+  std::string static_note;                  ///< what the static share says, in words ("" = nothing left)
   double verified_baseline_nrmse = -1.0;    ///< full FEM (verify), -1 when not run
   double verified_fitted_nrmse = -1.0;
   /// Why a full-FEM run of --verify / --refine failed ("" = none failed). The diagnosis itself is
@@ -129,6 +155,22 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options
 /// a recording made on a finer mesh than the model's, diagnosed on the coarse one, selects Mullins
 /// with r = 1.1, its lower bound, in round 2). The rig angle is exempt: 0 and 180 deg are real rigs.
 std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::vector<double>& values);
+
+/// A static model-form discrepancy (the delta(x) of Kennedy & O'Hagan 2001, here a cubic in the
+/// model's own angle) fitted to the residual model - measured of `frames` by least squares:
+/// delta = a0 + a1 x + a2 x^2 + a3 x^3, x = model angle / its largest magnitude, one function for
+/// every trial and time. A misfit of the elastic response (the mesh, the geometry, the hyperelastic
+/// law, the stiffness, the weight) moves the angle as a smooth function of the state, and the state
+/// of a staircase is, to first order, the model angle; history effects (creep within a hold,
+/// softening after the first trial, growth over trials, lag after a step) do not: at one model
+/// angle they differ between holds, trials or times. An effect selected after another must explain
+/// error that this fit cannot (app/diagnose.cpp), else it is a stand-in for a static misfit.
+struct StaticFit {
+  double rss_deg2 = 0.0;                   ///< residual sum of squares after the fit (deg^2)
+  std::vector<double> residual_deg;        ///< model - measured - delta, per frame
+  std::vector<double> coefficients_deg;    ///< a0 ... a3
+};
+StaticFit fit_static_discrepancy(const std::vector<ComparedFrame>& frames);
 
 /// AR(1) effective sample size of a residual sequence (segments = trials): n (1 - rho)/(1 + rho),
 /// rho the lag-1 autocorrelation within segments, clamped to [min(n, 10), n].

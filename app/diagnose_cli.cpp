@@ -39,6 +39,11 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   c->cmd->add_flag_callback(
       "--all-rounds", [o = &c->options] { o->stop_at_noise_floor = false; },
       "Run every forward-selection round, even when the residual is already at the noise floor");
+  c->cmd->add_flag("--trust-elastic-model", c->options.trust_elastic_model,
+                   "The elastic response is known to be right (converged mesh of the measured geometry, calibrated "
+                   "material): an effect after the first may then be one that only corrects the static angle curve "
+                   "(stiffness, gravity). Default: it must explain error beyond a static misfit, which a coarse mesh "
+                   "or an approximate geometry leaves too");
   c->cmd->add_option("--rom-points", c->options.rom_points, "Material points of the reduced model")
       ->check(CLI::Range(100, 10000000))
       ->capture_default_str();
@@ -86,9 +91,10 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
     std::string bound;
     for (const std::string& n : k.at_bound) bound += (bound.empty() ? "  (at the edge of its range: " : ", ") + n;
     if (!bound.empty()) bound += ")";
-    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  %s%s\n", k.round, k.effect.c_str(), k.nrmse, k.delta_aic,
-                k.significant ? "significant" : "", bound.c_str());
+    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  beyond static %.4f  %s%s\n", k.round, k.effect.c_str(), k.nrmse,
+                k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
   }
+  if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
   if (!r.fem_error.empty()) std::printf("full FEM: %s\n", r.fem_error.c_str());

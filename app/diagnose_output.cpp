@@ -43,6 +43,9 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
     std::string ab = "[";
     for (std::size_t j = 0; j < c.at_bound.size(); ++j) ab += (j ? ", " : "") + json::quote(c.at_bound[j]);
     o.add("at_bound", ab + "]");
+    o.add("nrmse_beyond_static", c.nrmse_beyond_static).add("delta_aic_beyond_static", c.delta_aic_beyond_static);
+    o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
+    o.add("profiled", c.profiled ? "true" : "false");
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }
@@ -64,6 +67,9 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
   root.add("noise_floor_nrmse", out.noise_floor_nrmse);
   root.add("final_nrmse", out.final_nrmse);
   if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
+  json::Object sr;
+  sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
+  root.add("static_remainder", sr.str(2));
   if (!out.fem_error.empty()) root.add_str("fem_error", out.fem_error);
   json::Object method;
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
@@ -84,17 +90,19 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
     method.add("calibration_mesh", cm.str(4));
   }
   method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);
+  method.add("trust_elastic_model", opt.trust_elastic_model ? "true" : "false");
   method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
   root.add("method", method.str(2));
   root.add("scene", scene.to_json());
   write_file_atomic((fs::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
   write_file_atomic((fs::path(opt.out_dir) / "fitted.toml").string(), out.fitted_toml);
-  std::string csv = "round,effect,nrmse,delta_aic,removed_fraction,significant,evaluations,params\n";
+  std::string csv = "round,effect,nrmse,delta_aic,removed_fraction,significant,evaluations,params,nrmse_beyond_static,beyond_static\n";
   for (const CandidateResult& c : out.candidates) {
     std::string p;
     for (std::size_t j = 0; j < c.params.size(); ++j) p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.params[j]);
     csv += std::to_string(c.round) + "," + c.effect + "," + json::num(c.nrmse) + "," + json::num(c.delta_aic) + "," +
-           json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "\n";
+           json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "," +
+           json::num(c.nrmse_beyond_static) + "," + (c.beyond_static ? "1" : "0") + "\n";
   }
   write_file_atomic((fs::path(opt.out_dir) / "diagnosis.csv").string(), csv);
   std::string tr = "round,effect,evaluation,params,rss_deg2,error\n";
