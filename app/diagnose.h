@@ -24,7 +24,8 @@
 //    From round 2 on the tests are applied beyond a static misfit (fit_static_discrepancy below;
 //    history effects calibrated with it profiled out) and a constant at the edge of its range
 //    disqualifies: what the first effect leaves of a recording made by other means is mostly a
-//    misfit of the elastic response, and effects fitted to it are stand-ins. In round 1 a history
+//    misfit of the elastic response, and effects fitted to it are stand-ins. Such a history effect
+//    is then re-fitted jointly with the earlier effects' constants (local search, raw error). In round 1 a history
 //    effect that fails the raw tests is calibrated again that way and may pass beyond the misfit.
 //    --trust-elastic-model restores the raw tests in later rounds.
 // 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
@@ -117,6 +118,10 @@ struct CandidateResult {
   /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
   /// always for history effects from round 2 on; in round 1 when only that calibration passes.
   bool profiled = false;
+  /// From round 2 on, for a history effect: the constants of the effects selected before it,
+  /// re-fitted jointly with its own (in selection order; empty = not re-fitted). Selected, they
+  /// replace the earlier values in the model and in fitted.toml.
+  std::vector<double> refit_selected;
 };
 
 struct DiagnosisResult {

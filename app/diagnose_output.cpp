@@ -46,6 +46,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
     o.add("nrmse_beyond_static", c.nrmse_beyond_static).add("delta_aic_beyond_static", c.delta_aic_beyond_static);
     o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
     o.add("profiled", c.profiled ? "true" : "false");
+    if (!c.refit_selected.empty()) o.add("refit_selected_params", json::array(c.refit_selected));
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }
