@@ -481,6 +481,13 @@ TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
   EXPECT_GT(v.static_share, 0.5);
   EXPECT_LT(v.final_nrmse_beyond_static, v.final_nrmse);
   EXPECT_NE(v.static_note.find("gravity (NRMSE"), std::string::npos) << v.static_note;
+  // ... and diagnosis.json carries them (README schema).
+  std::ifstream vj(fs::temp_directory_path() / "pneufem_diag_stop_viscoelastic" / "diagnosis.json");
+  const std::string vjson((std::istreambuf_iterator<char>(vj)), std::istreambuf_iterator<char>());
+  EXPECT_NE(vjson.find("\"static_remainder\": {"), std::string::npos);
+  EXPECT_NE(vjson.find("\"share_of_excess\": "), std::string::npos);
+  EXPECT_NE(vjson.find("\"beyond_static\": false"), std::string::npos);
+  EXPECT_NE(vjson.find("\"nrmse_beyond_static\": "), std::string::npos);
 }
 
 // --trust-elastic-model restores the raw tests from round 2 on: on the same data gravity, which
