@@ -509,6 +509,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
     chosen.emplace_back(cands[*pick], best.params);
     out.selected.push_back(best.effect);
     if (round == 1) out.missing_effect = best.effect;
+    if (out.missing_history_effect.empty() && cands[*pick]->history) out.missing_history_effect = best.effect;
     selected_sets.insert(selected_sets.end(), best.sets.begin(), best.sets.end());
     current = metrics(cal_scene.with(selected_sets));
     current_rss = current.rss_deg2;

@@ -131,6 +131,10 @@ struct DiagnosisResult {
   std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
   std::vector<std::string> selected;
   std::string missing_effect;               ///< "" = none significant
+  /// The first selected effect that depends on the load history (creep, damage, lag: the catalog's
+  /// `history`), "" = none: under a large static misfit `missing_effect` can be the misfit (as
+  /// stiffness) with the history effect second; this names the latter directly.
+  std::string missing_history_effect;
   std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
   /// The final residual after a static correction (fit_static_discrepancy), and the share of the

@@ -98,6 +98,9 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
   if (!r.fem_error.empty()) std::printf("full FEM: %s\n", r.fem_error.c_str());
+  if (!r.missing_history_effect.empty() && r.missing_history_effect != r.missing_effect)
+    std::printf("missing history effect: %s (after %s, which takes the larger, static part of the misfit)\n",
+                r.missing_history_effect.c_str(), r.missing_effect.c_str());
   std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json and fitted.toml\n",
               r.missing_effect.empty() ? "none" : r.missing_effect.c_str(), r.selected.size(), r.final_nrmse, r.wall_s,
               c.options.out_dir.c_str());

@@ -52,6 +52,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
   }
   root.add("candidates", cs + "\n  ]");
   root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
+  root.add("missing_history_effect", out.missing_history_effect.empty() ? "null" : json::quote(out.missing_history_effect));
   if (!out.stopped.empty()) root.add("stopped", json::quote(out.stopped));
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);

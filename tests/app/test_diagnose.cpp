@@ -468,6 +468,8 @@ TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
   // misfit, and Mullins, calibrated beyond it, too little (0.0160 -> 0.0155): neither is added.
   // Before the static test both were significant, and Mullins was selected (at r = 1.1, its bound).
   EXPECT_EQ(v.selected, std::vector<std::string>{"viscoelastic"});
+  EXPECT_EQ(v.missing_history_effect, "viscoelastic");
+  EXPECT_EQ(s.missing_history_effect, "");  // stiffness is not a history effect
   for (const CandidateResult& c : v.candidates) {
     if (c.round != 2) continue;
     EXPECT_FALSE(c.significant) << c.effect << ": " << c.why;
@@ -488,6 +490,7 @@ TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
   EXPECT_NE(vjson.find("\"share_of_excess\": "), std::string::npos);
   EXPECT_NE(vjson.find("\"beyond_static\": false"), std::string::npos);
   EXPECT_NE(vjson.find("\"nrmse_beyond_static\": "), std::string::npos);
+  EXPECT_NE(vjson.find("\"missing_history_effect\": \"viscoelastic\""), std::string::npos);
 }
 
 // --trust-elastic-model restores the raw tests from round 2 on: on the same data gravity, which
