@@ -14,7 +14,9 @@
 //     max(3 sigma, 0.05 kPa), sigma = 1.4826 MAD(first differences)/sqrt(2) of the raw record
 //     (3 sigma of the raw noise is above what survives the median, so noise breakpoints are
 //     rare; 0.05 kPa is ~0.1 % of a 45 kPa staircase and bounds the pressure error of a
-//     noise-free record);
+//     noise-free record); the breakpoints' values are then fitted by least squares to all the
+//     filtered samples (a plateau takes the mean of its samples, not the value of one of them:
+//     near the limit point 0.05 kPa is 0.25° of angle);
 //  3. extra states so that the solved states are at most max_report_gap_s apart wherever the
 //     pressure changes (ramps) and, for models with history (creep, damage: Assembler state
 //     non-empty), everywhere, so relaxation inside holds is resolved; for elastic models a hold
