@@ -93,8 +93,8 @@ double rel_error(const Histories& h) {
 
 TEST(PathModel, ElasticReferenceIsReproduced) {
   const Histories h = compare({});
-  // The difference form is exact for the reference; what remains is the linear interpolation of
-  // the path between 1 kPa samples (the states at 5 kPa levels coincide with samples) and Newton
+  // The difference form is exact for the reference at the path's samples (the states at 5 kPa
+  // levels coincide with them; between samples see the next test); what remains is Newton
   // tolerances: 1e-6 of the angle is generous.
   ASSERT_GT(h.fem_deg.back(), 0.5);
   EXPECT_LT(rel_error(h), 1e-6);
