@@ -85,6 +85,7 @@ std::vector<double> fit_knot_values(const std::vector<double>& t, const std::vec
   for (std::size_t i = 0; i < t.size(); ++i)
     if (keep[i]) knot.push_back(i);
   const std::size_t m = knot.size();
+  if (m == 1) return {x[knot[0]]};
   std::vector<double> diag(m, 0.0), off(m, 0.0), rhs(m, 0.0);  // off[k] couples k and k + 1
   for (std::size_t k = 0; k + 1 < m; ++k) {
     const double ta = t[knot[k]], tb = t[knot[k + 1]];
@@ -99,7 +100,6 @@ std::vector<double> fit_knot_values(const std::vector<double>& t, const std::vec
       rhs[k + 1] += w * x[i];
     }
   }
-  if (m == 1) return {x[knot[0]]};
   for (std::size_t k = 1; k < m; ++k) {  // forward elimination
     const double f = off[k - 1] / diag[k - 1];
     diag[k] -= f * off[k - 1];

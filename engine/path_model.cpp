@@ -316,19 +316,18 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
     ++st.evaluations;
     const int k = segment(theta);
     const double dth = theta_[k + 1] - theta_[k], a = (theta - theta_[k]) / dth;
-    double p_el = p_[k] + a * (p_[k + 1] - p_[k]);
-    if (a >= 0.0 && a <= 1.0) {  // cubic Hermite with the monotone slopes
-      const double a2 = a * a, a3 = a2 * a;
-      p_el = (2 * a3 - 3 * a2 + 1) * p_[k] + (a3 - 2 * a2 + a) * dth * dp_dtheta_[k] + (3 * a2 - 2 * a3) * p_[k + 1] +
-             (a3 - a2) * dth * dp_dtheta_[k + 1];
-    }
+    const bool inside = a >= 0.0 && a <= 1.0;
+    const double a2 = a * a, a3 = a2 * a;  // inside: cubic Hermite with the monotone slopes; else the chord
+    const double p_el = inside ? (2 * a3 - 3 * a2 + 1) * p_[k] + (a3 - 2 * a2 + a) * dth * dp_dtheta_[k] +
+                                     (3 * a2 - 2 * a3) * p_[k + 1] + (a3 - a2) * dth * dp_dtheta_[k + 1]
+                               : p_[k] + a * (p_[k + 1] - p_[k]);
     const double dV = (V_[k + 1] - V_[k]) / dth;
     const double gS = model.gravity_m_s2.dot(S_[k + 1] - S_[k]) / dth;
     const Mat3* F0 = F_.data() + k * np;
     const double Gm = generalised_force(gm, F0, F0 + np, a, dth, pt_weight_, pt_element_, ts, &state_old, &state_new,
                                         Fbuf, rbuf);
     double Gr = 0.0;
-    if (a >= 0.0 && a <= 1.0) {  // cached reference force, linear between kRefSub sub-points
+    if (inside) {  // cached reference force, linear between kRefSub sub-points
       const double x = a * kRefSub;
       const int j = std::min(static_cast<int>(x), kRefSub - 1);
       const double* c = Gref_.data() + static_cast<std::size_t>(k) * (kRefSub + 1);
