@@ -59,6 +59,13 @@ std::string canonical_name(const std::string& header_name) {
   return out;
 }
 
+/// Whether a header cell starts with `stem` ("pressure" matches "pressure", "pressure_inh2o").
+bool has_stem(const std::vector<std::string>& names, const std::string& stem) {
+  for (const std::string& n : names)
+    if (lower(n).rfind(stem, 0) == 0) return true;
+  return false;
+}
+
 /// A hint for a missing required column: a header cell that shares its stem ("pressure" for
 /// pressure_kPa) was probably meant, with another unit or none.
 std::string missing_column_hint(const std::string& required, const std::vector<std::string>& names) {
@@ -71,6 +78,75 @@ std::string missing_column_hint(const std::string& required, const std::vector<s
              "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
   return "add the column; the header must name trial,time_s,pressure_kPa,angle_deg (any order, "
          "other columns are ignored, cells of pressure_kPa or angle_deg may be empty)";
+}
+
+/// Where a continuous log of several staircases (no trial column, time_s never restarting) starts
+/// its next trial: at each release, the first sample after the pressure has been above half the
+/// record's peak, fallen below a tenth of it and settled at the rest level (within 2 % of the peak of
+/// the median of the low stretch that follows, which lasts until the next rise past a tenth; a
+/// trial's 0 kPa hold then begins its trial, as in the scene's staircase). The peak is the 99th
+/// percentile, so a valve spike does not set it; a dip during a hold does not pass for a release,
+/// since the low stretch must last kMinRest_s. Returns the split times in order (empty: one trial).
+std::vector<double> release_times(const Series& p) {
+  constexpr double kMinRest_s = 1.0;
+  std::vector<double> out;
+  if (p.value.size() < 10) return out;
+  std::vector<double> sorted = p.value;
+  const std::size_t q = static_cast<std::size_t>(0.99 * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(q), sorted.end());
+  const double peak = sorted[q];
+  if (!(peak > 0.0)) return out;
+  bool high = false;
+  for (std::size_t i = 0; i < p.value.size(); ++i) {
+    if (p.value[i] > 0.5 * peak) high = true;
+    if (!high || p.value[i] >= 0.1 * peak) continue;
+    std::size_t end = i;  // the low stretch: until the next rise past a tenth of the peak
+    while (end < p.value.size() && p.value[end] < 0.1 * peak) ++end;
+    if (p.t_s[end - 1] - p.t_s[i] < kMinRest_s) {
+      i = end - 1;  // a dip, not a release (keep `high`)
+      continue;
+    }
+    std::vector<double> low(p.value.begin() + static_cast<long>(i), p.value.begin() + static_cast<long>(end));
+    std::nth_element(low.begin(), low.begin() + static_cast<long>(low.size() / 2), low.end());
+    const double rest = low[low.size() / 2];
+    std::size_t j = i;
+    while (j + 1 < end && std::abs(p.value[j] - rest) > 0.02 * peak) ++j;
+    if (end < p.value.size()) out.push_back(p.t_s[j]);  // a rest that ends the record starts no trial
+    high = false;
+    i = end - 1;
+  }
+  return out;
+}
+
+/// Splits the one trial of a continuous log at its releases (release_times); trial k's time_s
+/// starts at 0 at its release (the first trial keeps the log's clock). A note says where.
+void split_at_releases(Recording& rec) {
+  const std::vector<double> cut = release_times(rec.trials[0].pressure_kPa);
+  if (cut.empty()) return;
+  const TrialRecording all = std::move(rec.trials[0]);
+  rec.trials.assign(cut.size() + 1, TrialRecording{});
+  auto distribute = [&](const Series& s, Series TrialRecording::*member) {
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < s.t_s.size(); ++i) {
+      while (k < cut.size() && s.t_s[i] >= cut[k]) ++k;
+      Series& d = rec.trials[k].*member;
+      d.t_s.push_back(k == 0 ? s.t_s[i] : s.t_s[i] - cut[k - 1]);
+      d.value.push_back(s.value[i]);
+    }
+  };
+  distribute(all.pressure_kPa, &TrialRecording::pressure_kPa);
+  distribute(all.angle_deg, &TrialRecording::angle_deg);
+  std::string at;
+  for (std::size_t k = 0; k < cut.size(); ++k) {
+    rec.trials[k].trial = static_cast<int>(k + 1);
+    at += (k ? ", " : "") + csv::number_text(cut[k]);
+  }
+  rec.trials.back().trial = static_cast<int>(cut.size() + 1);
+  for (std::string& w : rec.warnings)
+    if (w.find(": no trial column:") != std::string::npos)
+      w = rec.source + ": no trial column and time_s never restarts: the log was split into " +
+          std::to_string(cut.size() + 1) + " trials where the pressure is released (at time_s = " + at +
+          "); each trial's time_s starts at 0 there. Give a trial column to number them yourself";
 }
 
 /// Per-stream bookkeeping while reading: order checks and repeated time stamps.
@@ -116,6 +192,7 @@ class CanonicalReader {
 
     Recording rec;
     rec.source = source_;
+    rec.pressure_recorded = !no_pressure_column_;
     rec.warnings = conversions_;
     if (skipped_rows > 0)
       rec.warnings.push_back(source_ + ": " + std::to_string(skipped_rows) +
@@ -125,12 +202,13 @@ class CanonicalReader {
       TrialState& st = trials_[index];
       note_repeats(rec, st.rec.trial, "pressure", st.pressure);
       note_repeats(rec, st.rec.trial, "angle", st.angle);
-      if (st.rec.pressure_kPa.t_s.empty())
+      if (st.rec.pressure_kPa.t_s.empty() && !no_pressure_column_)
         rec.warnings.push_back(source_ + ": trial " + std::to_string(number) + " has no pressure_kPa samples");
       if (st.rec.angle_deg.t_s.empty())
         rec.warnings.push_back(source_ + ": trial " + std::to_string(number) + " has no angle_deg samples");
       rec.trials.push_back(std::move(st.rec));
     }
+    if (auto_trials_ && rec.trials.size() == 1) split_at_releases(rec);
     return rec;
   }
 
@@ -170,8 +248,16 @@ class CanonicalReader {
       auto_trials_ = true;
       conversions_.push_back(source_ + ": no trial column: the trials are numbered 1, 2, ... where time_s restarts");
     }
+    if (column_[kPressure] < 0 && !has_stem(names, "pressure")) {
+      // Angles alone (video tracking of a commanded protocol, as the seed paper's): the caller drives
+      // the model with the scene's own [load] (app/drive.h, fill_commanded_pressure). A header that
+      // names a pressure in an unknown unit is still an error below: that column was meant.
+      no_pressure_column_ = true;
+      conversions_.push_back(source_ + ": no pressure column: only angles were recorded; the model is driven by the "
+                                       "scene's [load] protocol from time_s = 0 of every trial");
+    }
     for (std::size_t c = 0; c < kColumns.size(); ++c) {
-      if (column_[c] >= 0 || (c == kTrial && auto_trials_)) continue;
+      if (column_[c] >= 0 || (c == kTrial && auto_trials_) || (c == kPressure && no_pressure_column_)) continue;
       std::string have;
       for (const std::string& n : header_names_) have += (have.empty() ? "" : ",") + n;
       csv::fail(source_, line.number, 1,
@@ -238,7 +324,7 @@ class CanonicalReader {
 
     double t = 0.0, p = 0.0, a = 0.0;
     number(line, kTime, true, t);
-    const bool has_p = number(line, kPressure, false, p);
+    const bool has_p = !no_pressure_column_ && number(line, kPressure, false, p);
     const bool has_a = number(line, kAngle, false, a);
     if (!has_p && !has_a) return false;
 
@@ -308,6 +394,7 @@ class CanonicalReader {
   std::array<double, 4> scale_{};           ///< factor from the file's unit to the canonical one
   std::vector<std::string> conversions_;    ///< one note per converted column (or the trial numbering)
   bool auto_trials_ = false;                ///< no trial column: numbered where time_s restarts
+  bool no_pressure_column_ = false;         ///< angles only: the scene's protocol gives the pressure
   long auto_trial_ = 1;
   double last_row_time_ = -INFINITY;
   std::size_t width_ = 0;

@@ -15,7 +15,13 @@
 //    are converted on reading, with a warning naming the column and the factor: time_ms, time_min;
 //    pressure_Pa, pressure_hPa, pressure_mbar, pressure_bar, pressure_MPa, pressure_psi;
 //    angle_rad; trial_number for trial. A name without a unit ("pressure") is an error;
+//  * without a pressure column (and no other column named pressure...) only angles were recorded:
+//    Recording::pressure_recorded is false and the pressure series are empty (a note says so);
+//    compare and diagnose then drive the model with the scene's own [load] from time_s = 0;
 //  * without a trial column the trials are numbered 1, 2, ... where time_s restarts (a note says so);
+//    a continuous log whose time_s never restarts is split where its pressure is released (the
+//    first sample settled at the rest level after a fall from above half the peak; each trial's
+//    time_s then starts at 0 there; a note gives the times);
 //    an optional UTF-8 byte-order mark and CRLF line ends are accepted;
 //  * a file whose header has no commas but ';' or tabs (how spreadsheets in decimal-comma locales
 //    save CSV) is read with that separator and ',' as the decimal mark, with a note;
@@ -46,6 +52,9 @@ struct TrialRecording {
 struct Recording {
   std::vector<TrialRecording> trials;  ///< sorted by trial number, each number once
   std::string source;                  ///< file the data came from
+  /// false: the file has no pressure column (angles of a commanded protocol only); every trial's
+  /// pressure series is empty until app/drive.h's fill_commanded_pressure samples the scene's load.
+  bool pressure_recorded = true;
   std::vector<std::string> warnings;   ///< "<file>: ..." notes that did not stop the read
 };
 

@@ -332,8 +332,9 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   if (opt.out_dir.empty()) throw InputError("--out DIR is required");
   if (opt.data_path.empty()) throw InputError("--data FILE is required (canonical CSV trial,time_s,pressure_kPa,angle_deg)");
-  const Recording rec = opt.dlc_map_path.empty() ? read_measurements_csv(opt.data_path)
-                                                 : merge_deeplabcut(read_measurements_csv(opt.data_path), opt.dlc_map_path);
+  Recording rec = opt.dlc_map_path.empty() ? read_measurements_csv(opt.data_path)
+                                           : merge_deeplabcut(read_measurements_csv(opt.data_path), opt.dlc_map_path);
+  fill_commanded_pressure(rec, scene);  // angles alone: the scene's protocol drives the model
   CompareRunResult r;
   r.warnings = rec.warnings;
 

@@ -17,7 +17,7 @@ std::unique_ptr<CompareCommand> add_compare_command(CLI::App& app) {
                                         "replaced by the measured pressure")
       ->check(CLI::ExistingFile);
   s->add_option("--data", c->options.data_path,
-                "Recording, canonical CSV with columns trial,time_s,pressure_kPa,angle_deg (see analysis/measurements.h)")
+                "Recording, canonical CSV with columns trial,time_s,pressure_kPa,angle_deg (see analysis/measurements.h; without pressure_kPa the scene's [load] drives the model)")
       ->required()
       ->check(CLI::ExistingFile);
   s->add_option("--dlc-map", c->options.dlc_map_path,

@@ -22,6 +22,7 @@
 #include "analysis/measurements.h"
 #include "app/diagnose_detail.h"
 #include "app/diagnose_model.h"
+#include "app/drive.h"
 #include "app/effect_catalog.h"
 #include "app/elastic_curve.h"
 #include "materials/errors.h"
@@ -165,7 +166,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
   std::unique_ptr<tbb::global_control> gc;
   if (opt.threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
 
-  const Recording rec = read_measurements_csv(opt.data_path);
+  Recording rec = read_measurements_csv(opt.data_path);
+  fill_commanded_pressure(rec, scene);  // angles alone: the scene's protocol drives the model
   for (const std::string& w : rec.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   // Kept frames and metrics come from compare_recording; any model series gives the frames.
   std::vector<Series> zero(rec.trials.size());

@@ -17,7 +17,7 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       "them by the error they remove with an information criterion, and writes diagnosis.json and fitted.toml");
   c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
       ->check(CLI::ExistingFile);
-  c->cmd->add_option("--data", c->options.data_path, "Measurements: canonical CSV trial,time_s,pressure_kPa,angle_deg")
+  c->cmd->add_option("--data", c->options.data_path, "Measurements: canonical CSV trial,time_s,pressure_kPa,angle_deg (without pressure_kPa the scene's [load] drives the model)")
       ->required()
       ->check(CLI::ExistingFile);
   c->cmd->add_option("--out", c->options.out_dir, "Output directory (diagnosis.json, fitted.toml, diagnosis.csv, history.jsonl)")

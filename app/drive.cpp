@@ -179,10 +179,59 @@ void check_gauge_pressure(const Recording& rec) {
 }
 }  // namespace
 
+void fill_commanded_pressure(Recording& rec, const Scene& scene) {
+  if (rec.pressure_recorded) return;
+  const LoadHistory load = inlet_load(scene);
+  if (load.trials.empty()) throw InputError("[load]: the scene's protocol has no trials to drive " + rec.source + " with");
+  // 200 Hz and every breakpoint: the running median passes a monotone piece unchanged and RDP then
+  // keeps exactly the protocol's corners, so the drive solves the protocol's own pressures.
+  constexpr double kRate_Hz = 200.0;
+  std::ostringstream late;
+  for (std::size_t k = 0; k < rec.trials.size(); ++k) {
+    TrialRecording& tr = rec.trials[k];
+    const TrialLoad& tl = load.trials[std::min(k, load.trials.size() - 1)];
+    const double first = tr.angle_deg.t_s.empty() ? 0.0 : std::min(0.0, tr.angle_deg.t_s.front());
+    const double last = tr.angle_deg.t_s.empty() ? tl.duration() : std::max(tl.duration(), tr.angle_deg.t_s.back());
+    if (last > tl.duration() + 1.0 && late.tellp() == 0)
+      late << "trial " << tr.trial << " has frames up to time_s = " << last << ", after the protocol's trial ends ("
+           << tl.duration() << " s)";
+    std::vector<double> t;
+    for (long i = static_cast<long>(std::floor(first * kRate_Hz)); i / kRate_Hz <= last; ++i) t.push_back(i / kRate_Hz);
+    for (double b : tl.time_s) t.push_back(b);
+    if (t.back() < last) t.push_back(last);
+    std::sort(t.begin(), t.end());
+    t.erase(std::unique(t.begin(), t.end(), [](double a, double b) { return b - a < 1e-9; }), t.end());
+    tr.pressure_kPa.t_s.clear();
+    tr.pressure_kPa.value.clear();
+    for (double ti : t) {
+      tr.pressure_kPa.t_s.push_back(ti);
+      tr.pressure_kPa.value.push_back(tl.pressure(ti) * 1e-3);  // before 0: the start, after the end: the last level
+    }
+  }
+  std::ostringstream w;
+  w << rec.source << ": no pressure column: the model is driven by the scene's [load] (" << load.description
+    << "; the recording's k-th trial by the protocol's k-th"
+    << (load.trials.size() < rec.trials.size() ? ", trials beyond load.trials by its last" : "")
+    << "), time_s = 0 being the start of the protocol's trial";
+  // The reader's note ("no pressure column") becomes this one, which says what was done.
+  const auto note = std::find_if(rec.warnings.begin(), rec.warnings.end(),
+                                 [&](const std::string& m) { return m.rfind(rec.source + ": no pressure column", 0) == 0; });
+  if (note != rec.warnings.end()) *note = w.str();
+  else rec.warnings.push_back(w.str());
+  if (late.tellp() > 0)
+    rec.warnings.push_back(rec.source + ": " + late.str() +
+                           ": those frames are compared with the last level held; trim the recording or describe the "
+                           "whole protocol in [load]");
+  rec.pressure_recorded = true;
+}
+
 LoadHistory measured_load(const Recording& rec, const DriveOptions& opt, double rest_s, bool rate_dependent,
                           std::vector<double>& t_offset_s, double* used_tolerance_kPa) {
   if (rec.trials.empty()) throw InputError(rec.source + ": the recording has no trials; nothing to simulate");
   if (!(opt.max_report_gap_s > 0)) throw InputError("max_report_gap_s must be > 0");
+  if (!rec.pressure_recorded)
+    throw InputError(rec.source + ": the recording has no pressure column; the model needs the pressure it was driven "
+                                  "with (fill_commanded_pressure takes it from the scene's [load])");
   check_gauge_pressure(rec);
   LoadHistory h;
   h.rest_between_trials_s = rest_s;

@@ -82,6 +82,16 @@ struct DriveResult {
 
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt);
 
+/// A recording of angles alone (Recording::pressure_recorded false: video of a commanded protocol,
+/// as in the seed paper): fills every trial's pressure series with the scene's inlet load
+/// (scenes/build_model.h inlet_load: [load] before any chamber lag, which the drive then applies
+/// as to a measured inlet), sampled at 200 Hz and at the protocol's breakpoints over
+/// [min(0, first frame), max(end of the protocol's trial, last frame)]; the recording's k-th trial
+/// takes the protocol's k-th (its last for later ones). The protocol's time 0 is the recording's
+/// time_s = 0. Notes go to rec.warnings (also frames more than 1 s after the protocol's trial ends,
+/// which see its last level held). A recording with pressure is left alone.
+void fill_commanded_pressure(Recording& rec, const Scene& scene);
+
 /// Steps 1-2 above for one pressure series (kPa): the kept breakpoints. `tolerance_kPa` <= 0
 /// means auto; the tolerance used is stored in *used_kPa when given.
 Series simplify_pressure(const Series& pressure_kPa, double tolerance_kPa, double median_window_s,

@@ -644,6 +644,24 @@ Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   return mesh;
 }
 
+LoadHistory inlet_load(const Scene& s) {
+  LoadHistory load;
+  const std::string protocol = s.string("load.protocol");
+  if (protocol == "staircase") {
+    load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
+                     s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"), s.number("load.rest_s"),
+                     s.number("load.output_every_s"));
+  } else if (protocol == "csv") {
+    const std::string csv = s.string("load.csv");
+    if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
+    load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+    if (s.number("load.rest_s") > 0) load.rest_between_trials_s = s.number("load.rest_s");
+  } else {
+    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
+  }
+  return load;
+}
+
 std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   auto out = std::make_unique<BuiltModel>();
   Model& model = out->model;
@@ -806,19 +824,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   out->stats = compute_stats(mesh);
 
   // Load.
-  const std::string protocol = s.string("load.protocol");
-  if (protocol == "staircase") {
-    out->load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
-                          s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"),
-                          s.number("load.rest_s"), s.number("load.output_every_s"));
-  } else if (protocol == "csv") {
-    const std::string csv = s.string("load.csv");
-    if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
-    out->load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
-    if (s.number("load.rest_s") > 0) out->load.rest_between_trials_s = s.number("load.rest_s");
-  } else {
-    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
-  }
+  out->load = inlet_load(s);
   // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
   // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
   // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
@@ -827,7 +833,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
   if (lag_s > 0.0)
     out->load = apply_pressure_lag(out->load, lag_s,
-                                   protocol == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+                                   s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
 
   // Solver.
   SolverSettings& sv = out->solver;

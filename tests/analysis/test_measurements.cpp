@@ -3,12 +3,14 @@
 // printed, not asserted), and one case per class of malformed input asserting file:line:column.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "analysis/csv_scan.h"
 #include "analysis/measurements.h"
 #include "materials/errors.h"
 #include "tests/analysis/synthetic.h"
@@ -224,6 +226,66 @@ TEST(MeasurementsCsv, WithoutATrialColumnTrialsStartWhereTheTimeRestarts) {
   EXPECT_EQ(r.trials[1].angle_deg.value, (std::vector<double>{0.2, 1.3}));
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_EQ(r.warnings[0], "log.csv: no trial column: the trials are numbered 1, 2, ... where time_s restarts");
+}
+
+// Video of a commanded protocol (the seed paper's angles): no pressure column at all. The angles are
+// read, the pressure series stay empty and the recording says so; a column that names a pressure
+// without a known unit is still the error above (that column was meant, not left out).
+TEST(MeasurementsCsv, AnglesAloneAreReadWithoutPressure) {
+  const Recording r = parse_measurements_csv("trial,time_s,angle_deg\n1,0,0.1\n1,0.5,2\n2,0,0.3\n", "video.csv");
+  EXPECT_FALSE(r.pressure_recorded);
+  ASSERT_EQ(r.trials.size(), 2u);
+  EXPECT_EQ(r.trials[0].angle_deg.value, (std::vector<double>{0.1, 2}));
+  EXPECT_EQ(r.trials[1].angle_deg.t_s, (std::vector<double>{0}));
+  EXPECT_TRUE(r.trials[0].pressure_kPa.t_s.empty());
+  ASSERT_EQ(r.warnings.size(), 1u);  // the note, not one "no pressure samples" per trial
+  EXPECT_NE(r.warnings[0].find("video.csv: no pressure column"), std::string::npos) << r.warnings[0];
+  EXPECT_TRUE(parse_measurements_csv("trial,time_s,pressure_kPa,angle_deg\n1,0,0,0\n", "x.csv").pressure_recorded);
+  EXPECT_NE(error_of("trial,time_s,Pressure (inH2O),angle_deg\n1,0,1,2\n").find("missing column 'pressure_kPa'"),
+            std::string::npos);
+}
+
+// A continuous log of three staircases (no trial column, one clock): each trial 0-10-20 kPa in 4 s
+// holds from the start of its 0 kPa hold, then an exponential vent (time constant 0.2 s) and the
+// next trial's 0 kPa hold. The log is split where each vent has settled (within 2 % of the peak of
+// the rest level: 0.2 s * ln(20/0.4) = 0.78 s after the release), not at a 0.5 s dip to 0 during a
+// hold (shorter than the 1 s a rest must last) nor at a valve spike; sample times are 1/400 s, so
+// the split times are known to that resolution.
+TEST(MeasurementsCsv, AContinuousLogIsSplitIntoTrialsWhereThePressureIsReleased) {
+  std::string text = "time_s,pressure_kPa,angle_deg\n";
+  const double trial_s = 12.0 + 4.0;  // three 4 s holds, then 4 s of venting before the next 0 kPa hold
+  auto pressure = [&](double t) {
+    const double local = std::fmod(t, trial_s);
+    if (t > 5.0 && t < 5.5) return 0.0;   // a dip during trial 1's 10 kPa hold
+    if (std::abs(t - 21.0) < 0.001) return 80.0;  // a spike in trial 2's 10 kPa hold
+    if (local < 12.0) return 10.0 * std::floor(local / 4.0);
+    return 20.0 * std::exp(-(local - 12.0) / 0.2);
+  };
+  for (int i = 0; i < static_cast<int>(3 * trial_s * 400); ++i) {
+    const double t = i / 400.0;
+    text += csv::number_text(t) + "," + csv::number_text(pressure(t)) + "," + (i % 13 == 0 ? csv::number_text(t) : "") + "\n";
+  }
+  const Recording r = parse_measurements_csv(text, "log.csv");
+  ASSERT_EQ(r.trials.size(), 3u);
+  const double release_s = 12.0 + 0.2 * std::log(20.0 / 0.4);  // first sample within 0.4 kPa of rest
+  for (int k = 0; k < 3; ++k) {
+    const TrialRecording& tr = r.trials[static_cast<std::size_t>(k)];
+    EXPECT_EQ(tr.trial, k + 1);
+    EXPECT_NEAR(tr.pressure_kPa.t_s.front(), 0.0, 1e-9) << "trial " << k + 1;  // its clock starts at the split
+    // the angle column carries the log's time: each trial's frames are the log's, shifted by its start
+    for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
+      ASSERT_NEAR(tr.angle_deg.value[j] - tr.angle_deg.t_s[j], k == 0 ? 0.0 : tr.angle_deg.value[0] - tr.angle_deg.t_s[0], 1e-9);
+  }
+  EXPECT_NEAR(r.trials[1].angle_deg.value.front(), release_s, 14.0 / 400);   // frames every 13 samples
+  EXPECT_NEAR(r.trials[2].angle_deg.value.front(), trial_s + release_s, 14.0 / 400);
+  EXPECT_NEAR(r.trials[2].angle_deg.value.back(), 3 * trial_s, 14.0 / 400);  // the last trial runs to the end
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("log.csv: no trial column and time_s never restarts: the log was split into 3 trials"),
+            std::string::npos) << r.warnings[0];
+  // One staircase alone, or a log that ends in its rest: one trial, and the usual note.
+  const Recording one = parse_measurements_csv("time_s,pressure_kPa,angle_deg\n0,0,0\n0.5,5,1\n1,5,1\n", "one.csv");
+  ASSERT_EQ(one.trials.size(), 1u);
+  EXPECT_EQ(one.warnings[0], "one.csv: no trial column: the trials are numbered 1, 2, ... where time_s restarts");
 }
 
 // Spreadsheets in locales with a decimal comma save "CSV" with ';' between fields; tab-separated

@@ -2,7 +2,8 @@
 // (its staircase sampled at 400 Hz / 30 fps, driven through simulate_recording) plus a known
 // perturbation of the angle, so the metrics are non-trivial. The CLI's metrics.json must equal
 // the library's numbers, report.html must be well-formed and hold every figure, history.jsonl
-// must grow by one line per run, and malformed data must fail cleanly without touching DIR.
+// must grow by one line per run, and malformed data must fail cleanly without touching DIR. A
+// recording of angles alone is driven by the scene's staircase (compare and diagnose).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -15,8 +16,10 @@
 #include <sstream>
 
 #include "analysis/compare.h"
+#include "analysis/csv_scan.h"
 #include "app/compare.h"
 #include "app/compare_dlc.h"
+#include "app/diagnose.h"
 #include "app/drive.h"
 #include "materials/errors.h"
 #include "scenes/build_model.h"
@@ -177,6 +180,59 @@ TEST_F(CompareCli, WritesEverythingAndMatchesTheLibrary) {
   const fs::path fresh = *dir_ / "fresh";
   EXPECT_EQ(run("compare --data " + (*dir_ / "bad.csv").string() + " --out " + fresh.string()).code, 2);
   EXPECT_FALSE(fs::exists(fresh));
+}
+
+// The same data as video alone (no pressure column, no trial column: each trial's clock restarts
+// at 0): the scene's own staircase drives the model. The rig's record was that staircase sampled
+// without noise, so the model solves the same pressures and the metrics are the library's to the
+// equilibrium tolerance (1e-6 deg on angles of ~5 deg: 1e-6 relative is ample for NRMSEs ~1e-2).
+TEST_F(CompareCli, AnglesAloneAreDrivenByTheScenesProtocol) {
+  const Recording full = read_measurements_csv((*dir_ / "data.csv").string());
+  ASSERT_EQ(full.trials.size(), 2u);
+  std::ofstream video(*dir_ / "video.csv");
+  video << "Time (s),Angle (deg)\n";
+  for (const TrialRecording& tr : full.trials)
+    for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
+      video << csv::number_text(tr.angle_deg.t_s[j]) << "," << csv::number_text(tr.angle_deg.value[j]) << "\n";
+  video.close();
+  const fs::path out = *dir_ / "video_out";
+  const Result r = run("compare " + (*dir_ / "tiny.toml").string() + " --data " + (*dir_ / "video.csv").string() +
+                       " --out " + out.string() + " --threads 2");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("no pressure column: the model is driven by the scene's [load]"), std::string::npos) << r.out;
+  const std::string m = slurp(out / "metrics.json");
+  EXPECT_NEAR(top_number(m, "nrmse"), expected_->nrmse, 1e-6 * expected_->nrmse);
+  EXPECT_EQ(top_number(m, "n"), static_cast<double>(expected_->n));
+  EXPECT_NE(m.find("\"trial\": 2"), std::string::npos);
+}
+
+// diagnose reads angles alone the same way: its baseline (the reduced elastic model against the
+// data) is the one it finds with the pressure record, to the same tolerance as above, and so is the
+// stiffness it calibrates (1e-4: the optimiser's tolerance on the scale).
+TEST_F(CompareCli, DiagnoseOfAnglesAloneMatchesTheRecordWithPressure) {
+  const Recording full = read_measurements_csv((*dir_ / "data.csv").string());
+  std::ofstream video(*dir_ / "video_diag.csv");
+  video << "trial,time_s,angle_deg\n";
+  for (const TrialRecording& tr : full.trials)
+    for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
+      video << tr.trial << "," << csv::number_text(tr.angle_deg.t_s[j]) << "," << csv::number_text(tr.angle_deg.value[j])
+            << "\n";
+  video.close();
+  const Scene scene = Scene::load((*dir_ / "tiny.toml").string());
+  auto diagnose = [&](const std::string& data) {
+    DiagnoseOptions o;
+    o.data_path = (*dir_ / data).string();
+    o.out_dir = (*dir_ / ("diag_" + data)).string();
+    o.candidates = {"stiffness"};
+    o.max_effects = 1;
+    o.threads = 2;
+    return run_diagnosis(scene, o);
+  };
+  const DiagnosisResult with_p = diagnose("data.csv"), alone = diagnose("video_diag.csv");
+  EXPECT_NEAR(alone.baseline_nrmse, with_p.baseline_nrmse, 1e-6 * with_p.baseline_nrmse);
+  ASSERT_EQ(alone.candidates.size(), 1u);
+  ASSERT_EQ(with_p.candidates.size(), 1u);
+  EXPECT_NEAR(alone.candidates[0].params[0], with_p.candidates[0].params[0], 1e-4);
 }
 
 // A model the FEM cannot follow to the end (trial 2's inlet driven 10x past the tiny actuator's

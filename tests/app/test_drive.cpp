@@ -119,6 +119,45 @@ TEST_F(DriveTest, NoiseFreeRecordingReproducesTheDirectRun) {
   EXPECT_GT(std::abs(direct().records.back().angle_deg), 1.0) << "the actuator must bend for this test to mean anything";
 }
 
+// Angles alone (video of a commanded protocol): the scene's own staircase fills the pressure, so
+// the drive must solve the same pressures as from the rig's noise-free pressure record and give
+// the same angle at every frame. Same tolerance as above: two runs to the same equilibria.
+TEST_F(DriveTest, AnglesAloneAreDrivenByTheScenesProtocol) {
+  Recording rec = sampled_staircase(scene(), 0.0, 1);
+  for (TrialRecording& tr : rec.trials) tr.pressure_kPa = Series{};
+  rec.pressure_recorded = false;
+  rec.warnings = {rec.source + ": no pressure column: only angles were recorded"};  // the reader's note: replaced
+  // frames running 3 s past the protocol's trial end are noted (they see the last level held)
+  rec.trials[1].angle_deg.t_s.push_back(rec.trials[1].angle_deg.t_s.back() + 3.0);
+  rec.trials[1].angle_deg.value.push_back(0.0);
+  fill_commanded_pressure(rec, scene());
+  EXPECT_TRUE(rec.pressure_recorded);
+  ASSERT_EQ(rec.warnings.size(), 2u);
+  EXPECT_NE(rec.warnings[0].find("no pressure column: the model is driven by the scene's [load] (staircase 0-30 kPa"),
+            std::string::npos) << rec.warnings[0];
+  EXPECT_NE(rec.warnings[1].find("trial 2 has frames up to time_s = "), std::string::npos) << rec.warnings[1];
+  const LoadHistory load = inlet_load(scene());
+  for (const TrialRecording& tr : rec.trials) {
+    ASSERT_GT(tr.pressure_kPa.t_s.size(), 3000u);  // 16 s at 200 Hz
+    for (std::size_t i = 0; i < tr.pressure_kPa.t_s.size(); ++i)
+      ASSERT_EQ(tr.pressure_kPa.value[i], load.trials[0].pressure(tr.pressure_kPa.t_s[i]) * 1e-3);
+  }
+  DriveOptions opt;
+  opt.threads = 2;
+  const DriveResult r = simulate_recording(scene(), rec, opt);
+  ASSERT_EQ(r.trials.size(), clean().trials.size());
+  for (std::size_t k = 0; k < r.trials.size(); ++k)
+    for (std::size_t j = 0; j < clean().trials[k].angle_deg.t_s.size(); ++j)
+      EXPECT_NEAR(r.trials[k].angle_deg.value[j], clean().trials[k].angle_deg.value[j], 1e-6) << "trial " << k + 1;
+  EXPECT_GT(std::abs(r.trials[1].angle_deg.value.back()), 1.0);
+  // A recording with pressure is left as it is.
+  Recording measured = sampled_staircase(scene(), 0.1, 2);
+  const Series before = measured.trials[0].pressure_kPa;
+  fill_commanded_pressure(measured, scene());
+  EXPECT_EQ(measured.trials[0].pressure_kPa.value, before.value);
+  EXPECT_TRUE(measured.warnings.empty());
+}
+
 TEST_F(DriveTest, PressureNoiseChangesTheAnglesOnlyWithinTheDenoisingBound) {
   const double sigma = 0.2;  // kPa, a typical inlet sensor
   DriveOptions opt;
