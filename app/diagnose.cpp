@@ -26,6 +26,7 @@
 #include "app/effect_catalog.h"
 #include "app/elastic_curve.h"
 #include "materials/errors.h"
+#include "scenes/build_model.h"
 
 namespace pneufem {
 
@@ -154,8 +155,38 @@ void describe_static_remainder(const Comparison& final_cmp, const StaticFit& st,
 
 }  // namespace
 
-DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt) {
+// Auto (requested < 0): a built-in mesh of more than kAutoCalibrationDofs is calibrated on the same
+// mesher at three times its element size. What grows with the mesh is the elastic path trace and
+// the gravity candidate's FEM sweeps, more than linearly near a limit point: on the default actuator
+// (h = 2, 109k dof) 66 min on a shared machine against 8.6-11 min idle, with the same ranking and
+// missing effect (BENCHMARKS.md §8). A deck is its own mesh: only a note.
+double resolve_calibration_h(const Scene& scene, double requested_mm, std::vector<std::string>& notes) {
+  constexpr long kAutoCalibrationDofs = 50000;
+  if (requested_mm >= 0.0) return requested_mm;
+  const Mesh mesh = build_mesh(scene);
+  const long dofs = 3 * static_cast<long>(mesh.num_nodes());
+  if (dofs <= kAutoCalibrationDofs) return 0.0;
+  if (scene.string("mesh.source") != "pneunet") {
+    notes.push_back("the scene's mesh has " + std::to_string(dofs) +
+                    " dof: tracing its elastic path and the gravity candidate's FEM sweeps will take long; a coarser "
+                    "deck calibrates faster (then --verify on this one)");
+    return 0.0;
+  }
+  const double h = 3.0 * scene.number("mesh.h_mm");
+  notes.push_back("the scene's mesh has " + std::to_string(dofs) + " dof: the candidates are calibrated on the built-in " +
+                  "mesher at h = " + fmt("%g", h) + " mm through the scene mesh's elastic curve (--calibration-h " +
+                  fmt("%g", h) + "; --calibration-h 0 calibrates on the scene's mesh, slower)");
+  return h;
+}
+
+DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in) {
   const auto t0 = std::chrono::steady_clock::now();
+  DiagnoseOptions opt = opt_in;
+  {
+    std::vector<std::string> notes;
+    opt.calibration_h_mm = resolve_calibration_h(scene, opt_in.calibration_h_mm, notes);
+    for (const std::string& n : notes) std::fprintf(stderr, "note: %s\n", n.c_str());
+  }
   if (opt.out_dir.empty()) throw InputError("diagnose: --out DIR is required");
   if (opt.max_effects < 1) throw InputError("diagnose: --max-effects must be >= 1");
   std::vector<const CandidateEffect*> cands;

@@ -76,8 +76,10 @@ struct DiagnoseOptions {
   int fem_calibration_runs = 0;
   /// > 0: calibrate on the built-in mesher at this element size (mm) instead of the scene's mesh,
   /// with an elastic mesh correction from one static sweep of each mesh (see RomEvaluator in
-  /// app/diagnose_model.h); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh.
-  double calibration_h_mm = 0.0;
+  /// app/diagnose_model.h); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh;
+  /// < 0 = auto: 3x the scene's element size for a built-in mesh of more than 50k dof, else the
+  /// scene's mesh (a note on stderr says which).
+  double calibration_h_mm = -1.0;
   int threads = 0;
   bool progress = false;
   std::string command_line;
@@ -156,6 +158,12 @@ struct DiagnosisResult {
 
 /// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
 /// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
+/// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
+/// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more
+/// than 50k dof, else 0 (the scene's mesh; for a large deck with a note suggesting a coarser one).
+/// What was chosen and why goes to `notes`.
+double resolve_calibration_h(const Scene& scene, double requested_mm, std::vector<std::string>& notes);
+
 DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options);
 
 /// Names of the parameters of `c` whose calibrated `values` lie within 1 % of the calibrated range

@@ -63,8 +63,9 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
                      "Calibrate on the built-in mesher at this element size (mm, e.g. 6) instead of the scene's mesh, "
                      "with an elastic correction from one static sweep of the scene's mesh: for large meshes "
                      "(BENCHMARKS.md: same ranking as the default mesh); --verify/--refine/--fem-calibrate and "
-                     "fitted.toml keep the scene's mesh")
-      ->check(CLI::Range(0.1, 1000.0));
+                     "fitted.toml keep the scene's mesh. Default: 3x the scene's element size when its built-in mesh "
+                     "has more than 50k dof (the default actuator: 6), else the scene's mesh; 0 = the scene's mesh")
+      ->check(CLI::Range(0.0, 1000.0));
   c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
   c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));

@@ -287,6 +287,25 @@ TEST(CalibrationMesh, NeedsTheBuiltInMesher) {
   EXPECT_FALSE(fs::exists(dir / "diagnosis.json"));
 }
 
+// Without --calibration-h, a large built-in mesh is calibrated on a coarser one (the default
+// actuator: 108 852 dof at h = 2 -> 6 mm) and a small one on itself; a value given is kept (0 = the
+// scene's mesh); a note says which. The threshold (50k dof) sits between the 3-chamber actuator at
+// h = 2 (27k) and the default one (109k).
+TEST(CalibrationMesh, ChosenForLargeBuiltInMeshesUnlessGiven) {
+  std::vector<std::string> notes;
+  const Scene def = Scene::load("", {});
+  EXPECT_EQ(resolve_calibration_h(def, -1.0, notes), 6.0);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("108852 dof: the candidates are calibrated on the built-in mesher at h = 6 mm"), std::string::npos)
+      << notes[0];
+  notes.clear();
+  EXPECT_EQ(resolve_calibration_h(def, 0.0, notes), 0.0);
+  EXPECT_EQ(resolve_calibration_h(def, 4.0, notes), 4.0);
+  EXPECT_EQ(resolve_calibration_h(Scene::load("", {"geometry.chambers=3", "mesh.h_mm=2"}), -1.0, notes), 0.0);
+  EXPECT_EQ(resolve_calibration_h(def.with({"mesh.h_mm=6"}), -1.0, notes), 0.0);
+  EXPECT_TRUE(notes.empty());
+}
+
 TEST(HiddenEffect, NoneGivesNoMissingEffect) {
   const DiagnosisResult r = diagnose("none");
   EXPECT_EQ(r.missing_effect, "");
