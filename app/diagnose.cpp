@@ -547,7 +547,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   out.final_nrmse = current.nrmse;
   describe_static_remainder(current, current_static, opt, out);
 
-  refine_with_fem(scene, cal_scene, rec, frames, rom, opt, chosen, selected_sets, rom_runs, out);
+  std::vector<Series> fitted_fem;  // the FEM traces of the refined constants, when a refinement ran them
+  refine_with_fem(scene, cal_scene, rec, frames, rom, opt, chosen, selected_sets, rom_runs, out, &fitted_fem);
   out.rom_runs = rom_runs;
 
   const Scene fitted = scene.with(selected_sets);
@@ -556,7 +557,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
                     (out.selected.size() > 1 ? " + " + out.selected[1] : std::string()) + ") with calibrated constants.\n" +
                     "# Data: " + opt.data_path + "\n" + fitted.to_toml();
 
-  if (opt.verify || opt.refine > 0 || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out);
+  if (opt.verify || opt.refine > 0 || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   write_diagnosis(scene, fitted, rom, chosen, opt, out);

@@ -49,8 +49,9 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       ->capture_default_str();
   c->cmd->add_flag("--verify", c->options.verify, "Also run the baseline and the fitted scene with the full FEM");
   c->cmd->add_option("--refine", c->options.refine,
-                     "Full-FEM corrections of the selected effects' constants (space mapping; each costs one FEM run "
-                     "plus a verification); recommended for damage effects (mullins, fatigue)")
+                     "Full-FEM corrections of the selected effects' constants (space mapping: N corrections cost N + 1 "
+                     "FEM runs of the recording, plus one of the baseline); recommended for damage effects (mullins, "
+                     "fatigue)")
       ->check(CLI::Range(0, 5))
       ->capture_default_str();
   c->cmd->add_option("--fem-calibrate", c->options.fem_calibration_runs,

@@ -93,19 +93,22 @@ std::string evidence(const std::string& effect, const Signature& s);
 // ---- full FEM (diagnose_fem.cpp)
 
 /// --refine and --fem-calibrate: re-calibrates the constants of `chosen` against the full FEM of
-/// `scene` (space mapping on the reduced model of `cal_scene`, then local FEM calibration), and
-/// keeps those of the best complete FEM run. Updates `chosen`, `selected_sets` (the scene
-/// overrides of `chosen`), `rom_runs` and out.fem_error / out.refined_params. Does nothing when
-/// neither is asked for or nothing was selected.
+/// `scene` (space mapping on the reduced model of `cal_scene`, N + 1 FEM runs for --refine N, then
+/// local FEM calibration), and keeps those of the best complete FEM run. Updates `chosen`,
+/// `selected_sets` (the scene overrides of `chosen`), `rom_runs` and out.fem_error /
+/// out.refined_params; `fitted_fem` (if given) gets the FEM angle traces of the kept constants when
+/// a refinement run computed them (else it is left empty). Does nothing when neither is asked for
+/// or nothing was selected.
 void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
                      const std::vector<ComparedFrame>& frames, const RomEvaluator& rom, const DiagnoseOptions& opt,
                      ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
-                     DiagnosisResult& out);
+                     DiagnosisResult& out, std::vector<Series>* fitted_fem = nullptr);
 
 /// --verify: the full-FEM NRMSEs of the baseline `scene` and of `fitted` (out.verified_*; -1 and a
-/// note in out.fem_error when a run fails).
+/// note in out.fem_error when a run fails). `fitted_fem`, when non-empty, are the FEM traces of
+/// `fitted` already computed (by refine_with_fem): its run is not repeated.
 void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& rec, const DiagnoseOptions& opt,
-                     DiagnosisResult& out);
+                     DiagnosisResult& out, const std::vector<Series>* fitted_fem = nullptr);
 
 // ---- outputs (diagnose_output.cpp)
 

@@ -19,7 +19,7 @@ namespace pneufem::diagnose_detail {
 void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
                      const std::vector<ComparedFrame>& frames, const RomEvaluator& rom, const DiagnoseOptions& opt,
                      ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
-                     DiagnosisResult& out) {
+                     DiagnosisResult& out, std::vector<Series>* fitted_fem) {
   // Space mapping (output correction): the reduced model is a 1-dof Ritz model and misjudges
   // strongly localised effects (damage concentrated in the walls) by up to a factor ~2 in angle
   // change (tests/app/test_path_model.cpp). Each refinement runs the full FEM once at the current
@@ -33,13 +33,18 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
   // frames the FEM did solve: the correction is applied there and the reduced model alone is used
   // after the failure. Re-calibrating against that moves the constants towards what the FEM can
   // follow, and the next refinement's FEM gets further (an FEM-verified continuation).
-  auto fem_at_frames = [&](const Scene& s, std::string* failure, double* failure_time_s) {
+  auto fem_at_frames = [&](const Scene& s, std::string* failure, double* failure_time_s,
+                           std::vector<Series>* traces = nullptr) {
     DriveOptions d;
     d.threads = opt.threads;
     d.partial_on_failure = true;
     const DriveResult dr = simulate_recording(s, rec, d);
     *failure = dr.failure;
     *failure_time_s = dr.failure_time_s;
+    if (traces) {
+      traces->clear();
+      for (const TrialTrace& t : dr.trials) traces->push_back(t.angle_deg);
+    }
     std::vector<double> v(frames.size());
     for (std::size_t i = 0; i < frames.size(); ++i) {
       const Series& a = dr.trials[frames[i].trial_index].angle_deg;
@@ -79,24 +84,33 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
   };
   auto chosen_best = chosen;
   double best_fem_rss = std::numeric_limits<double>::infinity();  // complete FEM runs only
-  for (int it = 0; it < opt.refine && !chosen.empty(); ++it) {
-    if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d with the full FEM ...\n", it + 1);
+  if (fitted_fem) fitted_fem->clear();
+  // Run 0 scores the reduced model's constants and gives the first correction; run k = 1..N scores
+  // the k-th re-calibration (and corrects the next). So --refine N costs N + 1 FEM runs, and the
+  // constants returned have always been run by the FEM (the last re-calibration too: before
+  // 2026-11-26 it was never run, so --refine 1 returned the reduced model's constants unchanged).
+  for (int it = 0; it <= opt.refine && !chosen.empty(); ++it) {
+    if (opt.progress)
+      std::fprintf(stderr, it == 0 ? "diagnose: the reduced model's constants with the full FEM ...\n"
+                                   : "diagnose: refinement %d with the full FEM ...\n", it);
     std::string failure;
     double failure_time_s = -1.0;
-    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets), &failure, &failure_time_s);
+    std::vector<Series> traces;
+    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets), &failure, &failure_time_s, &traces);
     std::size_t solved = 0;
     for (double v : fem) solved += std::isfinite(v) ? 1 : 0;
     if (!failure.empty()) {
       std::ostringstream m;
-      m << "refinement " << it + 1 << ": the full FEM stopped at t = " << failure_time_s << " s of trial "
+      m << (it == 0 ? std::string("the reduced model's constants") : "refinement " + std::to_string(it))
+        << ": the full FEM stopped at t = " << failure_time_s << " s of trial "
         << frames[std::min(solved, frames.size() - 1)].trial_index + 1 << " (" << solved << " of " << frames.size()
         << " frames solved; corrected there, reduced model alone after): " << failure;
       out.fem_error += (out.fem_error.empty() ? "" : "; ") + m.str();
       if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", m.str().c_str());
-      if (solved == 0) break;
+      if (solved == 0 || it == opt.refine) break;
     } else {
       const double fem_rss = rss_of(fem, frames);
-      if (opt.progress) std::fprintf(stderr, "diagnose: refinement %d: FEM rss %.4g deg^2 (best %.4g)\n", it + 1, fem_rss, best_fem_rss);
+      if (opt.progress) std::fprintf(stderr, "diagnose: FEM rss %.4g deg^2 (best before %.4g)\n", fem_rss, best_fem_rss);
       if (!(fem_rss < best_fem_rss) && std::isfinite(best_fem_rss)) {
         // Worse than the best complete run: step halfway back, no new correction.
         for (std::size_t j = 0; j < chosen.size(); ++j) {
@@ -112,6 +126,8 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
       }
       best_fem_rss = fem_rss;
       chosen_best = chosen;
+      if (fitted_fem) *fitted_fem = std::move(traces);
+      if (it == opt.refine) break;  // the last run only scores
     }
     const std::vector<double> romv = rom.at_frames(cal_scene.with(selected_sets));
     std::vector<double> corr(fem.size());
@@ -156,6 +172,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
         chosen[j].second = cal.values;
         best_fem_rss = cal.rss;
         chosen_best = chosen;
+        if (fitted_fem) fitted_fem->clear();  // not the traces of these constants any more
       }
     }
     selected_sets = sets_of(chosen);
@@ -173,7 +190,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
 }
 
 void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& rec, const DiagnoseOptions& opt,
-                     DiagnosisResult& out) {
+                     DiagnosisResult& out, const std::vector<Series>* fitted_fem) {
   DriveOptions d;
   d.threads = opt.threads;
   auto fem_nrmse = [&](const Scene& s, const char* which) {
@@ -190,7 +207,8 @@ void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& r
     }
   };
   out.verified_baseline_nrmse = fem_nrmse(scene, "baseline");
-  out.verified_fitted_nrmse = fem_nrmse(fitted, "fitted");
+  out.verified_fitted_nrmse = fitted_fem && !fitted_fem->empty() ? compare_recording(rec, *fitted_fem).nrmse
+                                                                  : fem_nrmse(fitted, "fitted");
 }
 
 }  // namespace pneufem::diagnose_detail
