@@ -89,7 +89,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
   // the k-th re-calibration (and corrects the next). So --refine N costs N + 1 FEM runs, and the
   // constants returned have always been run by the FEM (the last re-calibration too: before
   // 2026-11-26 it was never run, so --refine 1 returned the reduced model's constants unchanged).
-  for (int it = 0; it <= opt.refine && !chosen.empty(); ++it) {
+  for (int it = 0; opt.refine > 0 && it <= opt.refine && !chosen.empty(); ++it) {
     if (opt.progress)
       std::fprintf(stderr, it == 0 ? "diagnose: the reduced model's constants with the full FEM ...\n"
                                    : "diagnose: refinement %d with the full FEM ...\n", it);

@@ -158,17 +158,18 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options) : 
         pt_qp_.push_back(q);
         pt_weight_.push_back(geom.w(e, q));
       }
-  } else if (ne <= opt_.max_points) {
-    for (int e = 0; e < ne; ++e) {
-      pt_element_.push_back(e);
-      pt_qp_.push_back(-1);
-      pt_weight_.push_back(geom.volume[e]);
-    }
   } else {
-    // Importance sample: probability pi_e = (volume share + energy share at the path's top) / 2;
-    // systematic sampling of n positions on the cumulative distribution; each pick carries the
-    // Horvitz-Thompson weight vol_e / (n pi_e), so sums over picks estimate volume integrals
-    // without bias, while the high-energy elements (where damage lives) are densely covered.
+    // Importance sample of elements: probability pi_e = (volume share + energy share at the path's
+    // top) / 2; systematic sampling of n positions on the cumulative distribution; each pick keeps
+    // every quadrature point of its element, with the Horvitz-Thompson weight w_eq / (n pi_e), so
+    // sums over picks estimate volume integrals without bias, while the high-energy elements (where
+    // damage lives) are densely covered. Every quadrature point, not the element centroid: the
+    // interior walls bend, and the centroid (the element's mean strain) misses the bending strain
+    // that varies through a wall one or two quadratic elements thick. History driven by it is then
+    // underestimated — by a third of the creep near the default actuator's limit point with
+    // viscoelasticity (2026-11-26: 4.4 deg instead of the FEM's 6.4 deg after a 16 s hold at
+    // 45 kPa; 6.1 deg with every quadrature point), whatever the number of elements sampled.
+    const int n = std::max(1, opt_.max_points / geom.nqp);
     std::vector<double> energy(ne);
     double vtot = 0.0, etot = 0.0;
     for (int e = 0; e < ne; ++e) {
@@ -181,16 +182,17 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options) : 
       vtot += geom.volume[e];
       etot += energy[e];
     }
-    const int n = opt_.max_points;
     double cum = 0.0;
     int next = 0;
     for (int e = 0; e < ne && next < n; ++e) {
       const double pi = 0.5 * geom.volume[e] / vtot + (etot > 0.0 ? 0.5 * energy[e] / etot : 0.5 * geom.volume[e] / vtot);
       cum += pi;
       while (next < n && (next + 0.5) / n < cum) {
-        pt_element_.push_back(e);
-        pt_qp_.push_back(-1);
-        pt_weight_.push_back(geom.volume[e] / (n * pi));
+        for (int q = 0; q < geom.nqp; ++q) {
+          pt_element_.push_back(e);
+          pt_qp_.push_back(q);
+          pt_weight_.push_back(geom.w(e, q) / (n * pi));
+        }
         ++next;
       }
     }

@@ -28,8 +28,9 @@
 // damage) is represented by its best path point (Ritz/Galerkin: first order in the shape change
 // for the angle, second order for the energy). Tests bound the angle error against the FEM for
 // every built-in effect. Material points: all quadrature points of small meshes; above
-// `max_points`, an importance sample of elements (probability ~ half volume share + half
-// strain-energy share at the top of the path, Horvitz-Thompson weights), deterministic.
+// `max_points`, an importance sample of max_points / (points per element) elements (probability
+// ~ half volume share + half strain-energy share at the top of the path, Horvitz-Thompson weights),
+// each with all its quadrature points (not its centroid: the walls bend), deterministic.
 //
 // Units: SI; angles in degrees at the interface.
 #include <vector>
@@ -85,7 +86,7 @@ class PathModel {
   std::vector<double> theta_, p_, V_;       ///< per path sample
   std::vector<Eigen::Vector3d> S_;          ///< first mass moment of u per sample (kg m)
   std::vector<int> pt_element_;             ///< element of each material point
-  std::vector<int> pt_qp_;                  ///< its quadrature point (-1 = element centroid)
+  std::vector<int> pt_qp_;                  ///< its quadrature point
   std::vector<double> pt_weight_;           ///< quadrature weight (m^3)
   std::vector<Mat3> F_;                     ///< [sample][point]
   std::vector<double> dp_dtheta_;           ///< monotone cubic slopes of p_el(theta) at the samples

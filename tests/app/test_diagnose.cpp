@@ -210,10 +210,11 @@ TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
 
 // --refine 1: one space-mapping step (the FEM at the reduced model's constants gives a correction,
 // the constants are re-calibrated on the corrected reduced model, the FEM runs them too). Same case
-// as above: the reduced model's scale is 2.6 % off the truth (0.779); a space-mapping step on a
-// smooth one-parameter problem removes most of that (the correction changes little with the scale).
-// Before 2026-11-26 the re-calibrated constants were never run by the FEM and --refine 1 returned
-// the reduced model's own. The verified NRMSE is that of the last FEM run (not repeated).
+// as above: the reduced model's scale is 0.8 % off the truth (0.8062); a space-mapping step on a
+// smooth one-parameter problem removes most of that, as the correction changes little with the
+// scale (measured 0.8010: a sixth of the error left; asserted: under a quarter). Before 2026-11-26
+// the re-calibrated constants were never run by the FEM and --refine 1 returned the reduced
+// model's own. The verified NRMSE is that of the last FEM run (not repeated; measured 0.0012).
 TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
   const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
                                        "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
@@ -229,7 +230,7 @@ TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
   const double rom_scale = r.candidates.front().params[0], refined = r.refined_params[0][0];
   std::printf("scale: reduced model %.5f, refined %.5f (truth 0.8); FEM NRMSE %.5f\n", rom_scale, refined,
               r.verified_fitted_nrmse);
-  EXPECT_GT(std::abs(rom_scale - 0.8), 0.01 * 0.8);  // the case needs a biased reduced model
+  EXPECT_GT(std::abs(rom_scale - 0.8), 0.004 * 0.8);  // the case needs a biased reduced model
   EXPECT_LT(std::abs(refined - 0.8), 0.25 * std::abs(rom_scale - 0.8));
   EXPECT_GE(r.verified_fitted_nrmse, 0.0);
   EXPECT_LT(r.verified_fitted_nrmse, 0.01);
@@ -239,11 +240,12 @@ TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
 // --calibration-h: calibrate on a coarser built-in mesh, driven through the pressure map that makes
 // its elastic path the scene mesh's (app/diagnose_model.h, RomEvaluator). Case: a 3-chamber actuator
 // whose h = 8 mesh is 19 % stiffer in angle than its h = 3 mesh, data from the h = 3 FEM with the
-// silicone 20 % softer (noise-free). Measured: scene mesh baseline 0.1649 and scale 0.794; calibration
-// mesh 0.1649 and 0.785; the raw h = 8 mesh 0.2213 and 0.696. So: the baseline within 1 % (the map
-// is exact for the elastic baseline up to interpolation; raw differs by 34 %), the scale within
-// 3 % of the truth (the reduced model's own ~1 % plus the map's neglect of how the mesh error
-// changes with the scale; raw is 13 % off) and the same ranking of all six candidates, except
+// silicone 20 % softer (noise-free). Measured: scene mesh baseline 0.1696 and scale 0.8037; calibration
+// mesh 0.1696 and 0.8123; the raw h = 8 mesh 0.2275 and 0.7346 (before the reduced model sampled
+// every quadrature point of its elements, 2026-11-26: 0.794, 0.785, 0.696). So: the baseline within
+// 1 % (the map is exact for the elastic baseline up to interpolation; raw differs by 34 %), the scale
+// within 3 % of the truth (the reduced model's own ~1 % plus the map's neglect of how the mesh error
+// changes with the scale; raw is 8 % off) and the same ranking of all six candidates, except
 // between candidates whose errors on the scene mesh are within 2 % of each other (a tie at the
 // reduced model's accuracy). fitted.toml keeps the scene's mesh.
 TEST(CalibrationMesh, GivesTheSceneMeshsBaselineRankingAndConstants) {
@@ -274,7 +276,7 @@ TEST(CalibrationMesh, GivesTheSceneMeshsBaselineRankingAndConstants) {
   ASSERT_EQ(cal.selected, std::vector<std::string>{"stiffness"});
   ASSERT_EQ(fine.selected, std::vector<std::string>{"stiffness"});
   EXPECT_NEAR(cal.candidates.front().params[0], 0.8, 0.03 * 0.8);
-  EXPECT_GT(std::abs(raw.candidates.front().params[0] - 0.8), 0.08);
+  EXPECT_GT(std::abs(raw.candidates.front().params[0] - 0.8), 0.05);
 
   ASSERT_EQ(cal.candidates.size(), fine.candidates.size());
   std::map<std::string, std::size_t> rank;
