@@ -59,23 +59,23 @@ std::string canonical_name(const std::string& header_name) {
   return out;
 }
 
-/// Whether a header cell starts with `stem` ("pressure" matches "pressure", "pressure_inh2o").
-bool has_stem(const std::vector<std::string>& names, const std::string& stem) {
+/// The first header name (lower case, as csv::header_name gives them) that starts with the stem of
+/// `column` ("pressure" for pressure_kPa: "pressure", "pressure_inh2o"), or nullptr.
+const std::string* header_with_stem(const std::vector<std::string>& names, const std::string& column) {
+  const std::string stem = lower(column.substr(0, column.find('_')));
   for (const std::string& n : names)
-    if (lower(n).rfind(stem, 0) == 0) return true;
-  return false;
+    if (n.rfind(stem, 0) == 0) return &n;
+  return nullptr;
 }
 
 /// A hint for a missing required column: a header cell that shares its stem ("pressure" for
 /// pressure_kPa) was probably meant, with another unit or none.
 std::string missing_column_hint(const std::string& required, const std::vector<std::string>& names) {
-  const std::string stem = lower(required.substr(0, required.find('_')));
-  for (const std::string& n : names)
-    if (n.rfind(stem, 0) == 0)
-      return "the header has '" + n + "': rename it to " + required +
-             " (the unit is part of the name; convert the values if they are in another unit; units read and "
-             "converted: time_s, time_ms, time_min; pressure_kPa, pressure_Pa, pressure_hPa, pressure_mbar, "
-             "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
+  if (const std::string* n = header_with_stem(names, required))
+    return "the header has '" + *n + "': rename it to " + required +
+           " (the unit is part of the name; convert the values if they are in another unit; units read and "
+           "converted: time_s, time_ms, time_min; pressure_kPa, pressure_Pa, pressure_hPa, pressure_mbar, "
+           "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
   return "add the column; the header must name trial,time_s,pressure_kPa,angle_deg (any order, "
          "other columns are ignored, cells of pressure_kPa or angle_deg may be empty)";
 }
@@ -125,6 +125,7 @@ void split_at_releases(Recording& rec) {
   if (cut.empty()) return;
   const TrialRecording all = std::move(rec.trials[0]);
   rec.trials.assign(cut.size() + 1, TrialRecording{});
+  for (std::size_t k = 0; k < rec.trials.size(); ++k) rec.trials[k].trial = static_cast<int>(k + 1);
   auto distribute = [&](const Series& s, Series TrialRecording::*member) {
     std::size_t k = 0;
     for (std::size_t i = 0; i < s.t_s.size(); ++i) {
@@ -137,11 +138,7 @@ void split_at_releases(Recording& rec) {
   distribute(all.pressure_kPa, &TrialRecording::pressure_kPa);
   distribute(all.angle_deg, &TrialRecording::angle_deg);
   std::string at;
-  for (std::size_t k = 0; k < cut.size(); ++k) {
-    rec.trials[k].trial = static_cast<int>(k + 1);
-    at += (k ? ", " : "") + csv::number_text(cut[k]);
-  }
-  rec.trials.back().trial = static_cast<int>(cut.size() + 1);
+  for (std::size_t k = 0; k < cut.size(); ++k) at += (k ? ", " : "") + csv::number_text(cut[k]);
   for (std::string& w : rec.warnings)
     if (w.find(": no trial column:") != std::string::npos)
       w = rec.source + ": no trial column and time_s never restarts: the log was split into " +
@@ -248,7 +245,7 @@ class CanonicalReader {
       auto_trials_ = true;
       conversions_.push_back(source_ + ": no trial column: the trials are numbered 1, 2, ... where time_s restarts");
     }
-    if (column_[kPressure] < 0 && !has_stem(names, "pressure")) {
+    if (column_[kPressure] < 0 && !header_with_stem(names, kColumns[kPressure])) {
       // Angles alone (video tracking of a commanded protocol, as the seed paper's): the caller drives
       // the model with the scene's own [load] (app/drive.h, fill_commanded_pressure). A header that
       // names a pressure in an unknown unit is still an error below: that column was meant.

@@ -156,14 +156,14 @@ struct DiagnosisResult {
   long rom_runs = 0;
 };
 
-/// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
-/// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
 /// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
 /// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more
 /// than 50k dof, else 0 (the scene's mesh; for a large deck with a note suggesting a coarser one).
 /// What was chosen and why goes to `notes`.
 double resolve_calibration_h(const Scene& scene, double requested_mm, std::vector<std::string>& notes);
 
+/// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
+/// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
 DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options);
 
 /// Names of the parameters of `c` whose calibrated `values` lie within 1 % of the calibrated range

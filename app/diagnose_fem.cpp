@@ -89,7 +89,8 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
   // the k-th re-calibration (and corrects the next). So --refine N costs N + 1 FEM runs, and the
   // constants returned have always been run by the FEM (the last re-calibration too: before
   // 2026-11-26 it was never run, so --refine 1 returned the reduced model's constants unchanged).
-  for (int it = 0; opt.refine > 0 && it <= opt.refine && !chosen.empty(); ++it) {
+  const int fem_runs = opt.refine > 0 ? opt.refine + 1 : 0;
+  for (int it = 0; it < fem_runs && !chosen.empty(); ++it) {
     if (opt.progress)
       std::fprintf(stderr, it == 0 ? "diagnose: the reduced model's constants with the full FEM ...\n"
                                    : "diagnose: refinement %d with the full FEM ...\n", it);
@@ -107,7 +108,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
         << " frames solved; corrected there, reduced model alone after): " << failure;
       out.fem_error += (out.fem_error.empty() ? "" : "; ") + m.str();
       if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", m.str().c_str());
-      if (solved == 0 || it == opt.refine) break;
+      if (solved == 0 || it + 1 == fem_runs) break;
     } else {
       const double fem_rss = rss_of(fem, frames);
       if (opt.progress) std::fprintf(stderr, "diagnose: FEM rss %.4g deg^2 (best before %.4g)\n", fem_rss, best_fem_rss);
@@ -127,7 +128,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
       best_fem_rss = fem_rss;
       chosen_best = chosen;
       if (fitted_fem) *fitted_fem = std::move(traces);
-      if (it == opt.refine) break;  // the last run only scores
+      if (it + 1 == fem_runs) break;  // the last run only scores
     }
     const std::vector<double> romv = rom.at_frames(cal_scene.with(selected_sets));
     std::vector<double> corr(fem.size());

@@ -264,8 +264,8 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
   std::vector<Mat3> Fbuf;
   std::vector<PointResponse> rbuf;
 
-  // Non-local drivers (engine/nonlocal.h) over the reduced model's own points: quadrature points or
-  // element centroids, with their (importance-sampling) weights as volumes; the same protocol as the
+  // Non-local drivers (engine/nonlocal.h) over the reduced model's own quadrature
+  // points, with their (importance-sampling) weights as volumes; the same protocol as the
   // FEM's Assembler::update_nonlocal, after every committed state.
   std::unique_ptr<NonlocalAverage> nonlocal;
   std::vector<std::pair<int, std::size_t>> pt_slot(np, {-1, 0});  // (group, index within it) per point
@@ -284,11 +284,7 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
       const auto [it, added] = group_of.emplace(std::make_pair(spec.kind, spec.radius_m), static_cast<int>(radius.size()));
       if (added) radius.push_back(spec.radius_m);
       const int e = pt_element_[i], npe = ref_.mesh.npe();
-      if (pt_qp_[i] >= 0) {
-        tet_shape(ref_.mesh.type, rule[pt_qp_[i]].xi, rule[pt_qp_[i]].eta, rule[pt_qp_[i]].zeta, N.data(), dN.data());
-      } else {
-        tet_shape(ref_.mesh.type, 0.25, 0.25, 0.25, N.data(), dN.data());
-      }
+      tet_shape(ref_.mesh.type, rule[pt_qp_[i]].xi, rule[pt_qp_[i]].eta, rule[pt_qp_[i]].zeta, N.data(), dN.data());
       for (int a = 0; a < npe; ++a) pts[i].X += N[a] * ref_.mesh.X[ref_.mesh.element(e)[a]];
       pts[i].volume_m3 = pt_weight_[i];
       pts[i].group = it->second;

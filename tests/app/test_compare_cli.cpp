@@ -113,6 +113,18 @@ class CompareCli : public ::testing::Test {
     delete expected_;
     delete dir_;
   }
+  /// data.csv's angles alone, as video tracking writes them: no pressure column; with a trial
+  /// column, or without one (each trial's clock restarting at 0).
+  static void write_angles_alone(const fs::path& path, bool trial_column) {
+    const Recording full = read_measurements_csv((*dir_ / "data.csv").string());
+    ASSERT_EQ(full.trials.size(), 2u);
+    std::ofstream out(path);
+    out << (trial_column ? "trial,time_s,angle_deg\n" : "Time (s),Angle (deg)\n");
+    for (const TrialRecording& tr : full.trials)
+      for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
+        out << (trial_column ? std::to_string(tr.trial) + "," : "") << csv::number_text(tr.angle_deg.t_s[j]) << ","
+            << csv::number_text(tr.angle_deg.value[j]) << "\n";
+  }
   static fs::path* dir_;
   static Comparison* expected_;
 };
@@ -187,14 +199,7 @@ TEST_F(CompareCli, WritesEverythingAndMatchesTheLibrary) {
 // without noise, so the model solves the same pressures and the metrics are the library's to the
 // equilibrium tolerance (1e-6 deg on angles of ~5 deg: 1e-6 relative is ample for NRMSEs ~1e-2).
 TEST_F(CompareCli, AnglesAloneAreDrivenByTheScenesProtocol) {
-  const Recording full = read_measurements_csv((*dir_ / "data.csv").string());
-  ASSERT_EQ(full.trials.size(), 2u);
-  std::ofstream video(*dir_ / "video.csv");
-  video << "Time (s),Angle (deg)\n";
-  for (const TrialRecording& tr : full.trials)
-    for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
-      video << csv::number_text(tr.angle_deg.t_s[j]) << "," << csv::number_text(tr.angle_deg.value[j]) << "\n";
-  video.close();
+  write_angles_alone(*dir_ / "video.csv", false);
   const fs::path out = *dir_ / "video_out";
   const Result r = run("compare " + (*dir_ / "tiny.toml").string() + " --data " + (*dir_ / "video.csv").string() +
                        " --out " + out.string() + " --threads 2");
@@ -210,14 +215,7 @@ TEST_F(CompareCli, AnglesAloneAreDrivenByTheScenesProtocol) {
 // data) is the one it finds with the pressure record, to the same tolerance as above, and so is the
 // stiffness it calibrates (1e-4: the optimiser's tolerance on the scale).
 TEST_F(CompareCli, DiagnoseOfAnglesAloneMatchesTheRecordWithPressure) {
-  const Recording full = read_measurements_csv((*dir_ / "data.csv").string());
-  std::ofstream video(*dir_ / "video_diag.csv");
-  video << "trial,time_s,angle_deg\n";
-  for (const TrialRecording& tr : full.trials)
-    for (std::size_t j = 0; j < tr.angle_deg.t_s.size(); ++j)
-      video << tr.trial << "," << csv::number_text(tr.angle_deg.t_s[j]) << "," << csv::number_text(tr.angle_deg.value[j])
-            << "\n";
-  video.close();
+  write_angles_alone(*dir_ / "video_diag.csv", true);
   const Scene scene = Scene::load((*dir_ / "tiny.toml").string());
   auto diagnose = [&](const std::string& data) {
     DiagnoseOptions o;

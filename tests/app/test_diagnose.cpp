@@ -184,16 +184,25 @@ TEST(StaticDiscrepancy, RemovesAStaticMisfitAndKeepsHistoryEffects) {
   for (double c : f.coefficients_deg) EXPECT_TRUE(std::isfinite(c));
 }
 
-TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
-  const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
-                                       "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
-  const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_femcal");
-
+/// The FEM stages' case: a 3-chamber actuator, one trial to 20 kPa, noise-free data from its FEM with
+/// the silicone 20 % softer (in `dir`); the options calibrate the stiffness alone.
+Scene fem_stage_scene() {
+  return Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10", "load.hold_s=3",
+                          "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
+}
+DiagnoseOptions stiffness_only(const fs::path& dir) {
   DiagnoseOptions o;
   o.data_path = (dir / "data.csv").string();
   o.out_dir = (dir / "out").string();
   o.candidates = {"stiffness"};
   o.max_effects = 1;
+  return o;
+}
+
+TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
+  const Scene scene = fem_stage_scene();
+  const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_femcal");
+  DiagnoseOptions o = stiffness_only(dir);
   o.fem_calibration_runs = 12;
   const DiagnosisResult r = run_diagnosis(scene, o);
   ASSERT_EQ(r.selected, std::vector<std::string>{"stiffness"});
@@ -216,14 +225,9 @@ TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
 // the re-calibrated constants were never run by the FEM and --refine 1 returned the reduced
 // model's own. The verified NRMSE is that of the last FEM run (not repeated; measured 0.0012).
 TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
-  const Scene scene = Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6", "load.max_kPa=20", "load.step_kPa=10",
-                                       "load.hold_s=3", "load.ramp_s=0.5", "load.trials=1", "output.vtu=\"none\""});
+  const Scene scene = fem_stage_scene();
   const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_refine");
-  DiagnoseOptions o;
-  o.data_path = (dir / "data.csv").string();
-  o.out_dir = (dir / "out").string();
-  o.candidates = {"stiffness"};
-  o.max_effects = 1;
+  DiagnoseOptions o = stiffness_only(dir);
   o.refine = 1;
   const DiagnosisResult r = run_diagnosis(scene, o);
   ASSERT_EQ(r.refined_params.size(), 1u);
