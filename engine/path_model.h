@@ -23,6 +23,10 @@
 // Between samples the reference's pressure p_el(theta) is a monotone cubic and the reference force
 // is cached at 64 sub-points per segment, so the elastic model stays on its FEM curve there too
 // (0.004 % of the angle on the test actuator's steepest part, tests/app/test_path_model.cpp).
+// The path itself (F at every material point, V and S) is the cubic spline through the
+// samples, not a polyline: a polyline's F'(theta) jumps at the samples, and so would the
+// residual of every model but the reference, making its angle a step function of the material
+// constants that calibration cannot descend (PathModel.AngleIsSmoothInTheConstants).
 //
 // Approximation: a model whose deformation leaves the elastic path (e.g. strongly localised
 // damage) is represented by its best path point (Ritz/Galerkin: first order in the shape change
@@ -89,6 +93,9 @@ class PathModel {
   std::vector<int> pt_qp_;                  ///< its quadrature point
   std::vector<double> pt_weight_;           ///< quadrature weight (m^3)
   std::vector<Mat3> F_;                     ///< [sample][point]
+  std::vector<Mat3> dF_;                    ///< dF/dtheta, [sample][point] (C1 path between samples)
+  std::vector<double> dV_;                  ///< dV/dtheta per sample
+  std::vector<Eigen::Vector3d> dS_;         ///< dS/dtheta per sample
   std::vector<double> dp_dtheta_;           ///< monotone cubic slopes of p_el(theta) at the samples
   /// Cached reference force: sub-points per segment. 64, not 16: near the limit point the force
   /// along one segment is strongly nonlinear, and the reference residual is the difference of the
