@@ -30,7 +30,10 @@
 //    --trust-elastic-model restores the raw tests in later rounds.
 // 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
 //    trials, creep inside holds, first-trial vs later, lag after steps, offset at rest,
-//    proportional error) and the error it removes.
+//    proportional error) and the error it removes; a significant one with two or more constants
+//    also the range over which they trade off (trade_lo/trade_hi: the fit within 25 % of its RSS
+//    along its flattest direction), since a rate law's two constants are often fixed by the data
+//    only in combination.
 //
 // Calibration runs the reduced path model (engine/path_model.h: 1-dof Ritz model on the elastic
 // FEM path of the same mesh, using the scene's own material code), hundreds of times faster than
@@ -57,7 +60,7 @@ struct DiagnoseOptions {
   std::string out_dir;
   std::vector<std::string> candidates;  ///< names to try (empty = the whole catalog)
   int max_effects = 2;                  ///< greedy forward selection depth
-  int max_evaluations = 40;             ///< reduced-model runs per candidate calibration
+  int max_evaluations = 60;             ///< reduced-model runs per candidate calibration
   double aic_threshold = -10.0;
   double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
   double min_gain_of_floor = 0.1;       ///< ... and NRMSE gain of at least this times the noise floor
@@ -111,6 +114,11 @@ struct CandidateResult {
   std::string why;
   std::string error;                    ///< non-empty when the calibration failed
   std::vector<std::string> at_bound;    ///< parameters calibrated at the edge of their range (params_at_bounds)
+  /// Significant candidates with two or more constants: the range of each constant along the
+  /// direction in which the fit worsens slowest, while its RSS stays within (1 + trade_rss_tol) of
+  /// the best (app/diagnose_detail.h, trade_off). Empty when not computed.
+  std::vector<double> trade_lo, trade_hi;
+  double trade_rss_tol = 0.0;
   /// The same three tests after a static correction of both models (fit_static_discrepancy): what
   /// the effect explains beyond a smooth misfit of the angle curve. Rounds >= 2 require it.
   double nrmse_beyond_static = 0.0;

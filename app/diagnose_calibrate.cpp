@@ -8,6 +8,7 @@
 #include <exception>
 #include <map>
 
+#include <Eigen/Eigenvalues>
 #include <nlopt.hpp>
 
 #include "app/diagnose_detail.h"
@@ -134,6 +135,7 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
   opt.set_upper_bounds(std::vector<double>(k, 1.0));
   opt.set_maxeval(left);
   opt.set_xtol_abs(1e-4);
+  opt.set_ftol_abs(1e-4);
   opt.set_initial_step(std::vector<double>(k, 0.5 / per));
   auto fn = [](const std::vector<double>& x, std::vector<double>&, void* data) {
     return (*static_cast<std::function<double(const std::vector<double>&)>*>(data))(x);
@@ -148,6 +150,87 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
     // roundoff / forced stop: the best point seen is kept by eval()
   }
   return best;
+}
+
+TradeOff trade_off(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                   const std::vector<double>& values, double rss_best, double rss_tol) {
+  TradeOff out;
+  out.rss_tol = rss_tol;
+  const int k = static_cast<int>(c.params.size());
+  if (k < 2 || values.size() != c.params.size() || !std::isfinite(rss_best)) return out;
+  Eigen::VectorXd x0(k);
+  for (int i = 0; i < k; ++i) x0[i] = scale(c.params[i], values[i]);
+  // A failed run (no equilibrium) is no fit: +infinity, outside every range.
+  auto f = [&](const Eigen::VectorXd& x) {
+    std::vector<double> v(k);
+    for (int i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
+    ++out.evaluations;
+    try {
+      const double r = rss(v);
+      return std::isfinite(r) ? r : std::numeric_limits<double>::infinity();
+    } catch (const std::exception&) {
+      return std::numeric_limits<double>::infinity();
+    }
+  };
+  // Hessian of the RSS by forward/backward differences with step h = 0.02 in the calibration scale
+  // (2 % of a linear range, 10 % of a 150x log range: wide enough that the reduced model's
+  // integration tolerances do not show, narrow against the valleys' curvature), centred inside
+  // the box so a constant at its bound still gets a two-sided stencil.
+  const double h = 0.02;
+  Eigen::VectorXd xc = x0.cwiseMax(h).cwiseMin(1.0 - h);
+  const double fc = (xc - x0).norm() == 0.0 ? rss_best : f(xc);
+  Eigen::MatrixXd H(k, k);
+  std::vector<double> fp(k), fm(k);
+  for (int i = 0; i < k; ++i) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(k);
+    e[i] = h;
+    fp[i] = f(xc + e), fm[i] = f(xc - e);
+    H(i, i) = (fp[i] - 2.0 * fc + fm[i]) / (h * h);
+  }
+  for (int i = 0; i < k; ++i)
+    for (int j = i + 1; j < k; ++j) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(k);
+      e[i] = h, e[j] = h;
+      H(i, j) = H(j, i) = (f(xc + e) - fp[i] - fp[j] + fc) / (h * h);
+    }
+  if (!H.allFinite()) return out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  const Eigen::VectorXd dir = eig.eigenvectors().col(0);  // smallest curvature: the valley
+  const double limit = (1.0 + rss_tol) * rss_best;
+  std::vector<Eigen::VectorXd> accepted = {x0};
+  for (const double sign : {1.0, -1.0}) {
+    const Eigen::VectorXd d = sign * dir;
+    // Largest t keeping x0 + t d inside the box.
+    double t_max = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < k; ++i) {
+      if (d[i] > 1e-12) t_max = std::min(t_max, (1.0 - x0[i]) / d[i]);
+      if (d[i] < -1e-12) t_max = std::min(t_max, -x0[i] / d[i]);
+    }
+    double t_in = 0.0, t_out = -1.0;
+    for (double t = 0.05; t_in < t_max; t *= 2.0) {
+      const double tt = std::min(t, t_max);
+      if (f(x0 + tt * d) <= limit) {
+        t_in = tt;
+      } else {
+        t_out = tt;
+        break;
+      }
+    }
+    for (int b = 0; b < 2 && t_out > 0.0; ++b) {
+      const double tm = 0.5 * (t_in + t_out);
+      (f(x0 + tm * d) <= limit ? t_in : t_out) = tm;
+    }
+    if (t_in > 0.0) accepted.push_back(x0 + t_in * d);
+  }
+  out.lo.assign(k, std::numeric_limits<double>::infinity());
+  out.hi.assign(k, -std::numeric_limits<double>::infinity());
+  for (const Eigen::VectorXd& x : accepted)
+    for (int i = 0; i < k; ++i) {
+      const double v = unscale(c.params[i], x[i]);
+      out.lo[i] = std::min(out.lo[i], v);
+      out.hi[i] = std::max(out.hi[i], v);
+    }
+  return out;
 }
 
 }  // namespace pneufem::diagnose_detail

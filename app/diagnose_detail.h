@@ -61,7 +61,10 @@ struct Calibration {
 
 /// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
 /// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
-/// (several) from the best grid point.
+/// (several) from the best grid point, until the trust region is 1e-4 of the calibration scale,
+/// a step gains less than 1e-4 in log RSS, or `budget` runs are spent. Two constants that trade
+/// off leave a narrow valley that BOBYQA walks down in small steps: the default budget (60,
+/// DiagnoseOptions) is sized for that walk (Calibrate.WalksDownALogSpaceValleyWithinTheDefaultBudget).
 /// The optimiser sees log(rss), which has the same minimiser: near a limit point the RSS of
 /// neighbouring constants spans six decades (a softened model that snaps through is off by tens
 /// of degrees), and BOBYQA's quadratic models of the raw RSS are then dominated by those points.
@@ -69,6 +72,25 @@ struct Calibration {
 /// than the worst finite RSS seen, so it repels the search without breaking the model.
 Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
                       int budget, const std::vector<double>* start = nullptr);
+
+/// How far a calibration's constants can move together without worsening the fit much: the
+/// range of each constant along the direction in which the RSS rises slowest (the smallest
+/// curvature of a finite-difference Hessian in the calibration scale), walked both ways from the
+/// best point while the RSS stays within (1 + rss_tol) of the best. Two constants of a rate law
+/// often trade off (a lower fatigue threshold with a slower rate; a larger Prony gamma with a
+/// shorter tau): the recording then fixes a combination, not each constant, and the calibrated
+/// point is wherever along that valley the model's own error puts it.
+struct TradeOff {
+  std::vector<double> lo, hi;  ///< per parameter (catalog units); empty when not computed
+  double rss_tol = 0.0;
+  int evaluations = 0;
+};
+
+/// The trade-off of `values` (the calibrated point, RSS `rss_best`) for a candidate with two or
+/// more parameters (empty for one). Walk resolution: steps double from 0.05 in the calibration
+/// scale, then two bisections, so each end is found to within a quarter of its last step.
+TradeOff trade_off(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                   const std::vector<double>& values, double rss_best, double rss_tol);
 
 // ---- evidence (diagnose_evidence.cpp)
 

@@ -47,6 +47,13 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
     o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
     o.add("profiled", c.profiled ? "true" : "false");
     if (!c.refit_selected.empty()) o.add("refit_selected_params", json::array(c.refit_selected));
+    if (!c.trade_lo.empty()) {
+      json::Object ranges;
+      for (std::size_t j = 0; j < c.trade_lo.size(); ++j) ranges.add(c.param_names[j], json::array({c.trade_lo[j], c.trade_hi[j]}));
+      json::Object t;
+      t.add("rss_within", c.trade_rss_tol).add("ranges", ranges.str(8));
+      o.add("trade_off", t.str(6));
+    }
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }
