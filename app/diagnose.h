@@ -164,6 +164,11 @@ struct DiagnosisResult {
   long rom_runs = 0;
 };
 
+/// The constants of the selected effects as the console prints them, one line per effect: the
+/// final values (re-fitted jointly by a later round, or refined with the FEM, when that happened)
+/// and, for values straight from their own calibration, the trade-off ranges. "" = none selected.
+std::string selected_constants_text(const DiagnosisResult& r);
+
 /// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
 /// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more
 /// than 50k dof, else 0 (the scene's mesh; for a large deck with a note suggesting a coarser one).

@@ -96,6 +96,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
     std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  beyond static %.4f  %s%s\n", k.round, k.effect.c_str(), k.nrmse,
                 k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
   }
+  if (const std::string k = selected_constants_text(r); !k.empty()) std::printf("constants of the selected effects:\n%s", k.c_str());
   if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);

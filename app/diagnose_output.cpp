@@ -3,6 +3,7 @@
 // (every evaluation of every calibration) and the history lines. Apart from the diagnosis because
 // it only formats a finished DiagnosisResult; nothing here changes a number.
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 
@@ -145,3 +146,54 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
 }
 
 }  // namespace pneufem::diagnose_detail
+
+namespace pneufem {
+
+std::string selected_constants_text(const DiagnosisResult& r) {
+  struct Entry {
+    const CandidateResult* c;
+    std::vector<double> values;
+    std::string how;  ///< "" = its own calibration (ranges apply)
+  };
+  std::vector<Entry> e;
+  for (std::size_t i = 0; i < r.selected.size(); ++i) {
+    const auto it = std::find_if(r.candidates.begin(), r.candidates.end(), [&](const CandidateResult& c) {
+      return c.effect == r.selected[i] && c.round == static_cast<int>(i) + 1;
+    });
+    if (it == r.candidates.end()) continue;
+    std::size_t o = 0;  // a joint re-fit replaces the constants of the effects selected before
+    for (Entry& before : e)
+      for (double& v : before.values)
+        if (o < it->refit_selected.size()) v = it->refit_selected[o++], before.how = "re-fitted with " + it->effect;
+    e.push_back({&*it, it->params, ""});
+  }
+  if (r.refined_params.size() == e.size())
+    for (std::size_t i = 0; i < e.size(); ++i) e[i].values = r.refined_params[i], e[i].how = "refined with the FEM";
+  std::string out;
+  for (const Entry& x : e) {
+    std::string line = "  " + x.c->effect + ":";
+    const bool ranges = x.how.empty() && x.c->trade_lo.size() == x.values.size();
+    bool wide = false;
+    for (std::size_t j = 0; j < x.values.size(); ++j) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s %s %.4g", j ? "," : "", x.c->param_names[j].c_str(), x.values[j]);
+      line += buf;
+      if (ranges) {
+        std::snprintf(buf, sizeof buf, " (%.4g to %.4g)", x.c->trade_lo[j], x.c->trade_hi[j]);
+        line += buf;
+        wide = wide || x.c->trade_hi[j] > 2.0 * x.c->trade_lo[j];
+      }
+    }
+    if (!x.how.empty()) line += " (" + x.how + ")";
+    if (ranges) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "; ranges: RSS within %.0f %% of the best%s", 100.0 * x.c->trade_rss_tol,
+                    wide ? ", the constants trade off" : "");
+      line += buf;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace pneufem

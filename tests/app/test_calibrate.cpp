@@ -88,3 +88,41 @@ TEST(Calibrate, WalksDownALogSpaceValleyWithinTheDefaultBudget) {
 
 }  // namespace
 }  // namespace pneufem::diagnose_detail
+
+namespace pneufem {
+namespace {
+
+CandidateResult selected_candidate(const std::string& effect, int round, std::vector<std::string> names,
+                                   std::vector<double> values) {
+  CandidateResult c;
+  c.effect = effect, c.round = round, c.significant = true;
+  c.param_names = std::move(names), c.params = std::move(values);
+  return c;
+}
+
+// The console's summary of the selected constants: the values with their trade-off ranges when
+// they come straight from their own calibration; the re-fitted values (no ranges: those were
+// walked around the values before the re-fit) when a later round re-fitted them jointly; the FEM's
+// after --refine. Exact strings: the formatting is the contract users read.
+TEST(DiagnoseSummary, ListsTheSelectedConstantsWithTheirTradeOffRanges) {
+  DiagnosisResult r;
+  EXPECT_EQ(selected_constants_text(r), "");
+  CandidateResult stiff = selected_candidate("stiffness", 1, {"scale"}, {0.95});
+  CandidateResult fat = selected_candidate("fatigue", 2, {"W_th_MPa", "tau_s"}, {0.0042, 953.0});
+  fat.trade_lo = {0.003, 100.0}, fat.trade_hi = {0.0097, 2424.0}, fat.trade_rss_tol = 0.25;
+  CandidateResult other = selected_candidate("fatigue", 1, {"W_th_MPa", "tau_s"}, {0.01, 10.0});  // round 1: not selected
+  r.candidates = {stiff, other, fat};
+  r.selected = {"stiffness", "fatigue"};
+  EXPECT_EQ(selected_constants_text(r),
+            "  stiffness: scale 0.95\n"
+            "  fatigue: W_th_MPa 0.0042 (0.003 to 0.0097), tau_s 953 (100 to 2424); ranges: RSS within 25 % of "
+            "the best, the constants trade off\n");
+  r.candidates[2].refit_selected = {0.97};
+  EXPECT_EQ(selected_constants_text(r).substr(0, 49), "  stiffness: scale 0.97 (re-fitted with fatigue)\n");
+  r.refined_params = {{0.98}, {0.008, 200.0}};
+  EXPECT_EQ(selected_constants_text(r), "  stiffness: scale 0.98 (refined with the FEM)\n"
+                                        "  fatigue: W_th_MPa 0.008, tau_s 200 (refined with the FEM)\n");
+}
+
+}  // namespace
+}  // namespace pneufem
