@@ -579,10 +579,10 @@ TEST(HiddenEffect, Mullins) {
 // (test_path_model); here that leaves more of the error (measured final 0.0154, floor 0.0084),
 // hence 2x the floor + 0.005. The two constants trade off (a lower threshold with a slower rate
 // looks alike over three trials): along that valley the reduced model's RSS is 12.0 deg^2 at the
-// fit (W_th 4.4 kPa, tau 890 s), 13.7 at the truth and 11.8 at W_th's lower bound with tau 2 200 s,
+// fit (W_th 4.2 kPa, tau 953 s), 13.7 at the truth and 11.8 at W_th's lower bound with tau 2 200 s,
 // so where the calibration stops along it is set by the reduced model's own error, not by the
 // data. What the data do fix is the valley: the reported trade-off ranges (RSS within 25 %;
-// measured W_th 3.0-9.7 kPa, tau 100-2 460 s) must hold the truth, and must exclude most of the
+// measured W_th 3.0-9.7 kPa, tau 100-2 424 s) must hold the truth, and must exclude most of the
 // catalog's box (tau up to 1e5 s, W_th up to 0.1 MPa), or they would prove nothing.
 TEST(HiddenEffect, Fatigue) {
   const DiagnosisResult r = diagnose("fatigue");
