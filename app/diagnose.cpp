@@ -509,13 +509,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
         if (!t.lo.empty()) {
           r.trade_lo = t.lo, r.trade_hi = t.hi, r.trade_rss_tol = t.rss_tol;
           std::string ranges;
-          bool wide = false;
-          for (std::size_t i = 0; i < t.lo.size(); ++i) {
+          for (std::size_t i = 0; i < t.lo.size(); ++i)
             ranges += (i ? ", " : "") + c.params[i].name + " " + fmt("%.3g", t.lo[i]) + " to " + fmt("%.3g", t.hi[i]);
-            wide = wide || t.hi[i] > 2.0 * t.lo[i];
-          }
           r.why += " Within " + fmt("%.0f", 100.0 * kTradeOffRssTol) + " % of the best fit's RSS the constants move together over " + ranges + ".";
-          if (wide)
+          if (constants_trade_off(r))
             r.why += " They trade off: the recording fixes a combination of them more than each one (more trials, "
                      "or other pressure levels, separate them; --fem-calibrate fits them on the FEM).";
         }

@@ -164,6 +164,10 @@ struct DiagnosisResult {
   long rom_runs = 0;
 };
 
+/// True when one of the candidate's trade-off ranges spans more than a factor of 2: the recording
+/// then fixes a combination of its constants more than each one (`why` and the console say so).
+bool constants_trade_off(const CandidateResult& c);
+
 /// The constants of the selected effects as the console prints them, one line per effect: the
 /// final values (re-fitted jointly by a later round, or refined with the FEM, when that happened)
 /// and, for values straight from their own calibration, the trade-off ranges. "" = none selected.

@@ -149,6 +149,12 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
 
 namespace pneufem {
 
+bool constants_trade_off(const CandidateResult& c) {
+  for (std::size_t j = 0; j < c.trade_lo.size() && j < c.trade_hi.size(); ++j)
+    if (c.trade_hi[j] > 2.0 * c.trade_lo[j]) return true;
+  return false;
+}
+
 std::string selected_constants_text(const DiagnosisResult& r) {
   struct Entry {
     const CandidateResult* c;
@@ -173,7 +179,6 @@ std::string selected_constants_text(const DiagnosisResult& r) {
   for (const Entry& x : e) {
     std::string line = "  " + x.c->effect + ":";
     const bool ranges = x.how.empty() && x.c->trade_lo.size() == x.values.size();
-    bool wide = false;
     for (std::size_t j = 0; j < x.values.size(); ++j) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "%s %s %.4g", j ? "," : "", x.c->param_names[j].c_str(), x.values[j]);
@@ -181,14 +186,13 @@ std::string selected_constants_text(const DiagnosisResult& r) {
       if (ranges) {
         std::snprintf(buf, sizeof buf, " (%.4g to %.4g)", x.c->trade_lo[j], x.c->trade_hi[j]);
         line += buf;
-        wide = wide || x.c->trade_hi[j] > 2.0 * x.c->trade_lo[j];
       }
     }
     if (!x.how.empty()) line += " (" + x.how + ")";
     if (ranges) {
       char buf[120];
       std::snprintf(buf, sizeof buf, "; ranges: RSS within %.0f %% of the best%s", 100.0 * x.c->trade_rss_tol,
-                    wide ? ", the constants trade off" : "");
+                    constants_trade_off(*x.c) ? ", the constants trade off" : "");
       line += buf;
     }
     out += line + "\n";

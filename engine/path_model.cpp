@@ -67,24 +67,35 @@ Groups group_points(const Model& model, const std::vector<int>& pt_element) {
   return g;
 }
 
-/// A quantity and its slope at the two ends of a path segment, interpolated at
-/// a = (theta - theta_k) / dth as a cubic Hermite inside [0, 1] and linearly with the end slope
-/// outside (extrapolation: segment() clamps k, so a < 0 only on the first segment, a > 1 only on
-/// the last). Returns the value; `slope` gets d/dtheta. Smooth across samples: see `PathSegment`.
-template <class T>
-T hermite(const T& y0, const T& y1, const T& m0, const T& m1, double a, double dth, T* slope) {
-  if (a < 0.0) {
-    *slope = m0;
-    return y0 + (a * dth) * m0;
+/// Cubic Hermite interpolation on one path segment at a = (theta - theta_k) / dth: the weights of
+/// the two end values and end slopes, for the value and for its theta-derivative, computed once per
+/// segment position and applied to every quantity there (each material point's F, V, S, p_el).
+/// Outside [0, 1], linear with the end slope (extrapolation: segment() clamps k, so a < 0 only on
+/// the first segment, a > 1 only on the last). Smooth across samples: see `PathSegment`.
+struct Hermite {
+  double a, dth;
+  double w00 = 0, w10 = 0, w01 = 0, w11 = 0;  ///< value weights of y0, m0, y1, m1
+  double s0 = 0, sm0 = 0, sm1 = 0;            ///< slope = s0 (y0 - y1) + sm0 m0 + sm1 m1
+  Hermite(double a_, double dth_) : a(a_), dth(dth_) {
+    const double a2 = a * a, a3 = a2 * a;
+    w00 = 2 * a3 - 3 * a2 + 1, w10 = (a3 - 2 * a2 + a) * dth, w01 = 3 * a2 - 2 * a3, w11 = (a3 - a2) * dth;
+    s0 = (6 * a2 - 6 * a) / dth, sm0 = 3 * a2 - 4 * a + 1, sm1 = 3 * a2 - 2 * a;
   }
-  if (a > 1.0) {
-    *slope = m1;
-    return y1 + ((a - 1.0) * dth) * m1;
+  /// The interpolated value; `slope` gets its d/dtheta.
+  template <class T>
+  T operator()(const T& y0, const T& y1, const T& m0, const T& m1, T* slope) const {
+    if (a < 0.0) {
+      *slope = m0;
+      return y0 + (a * dth) * m0;
+    }
+    if (a > 1.0) {
+      *slope = m1;
+      return y1 + ((a - 1.0) * dth) * m1;
+    }
+    *slope = s0 * (y0 - y1) + sm0 * m0 + sm1 * m1;
+    return w00 * y0 + w10 * m0 + w01 * y1 + w11 * m1;
   }
-  const double a2 = a * a, a3 = a2 * a;
-  *slope = ((6 * a2 - 6 * a) / dth) * (y0 - y1) + (3 * a2 - 4 * a + 1) * m0 + (3 * a2 - 2 * a) * m1;
-  return (2 * a3 - 3 * a2 + 1) * y0 + ((a3 - 2 * a2 + a) * dth) * m0 + (3 * a2 - 2 * a3) * y1 + ((a3 - a2) * dth) * m1;
-}
+};
 
 /// Slopes of samples y[k] at theta[k] such that the piecewise cubic Hermite through them is the
 /// cubic spline (C2: continuous second derivative) with not-a-knot ends, which reproduces any
@@ -145,15 +156,15 @@ std::vector<T> sample_slopes(const std::vector<double>& theta, const std::functi
 /// is the cubic spline through the samples (sample_slopes), so F, F' and F'' are continuous.
 struct PathSegment {
   const Mat3 *F0, *F1, *M0, *M1;
-  double a, dth;
-  Mat3 F(int i, Mat3* dF) const { return hermite<Mat3>(F0[i], F1[i], M0[i], M1[i], a, dth, dF); }
+  Hermite h;
+  Mat3 F(int i, Mat3* dF) const { return h(F0[i], F1[i], M0[i], M1[i], dF); }
 };
 
 /// Segment k of a path with np points per sample, at a = (theta - theta_k) / dth.
 PathSegment path_segment(const std::vector<Mat3>& F, const std::vector<Mat3>& dF, const std::vector<double>& theta,
                          std::size_t np, std::size_t k, double a) {
   const std::size_t o = k * np;
-  return PathSegment{F.data() + o, F.data() + o + np, dF.data() + o, dF.data() + o + np, a, theta[k + 1] - theta[k]};
+  return PathSegment{F.data() + o, F.data() + o + np, dF.data() + o, dF.data() + o + np, Hermite(a, theta[k + 1] - theta[k])};
 }
 
 /// Generalised force sum_points w P(F(theta)) : F'(theta) over the points of `g` on path segment
@@ -412,19 +423,17 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
     const int k = segment(theta);
     const double dth = theta_[k + 1] - theta_[k], a = (theta - theta_[k]) / dth;
     const bool inside = a >= 0.0 && a <= 1.0;
-    const double a2 = a * a, a3 = a2 * a;  // inside: cubic Hermite with the monotone slopes; else the chord
-    const double p_el = inside ? (2 * a3 - 3 * a2 + 1) * p_[k] + (a3 - 2 * a2 + a) * dth * dp_dtheta_[k] +
-                                     (3 * a2 - 2 * a3) * p_[k + 1] + (a3 - a2) * dth * dp_dtheta_[k + 1]
-                               : p_[k] + a * (p_[k + 1] - p_[k]);
-    // V'(theta) and S'(theta) of the same C1 interpolation as F (a chord slope would jump at the
-    // samples just as F' did); the chord if the cubic's slope is not positive (not seen).
-    double dV = 0.0;
-    hermite<double>(V_[k], V_[k + 1], dV_[k], dV_[k + 1], a, dth, &dV);
+    const PathSegment seg = path_segment(F_, dF_, theta_, np, static_cast<std::size_t>(k), a);
+    // p_el with the monotone slopes (beyond the ends the end slopes are the end chords);
+    // V'(theta) and S'(theta) of the same spline as F (a chord slope would jump at the samples
+    // just as F' did); the chord if the cubic's slope is not positive (not seen).
+    double dp = 0.0, dV = 0.0;
+    const double p_el = seg.h(p_[k], p_[k + 1], dp_dtheta_[k], dp_dtheta_[k + 1], &dp);
+    seg.h(V_[k], V_[k + 1], dV_[k], dV_[k + 1], &dV);
     if (!(dV > 0.0)) dV = (V_[k + 1] - V_[k]) / dth;
     Eigen::Vector3d dS;
-    hermite<Eigen::Vector3d>(S_[k], S_[k + 1], dS_[k], dS_[k + 1], a, dth, &dS);
+    seg.h(S_[k], S_[k + 1], dS_[k], dS_[k + 1], &dS);
     const double gS = model.gravity_m_s2.dot(dS);
-    const PathSegment seg = path_segment(F_, dF_, theta_, np, static_cast<std::size_t>(k), a);
     const double Gm = generalised_force(gm, seg, pt_weight_, pt_element_, ts, &state_old, &state_new, Fbuf, dFbuf, rbuf);
     double Gr = 0.0;
     if (inside) {  // cached reference force, linear between kRefSub sub-points
