@@ -223,11 +223,13 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   if (opt.progress)
     std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
                  opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");
-  const RomEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr);
+  const RomEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
+                         opt.cache_dir);
   if (opt.progress) {
-    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s)\n",
+    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s; path %s%s%s)\n",
                  rom.path().path_pressure_Pa().back() * 1e-3, rom.path().num_points(),
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), rom.path_source().c_str(),
+                 rom.fine_source().empty() ? "" : ", scene mesh's sweep ", rom.fine_source().c_str());
     if (!rom.fine_curve().empty())
       std::fprintf(stderr,
                    "diagnose: calibration mesh %ld dof, scene mesh %ld dof: angle at %.1f kPa %.3f vs %.3f deg "

@@ -85,6 +85,8 @@ struct DiagnoseOptions {
   double calibration_h_mm = -1.0;
   int threads = 0;
   bool progress = false;
+  /// Cache directory for the actuator's elastic FEM results (app/result_cache.h); "" = none.
+  std::string cache_dir;
   std::string command_line;
 };
 

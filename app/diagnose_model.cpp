@@ -7,11 +7,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include <tbb/parallel_invoke.h>
 
+#include "app/diagnose_detail.h"
 #include "app/drive.h"
 #include "app/elastic_curve.h"
+#include "app/result_cache.h"
 #include "materials/errors.h"
 #include "scenes/pressure_lag.h"
 
@@ -47,8 +50,8 @@ bool has_history(const Model& m) {
 }  // namespace
 
 RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
-                           int rom_points, const Scene* mesh_scene)
-    : rec_(rec), frames_(frames) {
+                           int rom_points, const Scene* mesh_scene, const std::string& cache_dir)
+    : cache_dir_(cache_dir), rec_(rec), frames_(frames) {
   ref_ = build_model(elastic_reference(base));
   double p_max = 0.0;
   for (const TrialRecording& t : rec.trials)
@@ -66,18 +69,51 @@ RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::v
   po.max_points = rom_points;
   po.max_dt_s = 0.5;
   po.newton = ref_->solver.quasi_static.newton;
+  auto make_path = [&] {
+    if (cache_dir_.empty()) {
+      path_ = std::make_unique<PathModel>(ref_->model, po);
+      return;
+    }
+    // Stored flat: the sample count, the pressures, then each sample's displacement.
+    Fnv1a h;
+    h.str(executable_fingerprint());
+    h.str("elastic path");
+    hash_model(h, elastic_reference(base), ref_->model);
+    h.num(po.p_top_Pa);
+    h.num(po.dp_Pa);
+    const Eigen::Index nd = ref_->model.num_dofs();
+    const std::vector<double> flat = cached_doubles(
+        cache_dir_, "path", h.hex(),
+        [&] {
+          const ElasticPathTrace t = trace_elastic_path(ref_->model, po);
+          std::vector<double> f = {static_cast<double>(t.p_Pa.size())};
+          f.insert(f.end(), t.p_Pa.begin(), t.p_Pa.end());
+          for (const Eigen::VectorXd& u : t.u) f.insert(f.end(), u.data(), u.data() + u.size());
+          return f;
+        },
+        &path_source_);
+    ElasticPathTrace t;
+    const std::size_t ns = flat.empty() ? 0 : static_cast<std::size_t>(flat[0]);
+    if (flat.size() != 1 + ns + ns * static_cast<std::size_t>(nd))
+      throw InputError("diagnose: the cached elastic path (" + path_source_ + ") does not fit the model; delete it");
+    t.p_Pa.assign(flat.begin() + 1, flat.begin() + 1 + static_cast<std::ptrdiff_t>(ns));
+    for (std::size_t k = 0; k < ns; ++k)
+      t.u.push_back(Eigen::Map<const Eigen::VectorXd>(flat.data() + 1 + ns + k * static_cast<std::size_t>(nd), nd));
+    path_ = std::make_unique<PathModel>(ref_->model, po, t);
+  };
   if (!mesh_scene) {
-    path_ = std::make_unique<PathModel>(ref_->model, po);
+    make_path();
     return;
   }
   // The scene mesh's sweep (the expensive part) runs beside the coarse path trace.
   std::string fine_error;
-  tbb::parallel_invoke([&] { path_ = std::make_unique<PathModel>(ref_->model, po); },
+  tbb::parallel_invoke(make_path,
                        [&] {
                          try {
-                           const std::unique_ptr<BuiltModel> fine = build_model(elastic_reference(*mesh_scene));
+                           const Scene fine_scene = elastic_reference(*mesh_scene);
+                           const std::unique_ptr<BuiltModel> fine = build_model(fine_scene);
                            fine_dofs_ = fine->model.num_dofs();
-                           fine_curve_ = static_angle_curve(*fine, inlet_max_Pa_, kMeshCurvePoints);
+                           fine_curve_ = stored_curve(fine_scene, *fine, inlet_max_Pa_, kMeshCurvePoints, &fine_source_);
                          } catch (const PhysicsError& e) {
                            fine_error = e.what();
                          }
@@ -196,16 +232,32 @@ std::vector<std::vector<double>> RomEvaluator::simulate(const Scene& variant, bo
     // Gravity loads a deformation mode the 1-dof reduced model cannot carry: add the elastic
     // FEM's gravity offset at the same pressure, theta_g(p) - theta_0(p) (exact for the elastic
     // model; for history effects it neglects how their softening changes the sag, a second-order
-    // term). Two static sweeps per gravity vector (cached).
+    // term). Static sweeps, cached: one per gravity vector, or, for a rig angle phi, one per node
+    // of the rig-angle interpolation (app/elastic_curve.h), the offset being sum_j w_j(phi)
+    // offset(phi_j). Why interpolate: calibrating the rig angle on top of a history effect
+    // otherwise costs a static FEM sweep per evaluation (measured: 24 runs, 56 s of a 84 s
+    // diagnosis on the 5-chamber test actuator); five sweeps serve every angle, within ~1e-4 deg
+    // of the direct sweep (RigAngleInterpolation.MatchesDirectFemSweepsBetweenNodes).
     const Scene el = elastic_reference(variant);
-    const Vec3 gv = bm->model.gravity_m_s2;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
     const double hi = chamber(inlet_max_Pa_);  // pl holds mapped pressures
-    const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
     const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
-    std::vector<double> off(cg.size());
-    for (std::size_t i = 0; i < cg.size(); ++i) off[i] = cg[i] - c0[i];
+    std::vector<double> off(c0.size(), 0.0);
+    const double rig_deg = variant.has("gravity.rig_angle_deg") ? variant.number("gravity.rig_angle_deg") : -1.0;
+    if (rig_deg >= 0.0) {
+      const auto w = rig_angle_weights(rig_deg * std::numbers::pi / 180.0);
+      for (int j = 0; j < kRigAngleNodes; ++j) {
+        const std::vector<double> cj =
+            elastic_curve(el.with({"gravity.rig_angle_deg=" + fmt("%.17g", rig_angle_node_rad(j) * 180.0 / std::numbers::pi)}),
+                          nullptr, hi, kFemCurvePoints);
+        for (std::size_t i = 0; i < off.size(); ++i) off[i] += w[j] * (cj[i] - c0[i]);
+      }
+    } else {
+      const Vec3 gv = bm->model.gravity_m_s2;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
+      const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
+      for (std::size_t i = 0; i < off.size(); ++i) off[i] = cg[i] - c0[i];
+    }
     for (std::size_t i = 0; i < th.size(); ++i) th[i] += curve_at(off, hi, pl.p_Pa[i]);
   }
   for (std::size_t k = 0; k < nt; ++k) {
@@ -255,10 +307,23 @@ std::vector<double> RomEvaluator::elastic_curve(const Scene& variant, const Buil
   std::unique_ptr<BuiltModel> own;
   if (!bm_in) own = build_model(variant);
   const BuiltModel& bm = bm_in ? *bm_in : *own;
-  const std::vector<double> th = static_angle_curve(bm, hi, n);
+  const std::vector<double> th = stored_curve(variant, bm, hi, n);
   std::lock_guard<std::mutex> lock(cache_mu_);
   curves_[key] = th;
   return th;
+}
+
+std::vector<double> RomEvaluator::stored_curve(const Scene& variant, const BuiltModel& bm, double hi, int n,
+                                               std::string* source) const {
+  if (source) *source = "computed";
+  if (cache_dir_.empty()) return static_angle_curve(bm, hi, n);
+  Fnv1a h;
+  h.str(executable_fingerprint());
+  h.str("static angle curve");
+  hash_model(h, variant.with({"load.pressure_lag_s=0.0"}), bm.model);  // curves are lag-free (curve_key)
+  h.num(hi);
+  h.num(n);
+  return cached_doubles(cache_dir_, "curve", h.hex(), [&] { return static_angle_curve(bm, hi, n); }, source);
 }
 
 }  // namespace pneufem::diagnose_detail

@@ -38,8 +38,14 @@ namespace pneufem::diagnose_detail {
 /// effect". On the default actuator at 45 kPa the h = 6 mesh bends 55 deg, the h = 2 mesh 77 deg.
 class RomEvaluator {
  public:
+  /// `cache_dir` (may be empty: none): stores and reads the elastic path's trace, the scene mesh's
+  /// sweep and the static FEM curves there (app/result_cache.h), so re-runs on one actuator skip them.
   RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points,
-               const Scene* mesh_scene = nullptr);
+               const Scene* mesh_scene = nullptr, const std::string& cache_dir = "");
+
+  /// Where the elastic path and the scene mesh's sweep came from: "computed", "cache <file>", ...
+  const std::string& path_source() const { return path_source_; }
+  const std::string& fine_source() const { return fine_source_; }
 
   /// The calibration mesh's pressure map (empty without one): static angles (deg) of the scene's
   /// mesh and of the calibration mesh at p = inlet_max_Pa() i / n, and phi(p) there (Pa).
@@ -92,6 +98,11 @@ class RomEvaluator {
   /// is the variant's built model, or null to build it on a cache miss).
   std::vector<double> elastic_curve(const Scene& variant, const BuiltModel* bm_in, double hi, int n) const;
 
+  /// static_angle_curve of a built elastic model, through the cache directory when there is one.
+  std::vector<double> stored_curve(const Scene& variant, const BuiltModel& bm, double hi, int n,
+                                   std::string* source = nullptr) const;
+
+  std::string cache_dir_, path_source_ = "computed", fine_source_;
   mutable std::mutex cache_mu_;
   mutable std::map<std::string, std::vector<double>> curves_;
   const Recording& rec_;

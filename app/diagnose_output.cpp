@@ -85,6 +85,8 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
                                   " material points, elastic path to " +
                                   fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add_str("elastic_path_source", rom.path_source());
+  if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
   if (opt.calibration_h_mm > 0.0) {
     // The calibration mesh and its correction, so a reader can judge its size against the effects'.
     json::Object cm;
@@ -97,6 +99,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator
     for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
     cm.add("pressure_kPa", json::array(p)).add("scene_mesh_angle_deg", json::array(f)).add("calibration_mesh_angle_deg", json::array(c));
     cm.add("mapped_pressure_kPa", json::array(m));
+    cm.add_str("scene_mesh_sweep_source", rom.fine_source());
     method.add("calibration_mesh", cm.str(4));
   }
   method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);

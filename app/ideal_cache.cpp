@@ -1,15 +1,11 @@
 #include "app/ideal_cache.h"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <unistd.h>
-
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
+#include "app/result_cache.h"
 #include "materials/atomic_file.h"
 #include "materials/errors.h"
 
@@ -18,48 +14,6 @@ namespace pneufem {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// FNV-1a, 64 bit: a stable hash of bytes (not cryptographic; it tells scenes apart).
-class Fnv1a {
- public:
-  void bytes(const void* p, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 0x100000001b3ULL;
-  }
-  template <class T>
-  void vec(const std::vector<T>& v) {
-    const std::uint64_t n = v.size();
-    bytes(&n, sizeof n);
-    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-  }
-  void str(const std::string& s) {
-    vec(std::vector<char>(s.begin(), s.end()));
-  }
-  std::string hex() const {
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h_));
-    return buf;
-  }
-
- private:
-  std::uint64_t h_ = 0xcbf29ce484222325ULL;
-};
-
-/// Holds an exclusive flock on a file for its lifetime.
-class FileLock {
- public:
-  explicit FileLock(const std::string& path) {
-    fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0 || flock(fd_, LOCK_EX) != 0)
-      throw InputError("--ideal-cache: cannot lock " + path + " (is the directory writable?)");
-  }
-  ~FileLock() { close(fd_); }
-  FileLock(const FileLock&) = delete;
-  FileLock& operator=(const FileLock&) = delete;
-
- private:
-  int fd_ = -1;
-};
 
 /// True when `recs` are one trial reported at exactly `times` (the protocol's report times).
 bool matches(const std::vector<StateRecord>& recs, const std::vector<double>& times) {
@@ -76,20 +30,7 @@ bool matches(const std::vector<StateRecord>& recs, const std::vector<double>& ti
 std::string ideal_cache_key(const Scene& ideal_scene, const Model& model, const std::string& version) {
   Fnv1a h;
   h.str(version);
-  h.str(ideal_scene.model_toml());
-  std::vector<double> X;
-  X.reserve(3 * model.mesh.X.size());
-  for (const auto& x : model.mesh.X) X.insert(X.end(), {x.x(), x.y(), x.z()});
-  h.vec(X);
-  h.vec(model.mesh.conn);
-  h.vec(model.element_part);
-  h.vec(model.mesh.region);
-  h.vec(model.fixed);
-  std::vector<int> faces;
-  for (const FaceRef& f : model.pressure_faces) faces.insert(faces.end(), {f.element, f.local_face});
-  h.vec(faces);
-  for (const MembraneSet& m : model.membranes) h.vec(m.nodes);
-  h.vec(model.angle.tip_nodes);
+  hash_model(h, ideal_scene, model);
   return h.hex();
 }
 
@@ -131,7 +72,7 @@ IdealResult cached_ideal(const std::string& dir, const std::string& key, const S
   const fs::path base = fs::path(dir) / ("ideal_" + key);
   const std::string csv = base.string() + ".csv";
   // Whoever holds the lock computes; the others wait for it and then read its result.
-  FileLock lock(base.string() + ".lock");
+  FileLock lock(base.string() + ".lock", "--ideal-cache");
   if (fs::exists(csv)) {
     std::vector<StateRecord> recs = read_angles_csv(csv);
     if (matches(recs, expected_times_s)) return {std::move(recs), "cache " + csv};

@@ -199,9 +199,23 @@ double generalised_force(const Groups& g, const PathSegment& seg, const std::vec
 
 }  // namespace
 
-PathModel::PathModel(const Model& reference, const PathModelOptions& options) : ref_(reference), opt_(options) {
-  if (!(opt_.dp_Pa > 0.0) || !(opt_.p_top_Pa > opt_.dp_Pa) || opt_.max_points < 1 || !(opt_.max_dt_s > 0.0))
+namespace {
+
+void check_options(const PathModelOptions& o) {
+  if (!(o.dp_Pa > 0.0) || !(o.p_top_Pa > o.dp_Pa) || o.max_points < 1 || !(o.max_dt_s > 0.0))
     throw InputError("path model: need 0 < dp_Pa < p_top_Pa, max_points >= 1 and max_dt_s > 0");
+}
+
+Eigen::Vector3d first_moment(const Eigen::VectorXd& mass, const Eigen::VectorXd& u) {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (Eigen::Index a = 0; a < mass.size(); ++a) s += mass[a] * u.segment<3>(3 * a);
+  return s;
+}
+
+}  // namespace
+
+ElasticPathTrace trace_elastic_path(const Model& reference, const PathModelOptions& options) {
+  check_options(options);
   const Assembler asmb(reference);
   if (asmb.state_size() != 0)
     throw InputError("path model: the reference model must be elastic (materials without history)");
@@ -209,43 +223,62 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options) : 
   // fraction of the sample spacing, not to the solver's default 1 Pa. Near the limit every failed
   // sub-increment costs max_iterations Newton iterations, and halving dp down to 1 Pa was half of
   // the trace's wall time on the hidden-effect test actuator (BENCHMARKS.md section 8).
-  StaticOptions newton = opt_.newton;
-  newton.min_increment_Pa = std::max(newton.min_increment_Pa, opt_.dp_Pa / 16.0);
+  StaticOptions newton = options.newton;
+  newton.min_increment_Pa = std::max(newton.min_increment_Pa, options.dp_Pa / 16.0);
   StaticSolver solver(asmb, newton);
-  const Eigen::VectorXd& mass = asmb.lumped_mass();
-  auto first_moment = [&](const Eigen::VectorXd& u) {
-    Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    for (int a = 0; a < reference.mesh.num_nodes(); ++a) s += mass[a] * u.segment<3>(3 * a);
-    return s;
-  };
-
-  // 1. Trace the elastic path (load control; ends quietly at a limit point).
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(reference.num_dofs());
+  // Load control; ends quietly at a limit point.
+  ElasticPathTrace tr;
+  tr.p_Pa = {0.0};
+  tr.u = {Eigen::VectorXd::Zero(reference.num_dofs())};
+  double theta = 0.0;
   std::vector<double> state;
-  std::vector<Eigen::VectorXd> us = {u};
-  theta_ = {0.0};
-  p_ = {0.0};
-  V_ = {asmb.cavity_volume(u)};
-  S_ = {Eigen::Vector3d::Zero()};
-  for (double p = opt_.dp_Pa; p <= opt_.p_top_Pa + 1e-9; p += opt_.dp_Pa) {
-    Eigen::VectorXd trial = u;
+  for (double p = options.dp_Pa; p <= options.p_top_Pa + 1e-9; p += options.dp_Pa) {
+    Eigen::VectorXd trial = tr.u.back();
     try {
-      solver.advance(p_.back(), p, 0.0, 0.0, state, trial);
+      solver.advance(tr.p_Pa.back(), p, 0.0, 0.0, state, trial);
     } catch (const PhysicsError&) {
       break;  // limit point (or inversion) beyond this pressure: the path ends here
     }
-    const double th = unwrap_deg(bending_angle(reference, trial).angle_deg, theta_.back());
-    if (!(th > theta_.back())) break;  // the angle must increase along the path
-    u = trial;
-    us.push_back(u);
-    theta_.push_back(th);
-    p_.push_back(p);
-    V_.push_back(asmb.cavity_volume(u));
-    S_.push_back(first_moment(u));
+    const double th = unwrap_deg(bending_angle(reference, trial).angle_deg, theta);
+    if (!(th > theta)) break;  // the angle must increase along the path
+    theta = th;
+    tr.u.push_back(std::move(trial));
+    tr.p_Pa.push_back(p);
   }
-  if (theta_.size() < 3)
-    throw PhysicsError("path model: the elastic path could not be traced beyond " + std::to_string(p_.back()) +
+  if (tr.p_Pa.size() < 3)
+    throw PhysicsError("path model: the elastic path could not be traced beyond " + std::to_string(tr.p_Pa.back()) +
                        " Pa; check the model with pneufem simulate first");
+  return tr;
+}
+
+PathModel::PathModel(const Model& reference, const PathModelOptions& options)
+    : PathModel(reference, options, trace_elastic_path(reference, options)) {}
+
+PathModel::PathModel(const Model& reference, const PathModelOptions& options, const ElasticPathTrace& trace)
+    : ref_(reference), opt_(options) {
+  check_options(opt_);
+  const Assembler asmb(reference);
+  if (asmb.state_size() != 0)
+    throw InputError("path model: the reference model must be elastic (materials without history)");
+  const std::vector<Eigen::VectorXd>& us = trace.u;
+  auto bad = [](const std::string& why) {
+    return InputError("path model: the elastic path trace " + why +
+                      " (a stored trace that is damaged or belongs to another model: delete it and trace again)");
+  };
+  if (us.size() != trace.p_Pa.size() || us.size() < 3) throw bad("has fewer than three samples or mismatched sizes");
+  const Eigen::VectorXd& mass = asmb.lumped_mass();
+  for (std::size_t k = 0; k < us.size(); ++k) {
+    if (us[k].size() != reference.num_dofs()) throw bad("has " + std::to_string(us[k].size()) + " dof, the model " +
+                                                        std::to_string(reference.num_dofs()));
+    if (!us[k].allFinite() || !std::isfinite(trace.p_Pa[k])) throw bad("holds non-finite values");
+    const double th = k == 0 ? 0.0 : unwrap_deg(bending_angle(reference, us[k]).angle_deg, theta_.back());
+    if (k == 0 ? (trace.p_Pa[0] != 0.0 || !us[0].isZero(0.0)) : !(th > theta_.back() && trace.p_Pa[k] > p_.back()))
+      throw bad(k == 0 ? "does not start unloaded" : "is not increasing in pressure and angle at sample " + std::to_string(k));
+    theta_.push_back(th);
+    p_.push_back(trace.p_Pa[k]);
+    V_.push_back(asmb.cavity_volume(us[k]));
+    S_.push_back(first_moment(mass, us[k]));
+  }
 
   // 2. Material points.
   const Mesh& mesh = reference.mesh;

@@ -60,6 +60,19 @@ struct PathLoad {
   std::vector<double> t_s, p_Pa;
 };
 
+/// The traced elastic path itself: pressure (Pa) and displacement (m, all dofs) of each sample,
+/// from the unloaded state on. Everything else the PathModel holds is computed from it, so a trace
+/// stored with its exact bits (app/result_cache.h) rebuilds the identical model.
+struct ElasticPathTrace {
+  std::vector<double> p_Pa;
+  std::vector<Eigen::VectorXd> u;
+};
+
+/// Step 1 of the PathModel: traces the elastic path of `reference` with Newton in load control, one
+/// sample per options.dp_Pa up to options.p_top_Pa; ends quietly at a limit point. Throws
+/// PhysicsError when fewer than three samples (the unloaded state included) could be traced.
+ElasticPathTrace trace_elastic_path(const Model& reference, const PathModelOptions& options);
+
 struct PathRunStats {
   long steps = 0;
   long evaluations = 0;
@@ -71,6 +84,10 @@ class PathModel {
   /// Traces the elastic path of `reference` (materials without history, no gravity) with Newton.
   /// Stops early, without error, at a limit point (the path then ends there).
   PathModel(const Model& reference, const PathModelOptions& options);
+  /// The same from a trace of this reference with these options (trace_elastic_path). Throws
+  /// InputError when the trace does not fit the model (dof count, unloaded first sample, finite
+  /// values, increasing pressure and angle): a stored trace that was damaged or belongs elsewhere.
+  PathModel(const Model& reference, const PathModelOptions& options, const ElasticPathTrace& trace);
 
   /// Angle history (deg) of `model` — same mesh as the reference, any materials and gravity —
   /// under `load`. Throws InputError when the mesh differs, PhysicsError when no path point

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <random>
 #include <string>
@@ -40,6 +41,12 @@ namespace {
 const std::vector<std::string> kScene = {"geometry.chambers=5", "mesh.h_mm=6.0",  "load.max_kPa=30.0",
                                          "load.step_kPa=10.0",  "load.hold_s=4.0", "load.trials=3"};
 
+// The actuator's elastic FEM work (path trace, static curves) is shared by the tests on kScene
+// through one cache directory (app/result_cache.h): keyed by this test program's own bytes, so a
+// rebuilt program never reads an old entry; results are bit-identical to computing them
+// (DiagnoseCache.ReRunGivesTheIdenticalDiagnosisFromTheCache).
+std::string shared_cache() { return (fs::temp_directory_path() / "pneufem_diagnose_cache").string(); }
+
 std::string data(const std::string& name) { return std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/" + name + ".csv"; }
 
 DiagnosisResult diagnose(const std::string& name, int refine = 0) {
@@ -48,6 +55,7 @@ DiagnosisResult diagnose(const std::string& name, int refine = 0) {
   o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_" + name)).string();
   fs::remove_all(o.out_dir);
   o.refine = refine;
+  o.cache_dir = shared_cache();
   o.max_effects = 1;  // one hidden effect: round 2 is exercised in GravityIsKeptUnderHistoryEffects and ForwardSelectionStopsAtTheNoiseFloor
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   std::printf("%s: baseline %.4f, floor %.4f, final %.4f (FEM %.4f); ranking:", name.c_str(), r.baseline_nrmse,
@@ -74,6 +82,11 @@ fs::path softer_silicone_recording(const Scene& scene, const std::string& name) 
   fs::create_directories(dir);
   write_measurements_csv((dir / "data.csv").string(), rec);
   return dir;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 double param(const DiagnosisResult& r, const std::string& name) {
@@ -215,6 +228,38 @@ TEST(DiagnoseFem, CalibratesOnTheFemFromTheReducedModelStart) {
   EXPECT_LE(std::abs(fem_scale - 0.8), std::abs(rom_scale - 0.8));
   EXPECT_GE(r.verified_fitted_nrmse, 0.0);
   EXPECT_LT(r.verified_fitted_nrmse, 0.005);
+  fs::remove_all(dir);
+}
+
+// --cache: a second run on the same actuator reads the elastic path and the static FEM curves (gravity
+// needs them) from the cache and gives the identical diagnosis, to the bit: the cache stores exact
+// doubles and everything else is recomputed from them.
+TEST(DiagnoseCache, ReRunGivesTheIdenticalDiagnosisFromTheCache) {
+  const Scene scene = fem_stage_scene();
+  const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_cache");
+  DiagnoseOptions o = stiffness_only(dir);
+  o.candidates = {"stiffness", "gravity", "viscoelastic"};
+  o.max_evaluations = 15;  // identity is the point here, not the fit
+  o.cache_dir = (dir / "cache").string();
+  const DiagnosisResult first = run_diagnosis(scene, o);
+  const std::string json1 = read_text(dir / "out" / "diagnosis.json");
+  o.out_dir = (dir / "out2").string();
+  const DiagnosisResult second = run_diagnosis(scene, o);
+  const std::string json2 = read_text(dir / "out2" / "diagnosis.json");
+  EXPECT_NE(json1.find("\"elastic_path_source\": \"computed\""), std::string::npos);
+  EXPECT_NE(json2.find("\"elastic_path_source\": \"cache "), std::string::npos);
+  int curves = 0;
+  for (const auto& e : fs::directory_iterator(dir / "cache")) curves += e.path().filename().string().starts_with("curve_");
+  EXPECT_GE(curves, 5);  // the gravity candidate's rig-angle node sweeps at least
+  ASSERT_EQ(first.candidates.size(), second.candidates.size());
+  for (std::size_t i = 0; i < first.candidates.size(); ++i) {
+    EXPECT_EQ(first.candidates[i].effect, second.candidates[i].effect);
+    EXPECT_EQ(first.candidates[i].params, second.candidates[i].params) << first.candidates[i].effect;
+    EXPECT_EQ(first.candidates[i].rss_deg2, second.candidates[i].rss_deg2) << first.candidates[i].effect;
+  }
+  EXPECT_EQ(first.baseline_nrmse, second.baseline_nrmse);
+  EXPECT_EQ(first.final_nrmse, second.final_nrmse);
+  EXPECT_EQ(read_text(dir / "out" / "diagnosis.csv"), read_text(dir / "out2" / "diagnosis.csv"));
   fs::remove_all(dir);
 }
 
@@ -392,6 +437,7 @@ TEST(Diagnose, ARecordingInTheOppositeSignConventionStopsWithTheFix) {
   DiagnoseOptions o;
   o.data_path = (dir / "data.csv").string();
   o.out_dir = (dir / "out").string();
+  o.cache_dir = shared_cache();
   try {
     run_diagnosis(Scene::load("", kScene), o);
     ADD_FAILURE() << "diagnose ran on negated angles";
@@ -473,6 +519,7 @@ TEST(HiddenEffect, GravityIsKeptUnderHistoryEffects) {
   o.max_effects = 2;
   o.stop_at_noise_floor = false;  // round 1 reaches the floor; this test is about round 2
   o.candidates = {"gravity", "viscoelastic"};
+  o.cache_dir = shared_cache();
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   ASSERT_EQ(r.missing_effect, "gravity");
   double g1 = NAN, v2 = NAN;
@@ -497,6 +544,7 @@ TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
     fs::remove_all(o.out_dir);
     o.max_effects = 2;
     o.candidates = std::move(cands);
+    o.cache_dir = shared_cache();
     return run_diagnosis(Scene::load("", kScene), o);
   };
   auto rounds = [](const DiagnosisResult& r) {
@@ -558,6 +606,7 @@ TEST(HiddenEffect, TrustingTheElasticModelLetsAStaticEffectFollow) {
   o.max_effects = 2;
   o.candidates = {"viscoelastic", "gravity"};
   o.trust_elastic_model = true;
+  o.cache_dir = shared_cache();
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   EXPECT_EQ(r.selected, (std::vector<std::string>{"viscoelastic", "gravity"}));
 }

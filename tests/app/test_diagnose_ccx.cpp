@@ -103,6 +103,7 @@ DiagnosisResult diagnose(const std::string& name, double lag_s) {
   // A static candidate, a history one and the lag: what a static misfit (the reduced model's own
   // error) would be taken for, what noise on a creep-free record could pass for, and the truth.
   o.candidates = {"stiffness", "viscoelastic", "pressure_lag"};
+  o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();  // shared elastic work (app/result_cache.h)
   return run_diagnosis(Scene::load(kData + "scene.toml"), o);
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <map>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -15,6 +16,7 @@
 #include "engine/path_model.h"
 #include "engine/quasi_static.h"
 #include "engine/static_solver.h"
+#include "materials/errors.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -201,7 +203,25 @@ TEST(PathModel, AngleIsSmoothInTheConstants) {
   auto ref = build_model(Scene::load("", kSmall));
   PathModelOptions po;
   po.p_top_Pa = 25e3;  // the softest model at 15 kPa bends as the reference at ~21 kPa
-  const PathModel rom(ref->model, po);
+  // Built from its trace, as diagnose --cache does (the plain constructor traces and delegates).
+  const ElasticPathTrace trace = trace_elastic_path(ref->model, po);
+  const PathModel rom(ref->model, po, trace);
+  // A stored trace that does not fit the model is refused, saying why.
+  auto refused = [&](ElasticPathTrace t, const std::string& why) {
+    try {
+      const PathModel bad(ref->model, po, t);
+      ADD_FAILURE() << "accepted a trace that " << why;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  };
+  ElasticPathTrace shorter = trace, swapped = trace, nan = trace;
+  shorter.u[1].conservativeResize(shorter.u[1].size() - 3);
+  refused(shorter, "dof");
+  std::swap(swapped.u[1], swapped.u[2]);
+  refused(swapped, "is not increasing in pressure and angle at sample 2");
+  nan.u[2][7] = NAN;
+  refused(nan, "non-finite");
   PathLoad load;
   load.t_s = {0.0};
   load.p_Pa = {15e3};
