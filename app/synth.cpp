@@ -96,7 +96,7 @@ std::string key_of(const std::string& set) { return set.substr(0, set.find('='))
 /// another representation (`replaced_keys`: a hidden rig angle under a --set gravity vector).
 std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::string>& sets, const Scene& base,
                               const Scene& resolved, const std::set<std::string>& user_keys,
-                              const std::set<std::string>& replaced_keys) {
+                              const std::set<std::string>& replaced_keys, const std::vector<std::string>& user_sets) {
   json::Object params;
   std::vector<double> truth;
   for (const CandidateParameter& p : c.params) truth.push_back(p.truth);
@@ -129,8 +129,14 @@ std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::s
     else
       params.add(c.params[i].name, std::string("null"));
   }
+  // The overrides as the simulation applied them: a --set of the same key replaces the catalog's.
   std::string keys = "[";
-  for (std::size_t i = 0; i < sets.size(); ++i) keys += (i ? ", " : "") + json::quote(sets[i]);
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    std::string applied = sets[i];
+    for (const std::string& u : user_sets)
+      if (key_of(u) == key_of(sets[i])) applied = u;
+    keys += (i ? ", " : "") + json::quote(applied);
+  }
   json::Object e;
   e.add("truth", params.str(6)).add("sets", keys + "]");
   return e.str(4);
@@ -215,7 +221,7 @@ SynthResult run_synth(const SynthOptions& o) {
   }
   const Scene scene = base.with(res.hidden_sets).with(user_sets);
   json::Object effects;
-  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys, replaced_keys));
+  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys, replaced_keys, user_sets));
   if (scene.string("load.protocol") != "staircase")
     scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
   if (scene.string("solver.mode") != "quasi_static")

@@ -652,5 +652,39 @@ TEST(HiddenEffect, Fatigue) {
   EXPECT_NE(c->why.find("They trade off"), std::string::npos) << c->why;
 }
 
+// Two hidden effects at once, as in the paper's recordings: creep in every hold (viscoelastic,
+// gamma 0.5, tau 4 s) and fatigue growing over the trials (W_th 4 kPa, tau 200 s: with the Prony
+// term this actuator is stiffer and its walls store less energy, and at the fatigue dataset's 8 kPa
+// the fatigue moved the angle by < 0.07 deg in three trials, the tracking noise; at 4 kPa by
+// 0.77 deg in trial 3). Round 1 must name the creep (it explains most: measured NRMSE 0.154 ->
+// 0.040), round 2 the fatigue beyond it (-> 0.0167 at a 0.0107 floor), not Mullins, the other wall
+// damage, which stops growing after the first peak. Candidates: these three and the static stand-in;
+// gravity and lag are not in question here and cost half the run. Bounds: the final error as in
+// HiddenEffect.Fatigue (2x the floor + 0.005: the reduced model's wall-damage error); the fatigue
+// threshold within 2x of the truth (measured 4.05 kPa); its tau is not asserted, it trades off
+// with the threshold (HiddenEffect.Fatigue).
+TEST(HiddenEffect, CreepAndFatigueTogetherAreBothFound) {
+  DiagnoseOptions o;
+  o.data_path = data("viscoelastic_fatigue");
+  o.out_dir = (fs::temp_directory_path() / "pneufem_diag_visco_fatigue").string();
+  fs::remove_all(o.out_dir);
+  o.max_effects = 2;
+  o.candidates = {"stiffness", "viscoelastic", "mullins", "fatigue"};
+  o.cache_dir = shared_cache();
+  const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
+  std::printf("baseline %.4f, floor %.4f, final %.4f; selected:", r.baseline_nrmse, r.noise_floor_nrmse, r.final_nrmse);
+  for (const std::string& s : r.selected) std::printf(" %s", s.c_str());
+  std::printf("\n");
+  ASSERT_EQ(r.selected, (std::vector<std::string>{"viscoelastic", "fatigue"}));
+  EXPECT_EQ(r.missing_effect, "viscoelastic");
+  EXPECT_LT(r.final_nrmse, 2.0 * r.noise_floor_nrmse + 0.005);
+  EXPECT_GT(r.baseline_nrmse, 5.0 * r.final_nrmse);
+  const auto f = std::find_if(r.candidates.begin(), r.candidates.end(),
+                              [](const CandidateResult& c) { return c.effect == "fatigue" && c.round == 2; });
+  ASSERT_NE(f, r.candidates.end());
+  std::printf("fatigue: W_th %.4g MPa, tau %.4g s (truth 0.004, 200)\n", f->params[0], f->params[1]);
+  EXPECT_NEAR(std::log10(f->params[0]), std::log10(0.004), std::log10(2.0));
+}
+
 }  // namespace
 }  // namespace pneufem

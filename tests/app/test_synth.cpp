@@ -174,6 +174,9 @@ TEST(Synth, TruthRecordsOverriddenConstants) {
   EXPECT_NE(j.find("\"tau_s\": 300"), std::string::npos) << j;
   EXPECT_NE(j.find("\"W_th_MPa\": " + json::num(f.params[0].truth)), std::string::npos) << j;
   EXPECT_NE(j.find("\"" + candidate_effect("gravity").params[0].name + "\": null"), std::string::npos) << j;
+  // ... and its "sets" are the overrides as applied: the --set, not the catalog's value it replaced.
+  EXPECT_NE(j.find("\"materials.silicone.fatigue.tau_s=300.0\""), std::string::npos) << j;
+  EXPECT_EQ(j.find("\"materials.silicone.fatigue.tau_s=" + json::num(f.params[1].truth) + "\""), std::string::npos) << j;
 }
 
 TEST(Synth, BadHiddenNameListsTheCandidates) {
