@@ -241,6 +241,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   std::mutex mu;
 
   DiagnosisResult out;
+  out.elastic_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   auto metrics = [&](const Scene& s) { return compare_recording(rec, rom.series(s)); };
   const Comparison base = metrics(cal_scene);
   ++rom_runs;

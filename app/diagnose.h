@@ -163,6 +163,9 @@ struct DiagnosisResult {
   std::vector<std::vector<double>> refined_params;  ///< per selected effect, after refinement
   std::string fitted_toml;
   double wall_s = 0.0;
+  /// Wall time of the elastic FEM work before the calibrations (path trace, scene-mesh sweep;
+  /// near 0 when read from --cache).
+  double elastic_wall_s = 0.0;
   long rom_runs = 0;
 };
 

@@ -111,6 +111,10 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json and fitted.toml\n",
               r.missing_effect.empty() ? "none" : r.missing_effect.c_str(), r.selected.size(), r.final_nrmse, r.wall_s,
               c.options.out_dir.c_str());
+  if (c.options.cache_dir.empty() && r.elastic_wall_s > 20.0)
+    std::printf("note: %.0f s of this run was elastic FEM work that depends only on the actuator and the peak pressure; "
+                "--cache DIR keeps it for re-runs (README, \"Re-runs\")\n",
+                r.elastic_wall_s);
   return 0;
 }
 

@@ -114,6 +114,30 @@ TEST(Cli, KilledRunResumesToTheUninterruptedResult) {
   }
 }
 
+// diagnose --cache on the command line: the second run reads the elastic path the first stored and
+// writes the same diagnosis; a cache directory that cannot be made is bad input (exit 2, nothing
+// written). (The cache itself: test_result_cache.cpp, DiagnoseCache in test_diagnose.cpp.)
+TEST(Cli, DiagnoseReadsItsCacheOnTheSecondRun) {
+  const std::string data = std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/stiffness.csv";
+  const std::string args = " --set geometry.chambers=5 --set mesh.h_mm=6.0 --set load.max_kPa=30.0 --set load.step_kPa=10.0"
+                           " --set load.hold_s=4.0 --set load.trials=3 --candidates stiffness --max-effects 1"
+                           " --evaluations 5 --progress --threads 2";
+  const fs::path d = fresh_dir("diag_cache");
+  const Result bad = run("diagnose --data " + data + " --out " + (d / "bad").string() + args + " --cache /dev/null/cache");
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("--cache /dev/null/cache"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(d / "bad" / "diagnosis.json"));
+  const std::string cache = (d / "cache").string();
+  const Result a = run("diagnose --data " + data + " --out " + (d / "a").string() + args + " --cache " + cache);
+  ASSERT_EQ(a.code, 0) << a.out;
+  EXPECT_NE(a.out.find("path computed"), std::string::npos) << a.out;
+  const Result b = run("diagnose --data " + data + " --out " + (d / "b").string() + args + " --cache " + cache);
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("path cache " + cache), std::string::npos) << b.out;
+  EXPECT_EQ(slurp(d / "a" / "diagnosis.csv"), slurp(d / "b" / "diagnosis.csv"));
+  EXPECT_EQ(slurp(d / "a" / "fitted.toml"), slurp(d / "b" / "fitted.toml"));
+}
+
 TEST(Cli, MeshExportsARunnableCalculixDeck) {
   const fs::path f = fs::temp_directory_path() / "pneufem_cli_mesh.inp";
   const Result r = run("mesh --out " + f.string() + " " + kTiny);
