@@ -1,14 +1,15 @@
 #pragma once
 // Expensive elastic results shared between runs through a cache directory.
 //
-// `pneufem diagnose` starts every run with static FEM work that depends only on the actuator, not on
-// the recording's details or the candidates: the elastic path of the reduced model (a Newton trace
-// of the calibration mesh) and, with a calibration mesh, one static sweep of the scene's own mesh —
-// 314 s of the default scene's 536 s (BENCHMARKS.md section 8). With `--cache DIR` the first run
-// stores them and later runs on the same actuator read them, bit for bit, so a re-run gives the
-// identical diagnosis without the cost.
+// `pneufem diagnose` starts every run with static FEM work that depends only on the actuator and
+// the recording's peak pressure, not on the candidates or the rest of the recording: the elastic
+// path of the reduced model (a Newton trace of the calibration mesh) and, with a calibration mesh,
+// one static sweep of the scene's own mesh — 305 s of the default scene's 527 s — plus the static
+// curves of the gravity candidate (BENCHMARKS.md section 8, session 24). With `--cache DIR` the
+// first run stores them and later runs read them, bit for bit: a re-run gives the identical
+// diagnosis without the cost (527 s -> 50 s there).
 //
-// Keys (CacheKey): FNV-1a, 64 bit, of what the result depends on — the running executable's own
+// Keys: FNV-1a, 64 bit, of what the result depends on — the running executable's own
 // bytes (any rebuild of pneufem, or of the test program, starts a new cache: a stored result never
 // outlives the code that computed it), the resolved model scene (Scene::model_toml), the built
 // model's mesh, boundary conditions, cavity faces and tip nodes (ideal_cache_key: a deck's
