@@ -25,26 +25,26 @@ namespace {
 
 constexpr char kMagic[] = "pneufem cache 1\n";
 
-/// The entry's doubles, or empty when the file is missing, truncated or fails its checksum.
-std::vector<double> read_entry(const std::string& path, bool* damaged) {
-  *damaged = false;
+enum class Entry { missing, damaged, valid };
+
+/// Reads an entry into `v`: missing (no file), damaged (truncated, foreign, or failing its
+/// checksum) or valid.
+Entry read_entry(const std::string& path, std::vector<double>& v) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
+  if (!in) return Entry::missing;
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::size_t head = sizeof kMagic - 1;
   std::uint64_t n = 0, sum = 0;
-  *damaged = true;
-  if (bytes.size() < head + 2 * sizeof n || bytes.compare(0, head, kMagic) != 0) return {};
+  if (bytes.size() < head + 2 * sizeof n || bytes.compare(0, head, kMagic) != 0) return Entry::damaged;
   std::memcpy(&n, bytes.data() + head, sizeof n);
-  if (n > (bytes.size() - head) / sizeof(double) || bytes.size() != head + sizeof n + n * sizeof(double) + sizeof sum) return {};
-  std::vector<double> v(n);
+  if (n > (bytes.size() - head) / sizeof(double) || bytes.size() != head + sizeof n + n * sizeof(double) + sizeof sum)
+    return Entry::damaged;
+  v.resize(n);
   std::memcpy(v.data(), bytes.data() + head + sizeof n, n * sizeof(double));
   std::memcpy(&sum, bytes.data() + head + sizeof n + n * sizeof(double), sizeof sum);
   Fnv1a h;
   h.vec(v);
-  if (h.value() != sum) return {};
-  *damaged = false;
-  return v;
+  return h.value() == sum ? Entry::valid : Entry::damaged;
 }
 
 std::string entry_bytes(const std::vector<double>& v) {
@@ -119,15 +119,14 @@ std::vector<double> cached_doubles(const std::string& dir, const std::string& ki
   std::vector<double> out;
   tbb::this_task_arena::isolate([&] {
     FileLock lock(base + ".lock", "--cache");
-    bool damaged = false;
-    out = read_entry(file, &damaged);
-    if (!damaged && fs::exists(file)) {
+    const Entry e = read_entry(file, out);
+    if (e == Entry::valid) {
       if (source) *source = "cache " + file;
       return;
     }
     out = compute();
     write_file_atomic(file, entry_bytes(out));
-    if (source) *source = damaged ? "recomputed (" + file + " was damaged)" : "computed";
+    if (source) *source = e == Entry::damaged ? "recomputed (" + file + " was damaged)" : "computed";
   });
   return out;
 }

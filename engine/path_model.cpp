@@ -197,10 +197,6 @@ double generalised_force(const Groups& g, const PathSegment& seg, const std::vec
   return G;
 }
 
-}  // namespace
-
-namespace {
-
 void check_options(const PathModelOptions& o) {
   if (!(o.dp_Pa > 0.0) || !(o.p_top_Pa > o.dp_Pa) || o.max_points < 1 || !(o.max_dt_s > 0.0))
     throw InputError("path model: need 0 < dp_Pa < p_top_Pa, max_points >= 1 and max_dt_s > 0");
@@ -268,12 +264,17 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
   if (us.size() != trace.p_Pa.size() || us.size() < 3) throw bad("has fewer than three samples or mismatched sizes");
   const Eigen::VectorXd& mass = asmb.lumped_mass();
   for (std::size_t k = 0; k < us.size(); ++k) {
-    if (us[k].size() != reference.num_dofs()) throw bad("has " + std::to_string(us[k].size()) + " dof, the model " +
-                                                        std::to_string(reference.num_dofs()));
+    if (us[k].size() != reference.num_dofs())
+      throw bad("has " + std::to_string(us[k].size()) + " dof, the model " + std::to_string(reference.num_dofs()));
     if (!us[k].allFinite() || !std::isfinite(trace.p_Pa[k])) throw bad("holds non-finite values");
-    const double th = k == 0 ? 0.0 : unwrap_deg(bending_angle(reference, us[k]).angle_deg, theta_.back());
-    if (k == 0 ? (trace.p_Pa[0] != 0.0 || !us[0].isZero(0.0)) : !(th > theta_.back() && trace.p_Pa[k] > p_.back()))
-      throw bad(k == 0 ? "does not start unloaded" : "is not increasing in pressure and angle at sample " + std::to_string(k));
+    double th = 0.0;
+    if (k == 0) {
+      if (trace.p_Pa[0] != 0.0 || !us[0].isZero(0.0)) throw bad("does not start unloaded");
+    } else {
+      th = unwrap_deg(bending_angle(reference, us[k]).angle_deg, theta_.back());
+      if (!(th > theta_.back() && trace.p_Pa[k] > p_.back()))
+        throw bad("is not increasing in pressure and angle at sample " + std::to_string(k));
+    }
     theta_.push_back(th);
     p_.push_back(trace.p_Pa[k]);
     V_.push_back(asmb.cavity_volume(us[k]));
@@ -375,7 +376,6 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
       Gref_[k * (kRefSub + 1) + j] = generalised_force(gr, path_segment(F_, dF_, theta_, np, k, static_cast<double>(j) / kRefSub),
                                                        pt_weight_, pt_element_, TimeStep{}, nullptr, nullptr, Fbuf, dFbuf, rbuf);
 }
-
 
 int PathModel::segment(double theta) const {
   const auto it = std::upper_bound(theta_.begin(), theta_.end(), theta);

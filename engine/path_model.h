@@ -110,7 +110,7 @@ class PathModel {
   std::vector<int> pt_qp_;                  ///< its quadrature point
   std::vector<double> pt_weight_;           ///< quadrature weight (m^3)
   std::vector<Mat3> F_;                     ///< [sample][point]
-  std::vector<Mat3> dF_;                    ///< dF/dtheta, [sample][point] (C1 path between samples)
+  std::vector<Mat3> dF_;                    ///< dF/dtheta, [sample][point] (the C2 spline's slopes)
   std::vector<double> dV_;                  ///< dV/dtheta per sample
   std::vector<Eigen::Vector3d> dS_;         ///< dS/dtheta per sample
   std::vector<double> dp_dtheta_;           ///< monotone cubic slopes of p_el(theta) at the samples

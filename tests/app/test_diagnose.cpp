@@ -49,14 +49,26 @@ std::string shared_cache() { return (fs::temp_directory_path() / "pneufem_diagno
 
 std::string data(const std::string& name) { return std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/" + name + ".csv"; }
 
-DiagnosisResult diagnose(const std::string& name, int refine = 0) {
+/// Options for a diagnosis of the hidden-effect dataset `name` on kScene: output in a fresh
+/// <tmp>/pneufem_diag_<out>, the shared cache, at most `max_effects` rounds over `candidates`
+/// (empty = the whole catalog).
+DiagnoseOptions hidden_options(const std::string& name, const std::string& out, int max_effects,
+                               std::vector<std::string> candidates = {}) {
   DiagnoseOptions o;
   o.data_path = data(name);
-  o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_" + name)).string();
+  o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_" + out)).string();
   fs::remove_all(o.out_dir);
-  o.refine = refine;
+  o.max_effects = max_effects;
+  o.candidates = std::move(candidates);
   o.cache_dir = shared_cache();
-  o.max_effects = 1;  // one hidden effect: round 2 is exercised in GravityIsKeptUnderHistoryEffects and ForwardSelectionStopsAtTheNoiseFloor
+  return o;
+}
+
+DiagnosisResult diagnose(const std::string& name, int refine = 0) {
+  // One round: one hidden effect (round 2 is exercised in GravityIsKeptUnderHistoryEffects and
+  // ForwardSelectionStopsAtTheNoiseFloor).
+  DiagnoseOptions o = hidden_options(name, name, 1);
+  o.refine = refine;
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   std::printf("%s: baseline %.4f, floor %.4f, final %.4f (FEM %.4f); ranking:", name.c_str(), r.baseline_nrmse,
               r.noise_floor_nrmse, r.final_nrmse, r.verified_fitted_nrmse);
@@ -512,14 +524,8 @@ TEST(HiddenEffect, GravityOnATiltedDeckIsFoundInTheActuatorsFrame) {
 }
 
 TEST(HiddenEffect, GravityIsKeptUnderHistoryEffects) {
-  DiagnoseOptions o;
-  o.data_path = data("gravity");
-  o.out_dir = (fs::temp_directory_path() / "pneufem_diag_gravity_visco").string();
-  fs::remove_all(o.out_dir);
-  o.max_effects = 2;
+  DiagnoseOptions o = hidden_options("gravity", "gravity_visco", 2, {"gravity", "viscoelastic"});
   o.stop_at_noise_floor = false;  // round 1 reaches the floor; this test is about round 2
-  o.candidates = {"gravity", "viscoelastic"};
-  o.cache_dir = shared_cache();
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   ASSERT_EQ(r.missing_effect, "gravity");
   double g1 = NAN, v2 = NAN;
@@ -538,14 +544,7 @@ TEST(HiddenEffect, GravityIsKeptUnderHistoryEffects) {
 // round 2 still runs there.
 TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
   auto run = [](const std::string& name, std::vector<std::string> cands) {
-    DiagnoseOptions o;
-    o.data_path = data(name);
-    o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_stop_" + name)).string();
-    fs::remove_all(o.out_dir);
-    o.max_effects = 2;
-    o.candidates = std::move(cands);
-    o.cache_dir = shared_cache();
-    return run_diagnosis(Scene::load("", kScene), o);
+    return run_diagnosis(Scene::load("", kScene), hidden_options(name, "stop_" + name, 2, std::move(cands)));
   };
   auto rounds = [](const DiagnosisResult& r) {
     int m = 0;
@@ -599,14 +598,8 @@ TEST(HiddenEffect, ForwardSelectionStopsAtTheNoiseFloor) {
 // --trust-elastic-model restores the raw tests from round 2 on: on the same data gravity, which
 // passes them, is then added (the option is for a model whose elastic response is known).
 TEST(HiddenEffect, TrustingTheElasticModelLetsAStaticEffectFollow) {
-  DiagnoseOptions o;
-  o.data_path = data("viscoelastic");
-  o.out_dir = (fs::temp_directory_path() / "pneufem_diag_trust").string();
-  fs::remove_all(o.out_dir);
-  o.max_effects = 2;
-  o.candidates = {"viscoelastic", "gravity"};
+  DiagnoseOptions o = hidden_options("viscoelastic", "trust", 2, {"viscoelastic", "gravity"});
   o.trust_elastic_model = true;
-  o.cache_dir = shared_cache();
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   EXPECT_EQ(r.selected, (std::vector<std::string>{"viscoelastic", "gravity"}));
 }
@@ -664,14 +657,9 @@ TEST(HiddenEffect, Fatigue) {
 // threshold within 2x of the truth (measured 4.05 kPa); its tau is not asserted, it trades off
 // with the threshold (HiddenEffect.Fatigue).
 TEST(HiddenEffect, CreepAndFatigueTogetherAreBothFound) {
-  DiagnoseOptions o;
-  o.data_path = data("viscoelastic_fatigue");
-  o.out_dir = (fs::temp_directory_path() / "pneufem_diag_visco_fatigue").string();
-  fs::remove_all(o.out_dir);
-  o.max_effects = 2;
-  o.candidates = {"stiffness", "viscoelastic", "mullins", "fatigue"};
-  o.cache_dir = shared_cache();
-  const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
+  const DiagnosisResult r = run_diagnosis(
+      Scene::load("", kScene),
+      hidden_options("viscoelastic_fatigue", "visco_fatigue", 2, {"stiffness", "viscoelastic", "mullins", "fatigue"}));
   std::printf("baseline %.4f, floor %.4f, final %.4f; selected:", r.baseline_nrmse, r.noise_floor_nrmse, r.final_nrmse);
   for (const std::string& s : r.selected) std::printf(" %s", s.c_str());
   std::printf("\n");
