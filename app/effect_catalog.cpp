@@ -130,7 +130,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     e.description = "the actuator's own weight, with the rig at angle phi: 0 = hanging tip-down, 90 = horizontal";
     e.signature = "an angle offset at zero pressure that changes with pressure as the tip swings, identical in every trial";
     // The rig angle phi is set in the actuator's own angle frame (gravity.rig_angle_deg, applied by
-    // scenes/build_model.cpp): 0 = g along the actuator away from the clamp (the tip hangs below it),
+    // scenes/angle_frame.cpp): 0 = g along the actuator away from the clamp (the tip hangs below it),
     // 90 deg = g towards the bend direction (horizontal, fabric side down), 180 = tip-up. So a deck in
     // any orientation (its frame taken from the mesh) is hung the same way; for the built-in actuator
     // (y along it, fabric at -z) g = [0, 9.81 cos(phi), -9.81 sin(phi)], and the half model (x >= 0)

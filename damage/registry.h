@@ -3,7 +3,7 @@
 // viscoelastic) and any effect a user adds in C++ (docs/adding_an_effect.md). An effect is a
 // decorator over a material (STYLE.md practice 2) with named numeric parameters; registering it
 // makes it available, by name, to
-//   * scenes:    [materials.<m>.<name>] enabled = true, <param> = value   (scenes/build_model.cpp)
+//   * scenes:    [materials.<m>.<name>] enabled = true, <param> = value   (scenes/scene_materials.cpp)
 //   * sweep:     --param materials.<m>.<name>.<param>=LO:HI:N
 //   * compare / diagnose / synth: as a candidate effect with the registered bounds (app/effect_catalog.h).
 //
@@ -60,7 +60,7 @@ const MaterialEffect* find_material_effect(const std::string& name);
 std::vector<const MaterialEffect*> material_effects();
 
 /// True for mullins, fatigue and viscoelastic, whose scene tables carry non-numeric keys and are
-/// read by scenes/build_model.cpp directly (the registry describes their numeric parameters).
+/// read by scenes/scene_materials.cpp directly (the registry describes their numeric parameters).
 bool is_builtin_effect(const std::string& name);
 
 }  // namespace pneufem

@@ -7,7 +7,7 @@
 // Exact property used by the tests: for a hyperelastic body under pressure p alone, the scaled body
 // at pressure s p has the unscaled body's equilibrium at p (the residual s f_int(u) - s p g(u) = 0).
 //
-// Placement (scenes/build_model.cpp): the scale wraps the hyperelastic BASE and sits inside the
+// Placement (scenes/scene_materials.cpp): the scale wraps the hyperelastic BASE and sits inside the
 // inelastic decorators, mullins(scaled(yeoh)) etc. Their energy thresholds (Mullins m, fatigue
 // W_th) therefore act on the scaled energy: a softer material reaches a fixed threshold later, as a
 // physically softer silicone would. The state layout is the base's (ScaledMaterial owns no state).

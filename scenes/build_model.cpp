@@ -1,46 +1,42 @@
+// Scene -> model (scenes/build_model.h): the mesh (built-in pneu-net or a deck), its regions and
+// parts, boundary conditions, cavity faces, fabric membrane and bending-angle keys, the load
+// history and the solver settings. Materials are built in scene_materials.cpp, a deck's angle frame
+// and the rig's gravity in angle_frame.cpp.
 #include "scenes/build_model.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <cstdint>
 #include <fstream>
-#include <functional>
 #include <initializer_list>
-#include <optional>
 #include <map>
-#include <numbers>
 #include <set>
 #include <sstream>
 
-#include <Eigen/Eigenvalues>
-
-#include "damage/effects.h"
-#include "damage/registry.h"
 #include "materials/errors.h"
 #include "materials/hyperelastic.h"
-#include "materials/ogden.h"
 #include "materials/scaled.h"
+#include "scenes/angle_frame.h"
 #include "scenes/inp.h"
 #include "scenes/inp_assembly.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/scene_keys.h"
 #include "scenes/solid_split.h"
 
 namespace pneufem {
 
 namespace {
 
-constexpr double kMPa = 1e6, kkPa = 1e3, kmm = 1e-3;
-
-void require_keys(const Scene& scene, const std::string& table, const std::set<std::string>& allowed,
-                  const std::string& what) {
-  for (const std::string& k : scene.table_keys(table))
-    if (!allowed.count(k)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      scene.fail(table + "." + k, "unknown key for " + what + "; allowed: " + list);
-    }
-}
+using detail::deck_tip_nodes;
+using detail::kkPa;
+using detail::kmm;
+using detail::node_set;
+using detail::positive;
+using detail::reject_ambiguous;
+using detail::require_keys;
+using detail::resolve_angle_frame;
+using detail::set_rig_gravity;
 
 /// The value of a string key that must be one of `options` (its name -> value), or a failure
 /// naming the key and every allowed name.
@@ -55,25 +51,6 @@ T choice(const Scene& scene, const std::string& key, std::initializer_list<std::
     ++i;
   }
   scene.fail(key, "must be " + allowed + ", got \"" + v + "\"");
-}
-
-double positive(const Scene& scene, const std::string& key) {
-  const double v = scene.number(key);
-  if (!(v > 0.0)) scene.fail(key, "must be > 0");
-  return v;
-}
-
-/// A name `key` gives that the mesh lacks but that several instances of a deck define (stored as
-/// "INSTANCE.NAME" each, inp_assembly.h): a failure listing the qualified names to choose from.
-template <class V>
-void reject_ambiguous(const Scene& s, const std::string& key, const std::map<std::string, V>& names,
-                      const std::string& name, const std::string& what) {
-  std::string upper = name;
-  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
-  const std::vector<std::string> choices = inp::qualified_choices(names, upper);
-  if (choices.size() > 1)
-    s.fail(key, what + " '" + name + "' is defined by " + std::to_string(choices.size()) +
-                    " instances of the deck; name one with its instance: " + inp::join_names(choices, " or "));
 }
 
 // ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
@@ -176,23 +153,6 @@ double length_unit(const Scene& s) {
   s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
 }
 
-const std::vector<int>& node_set(const Scene& s, const Mesh& m, const std::string& key) {
-  std::string name = s.string(key);
-  std::string upper = name;
-  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
-  for (const std::string& n : {name, upper}) {
-    auto it = m.node_sets.find(n);
-    if (it != m.node_sets.end()) {
-      if (it->second.empty()) s.fail(key, "node set '" + name + "' is empty");
-      return it->second;
-    }
-  }
-  reject_ambiguous(s, key, m.node_sets, name, "node set");
-  std::string avail;
-  for (const auto& [k, v] : m.node_sets) avail += (avail.empty() ? "" : ", ") + k;
-  s.fail(key, "node set '" + name + "' not found in the mesh; available: " + (avail.empty() ? "(none)" : avail));
-}
-
 const std::vector<int>* find_elset(const Mesh& m, const std::string& name) {
   std::string upper = name;
   std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
@@ -224,411 +184,11 @@ std::map<std::string, double> region_scales(const Scene& s, const Mesh& mesh) {
   return out;
 }
 
-
-}  // namespace
-
-namespace {
-
-const std::set<std::string> kEffects = {"mullins", "fatigue", "viscoelastic"};
-
-// Inelastic effects of a material table: [materials.NAME.mullins], .fatigue, .viscoelastic, each
-// with `enabled` and its constants. Applied in the canonical order viscoelastic(fatigue(mullins)).
-EffectParams effect_params(const Scene& s, const std::string& T) {
-  EffectParams e;
-  auto on = [&](const std::string& k) { return s.has(T + "." + k) && s.boolean(T + "." + k + ".enabled"); };
-  if (on("mullins")) {
-    const std::string K = T + ".mullins";
-    require_keys(s, K, {"enabled", "r", "m_MPa", "beta"}, "mullins");
-    e.mullins = MullinsParams{s.number(K + ".r"), s.number(K + ".m_MPa") * kMPa, s.number(K + ".beta")};
-  }
-  if (on("fatigue")) {
-    const std::string K = T + ".fatigue";
-    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail", "nonlocal_radius_mm"},
-                 "fatigue");
-    FatigueParams f;
-    const std::string driver = s.string(K + ".driver");
-    if (driver == "energy")
-      f.driver = FatigueDriver::energy;
-    else if (driver == "max_principal_stretch")
-      f.driver = FatigueDriver::max_principal_stretch;
-    else
-      s.fail(K + ".driver", "must be \"energy\" or \"max_principal_stretch\"");
-    f.W_th_Pa = s.number(K + ".W_th_MPa") * kMPa;
-    f.lambda_th = s.number(K + ".lambda_th");
-    f.tau_s = s.number(K + ".tau_s");
-    f.q = s.number(K + ".q");
-    f.n = s.number(K + ".n");
-    f.d_fail = s.number(K + ".d_fail");
-    const double R_mm = s.number(K + ".nonlocal_radius_mm");
-    if (!(std::isfinite(R_mm) && R_mm >= 0.0))
-      s.fail(K + ".nonlocal_radius_mm", "must be >= 0 mm (0 = local driver; > 0: averaged over this radius)");
-    f.nonlocal_radius_m = R_mm * 1e-3;
-    e.fatigue = f;
-  }
-  if (on("viscoelastic")) {
-    const std::string K = T + ".viscoelastic";
-    require_keys(s, K, {"enabled", "gamma", "tau_s"}, "viscoelastic");
-    e.viscoelastic = ViscoParams{s.numbers(K + ".gamma"), s.numbers(K + ".tau_s")};
-  }
-  return e;
-}
-
-}  // namespace
-
-namespace {
-MaterialPtr make_base_material(const Scene& s, const std::string& name);
-
-/// materials.NAME.stiffness_scale (absent in a user-defined table = 1).
-double material_scale(const Scene& s, const std::string& name) {
-  const std::string key = "materials." + name + ".stiffness_scale";
-  if (!s.has(key)) return 1.0;
-  const double v = s.number(key);
-  if (!(std::isfinite(v) && v > 0.0)) s.fail(key, "must be > 0 (1 = the material as given; 0.8 = 20 % softer)");
-  return v;
-}
-
-/// Keys every material table may have besides its law's constants: the scale and the effects.
-std::set<std::string> with_common_keys(std::set<std::string> keys) {
-  keys.insert("stiffness_scale");
-  for (const MaterialEffect* fx : material_effects()) keys.insert(fx->name);
-  return keys;
-}
-
-/// One inelastic layer to apply: ascending `order`, ties in registry order (damage/registry.h).
-struct Layer {
-  int order;
-  std::size_t rank;
-  std::string key;  ///< scene table, for error messages
-  std::function<MaterialPtr(MaterialPtr)> apply;
-};
-
-/// The enabled registered (non-built-in) effect `fx` of table T, or nothing. Parameters left out
-/// take the registry defaults; unknown keys are rejected naming the valid ones.
-std::optional<Layer> registered_layer(const Scene& s, const std::string& T, const MaterialEffect& fx, std::size_t rank) {
-  const std::string K = T + "." + fx.name;
-  if (!s.has(K) || !s.boolean(K + ".enabled")) return std::nullopt;
-  std::set<std::string> allowed{"enabled"};
-  std::map<std::string, double> values;
-  for (const EffectParameter& p : fx.params) {
-    allowed.insert(p.name);
-    values[p.name] = s.has(K + "." + p.name) ? s.number(K + "." + p.name) : p.default_value;
-  }
-  require_keys(s, K, allowed, "effect " + fx.name);
-  const MaterialEffect* f = &fx;  // registry entries are never moved
-  return Layer{fx.order, rank, K, [f, values](MaterialPtr b) { return f->decorate(std::move(b), values); }};
-}
-}  // namespace
-
-/// The material of table materials.NAME with its stiffness scale times `region_scale`, wrapped by its
-/// enabled effects: effect(...(scaled(base))). The scale sits inside the effects, so energy thresholds
-/// (Mullins m, fatigue W_th) are in the scaled energy (materials/scaled.h explains why).
-MaterialPtr make_material(const Scene& s, const std::string& name, double region_scale) {
-  const std::string T = "materials." + name;
-  MaterialPtr m = make_base_material(s, name);
-  try {
-    m = scale_material(std::move(m), material_scale(s, name) * region_scale);
-  } catch (const InputError& err) {
-    s.fail(T + ".stiffness_scale", err.what());
-  }
-  const EffectParams e = effect_params(s, T);
-  std::vector<Layer> layers;
-  std::size_t rank = 0;
-  for (const MaterialEffect* fx : material_effects()) {
-    ++rank;
-    if (fx->name == "mullins" && e.mullins)
-      layers.push_back({fx->order, rank, T, [p = *e.mullins](MaterialPtr b) { return make_mullins(std::move(b), p); }});
-    else if (fx->name == "fatigue" && e.fatigue)
-      layers.push_back({fx->order, rank, T, [p = *e.fatigue](MaterialPtr b) { return make_fatigue(std::move(b), p); }});
-    else if (fx->name == "viscoelastic" && e.viscoelastic)
-      layers.push_back({fx->order, rank, T, [p = *e.viscoelastic](MaterialPtr b) { return make_viscoelastic(std::move(b), p); }});
-    else if (!is_builtin_effect(fx->name))
-      if (auto l = registered_layer(s, T, *fx, rank)) layers.push_back(std::move(*l));
-  }
-  std::stable_sort(layers.begin(), layers.end(),
-                   [](const Layer& a, const Layer& b) { return a.order != b.order ? a.order < b.order : a.rank < b.rank; });
-  for (const Layer& l : layers) {
-    try {
-      m = l.apply(std::move(m));
-    } catch (const InputError& err) {
-      s.fail(l.key, err.what());
-    }
-  }
-  // A non-local fatigue driver reaches the engine through every layer around it (each forwards
-  // Material::nonlocal); an effect registered in C++ that does not would silently make it local.
-  if (e.fatigue && e.fatigue->nonlocal_radius_m > 0.0 && !(m->nonlocal().radius_m > 0.0))
-    s.fail(T + ".fatigue.nonlocal_radius_mm",
-           "an effect wrapped around fatigue ('" + m->name() + "') does not forward the non-local driver "
-           "(Material::nonlocal, nonlocal_driver, set_nonlocal_driver to its base; docs/adding_an_effect.md); "
-           "set nonlocal_radius_mm = 0.0 or forward them");
-  return m;
-}
-
-MaterialPtr make_material(const Scene& s, const std::string& name) { return make_material(s, name, 1.0); }
-
-namespace {
-MaterialPtr make_base_material(const Scene& s, const std::string& name) {
-  const std::string T = "materials." + name;
-  if (!s.has(T)) s.fail(T, "no such material; define a [" + T + "] table");
-  const std::string model = s.string(T + ".model");
-  static const std::set<std::string> kModels = {"linear_elastic", "yeoh", "neo_hookean", "mooney_rivlin", "ogden"};
-  if (!kModels.count(model))
-    s.fail(T + ".model", "unknown material model \"" + model +
-                             "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
-  positive(s, T + ".density_kg_m3");
-  try {
-    if (model == "linear_elastic") {
-      require_keys(s, T, with_common_keys({"model", "E_MPa", "nu", "density_kg_m3"}), "model linear_elastic");
-      return std::make_shared<SaintVenantKirchhoff>(s.number(T + ".E_MPa") * kMPa, s.number(T + ".nu"));
-    }
-    const double Kr = s.number(T + ".K_over_mu");
-    if (model == "yeoh") {
-      require_keys(s, T, with_common_keys({"model", "C10_MPa", "C20_MPa", "C30_MPa", "K_over_mu", "density_kg_m3"}), "model yeoh");
-      const double C10 = s.number(T + ".C10_MPa") * kMPa;
-      const double C20 = s.has(T + ".C20_MPa") ? s.number(T + ".C20_MPa") * kMPa : 0.0;
-      const double C30 = s.has(T + ".C30_MPa") ? s.number(T + ".C30_MPa") * kMPa : 0.0;
-      return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(C10, C20, C30, bulk_from_ratio(2 * C10, Kr)));
-    }
-    if (model == "neo_hookean") {
-      require_keys(s, T, with_common_keys({"model", "C10_MPa", "K_over_mu", "density_kg_m3"}), "model neo_hookean");
-      const double C10 = s.number(T + ".C10_MPa") * kMPa;
-      return std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(C10, bulk_from_ratio(2 * C10, Kr)));
-    }
-    if (model == "mooney_rivlin") {
-      require_keys(s, T, with_common_keys({"model", "C10_MPa", "C01_MPa", "K_over_mu", "density_kg_m3"}), "model mooney_rivlin");
-      const double C10 = s.number(T + ".C10_MPa") * kMPa, C01 = s.number(T + ".C01_MPa") * kMPa;
-      return std::make_shared<InvariantMaterial<MooneyRivlin>>(
-          MooneyRivlin(C10, C01, bulk_from_ratio(2 * (C10 + C01), Kr)));
-    }
-    if (model == "ogden") {
-      require_keys(s, T, with_common_keys({"model", "mu_MPa", "alpha", "K_over_mu", "density_kg_m3"}), "model ogden");
-      std::vector<double> mu = s.numbers(T + ".mu_MPa");
-      const std::vector<double> alpha = s.numbers(T + ".alpha");
-      double mu0 = 0.0;
-      for (double& m : mu) {
-        m *= kMPa;
-        mu0 += m;
-      }
-      return std::make_shared<Ogden>(mu, alpha, bulk_from_ratio(mu0, Kr));
-    }
-  } catch (const InputError& e) {
-    s.fail(T, e.what());
-  }
-  s.fail(T + ".model", "unknown material model \"" + model +
-                           "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
-}
-
-/// Vector text for messages, e.g. "[0.0, -1.0, 0.0]" (rounded to 3 decimals: a hint, not data).
-std::string vec_text(const Eigen::Vector3d& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "[%.3f, %.3f, %.3f]", v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
-  return buf;
-}
-
-/// The angle's frame from the mesh, for decks oriented otherwise than the built-in actuator (whose
-/// defaults the scene keys are). Two facts of the mesh fix it:
-///  * the clamped nodes (all three dofs fixed) of a plane end face give the face's outward normal;
-///    when they are not one plane face (a clamp over a length of the body), the direction from the
-///    tip face's centroid to the clamped nodes' does;
-///  * the inextensible (stiffest, 100x the softest) part lies on the side the actuator curls to.
-/// With `from_mesh` (a deck whose scene leaves angle.fixed_normal / angle.bend_direction at their
-/// defaults) the keys left at their defaults are taken from these, with a note naming the values (so a
-/// deck along x, or tilted, needs no angle keys). Keys the user set are checked instead: a fixed normal
-/// more than ~25 deg off the clamped face's would measure the rotation in a wrong plane, an error
-/// naming the normal to use; a bend direction pointing away from the layer only flips the angle's
-/// sign, a warning.
-void resolve_angle_frame(const Scene& s, Model& model, bool from_mesh, std::vector<std::string>& warnings) {
-  const Mesh& mesh = model.mesh;
-  const bool normal_free = from_mesh && s.origin("angle.fixed_normal") == "default scene";
-  const bool bend_free = from_mesh && s.origin("angle.bend_direction") == "default scene";
-  Eigen::Vector3d body = Eigen::Vector3d::Zero();
-  for (const auto& x : mesh.X) body += x;
-  body /= static_cast<double>(mesh.num_nodes());
-  std::vector<Eigen::Vector3d> clamped;
-  for (int n = 0; n < mesh.num_nodes(); ++n)
-    if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
-  // n_face: outward normal of the clamped plane face (or 0); n_axis: the body's axis at the clamp,
-  // pointing out of it, from the tip face (or 0).
-  Eigen::Vector3d n_face = Eigen::Vector3d::Zero(), n_axis = Eigen::Vector3d::Zero();
-  if (clamped.size() >= 3) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (const auto& x : clamped) c += x;
-    c /= static_cast<double>(clamped.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const auto& x : clamped) cov += (x - c) * (x - c).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);  // ascending eigenvalues
-    const bool planar = es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0;
-    Eigen::Vector3d n_fit = es.eigenvectors().col(0);
-    if (n_fit.dot(c - body) < 0.0) n_fit = -n_fit;  // outward: away from the body
-    if (planar && (c - body).norm() > 0.0) n_face = n_fit;
-    if (!model.angle.tip_nodes.empty()) {
-      Eigen::Vector3d t = Eigen::Vector3d::Zero();
-      for (int n : model.angle.tip_nodes) t += mesh.X[n];
-      t /= static_cast<double>(model.angle.tip_nodes.size());
-      if ((c - t).norm() > 0.0) n_axis = (c - t).normalized();
-    }
-  }
-  const Eigen::Vector3d n_mesh = n_face.norm() > 0.0 ? n_face : n_axis;
-  if (normal_free && n_mesh.norm() > 0.0 && n_mesh.dot(model.angle.fixed_normal_out.normalized()) < 1.0 - 1e-9) {
-    model.angle.fixed_normal_out = n_mesh;
-    warnings.push_back("angle.fixed_normal taken from the mesh: " + vec_text(n_mesh) + " (the outward normal of " +
-                       (n_face.norm() > 0.0 ? std::string("the clamped end face")
-                                            : std::string("the clamped end, from the tip face's centroid to the clamped nodes'")) +
-                       "); set angle.fixed_normal to choose another");
-  }
-  const Eigen::Vector3d n_given = model.angle.fixed_normal_out.normalized();
-  if (!normal_free && n_face.norm() > 0.0 && n_face.dot(n_given) < 0.9)
-    s.fail("angle.fixed_normal", "is " + vec_text(n_given) + " but the clamped nodes lie on a plane face whose outward "
-                                 "normal is " + vec_text(n_face) + ": set angle.fixed_normal = " + vec_text(n_face) +
-                                 " and angle.bend_direction perpendicular to it, towards the inextensible layer");
-  // The side of the stiff layer, across the actuator (0 when no part is 100x stiffer than another).
-  Eigen::Vector3d side = Eigen::Vector3d::Zero();
-  double mu_min = INFINITY, mu_max = 0.0;
-  for (const Part& p : model.parts) {
-    mu_min = std::min(mu_min, p.material->initial_shear_modulus());
-    mu_max = std::max(mu_max, p.material->initial_shear_modulus());
-  }
-  Eigen::Vector3d layer = Eigen::Vector3d::Zero();
-  double count = 0.0;
-  if (mu_max > 100.0 * mu_min) {
-    for (int e = 0; e < mesh.num_elements(); ++e)
-      if (model.material_of(e).initial_shear_modulus() == mu_max)
-        for (int a = 0; a < mesh.npe(); ++a) layer += mesh.X[mesh.element(e)[a]], count += 1.0;
-  } else {  // a membrane fabric (mesh.fabric_model = "membrane") is the layer
-    for (const MembraneSet& m : model.membranes)
-      for (int n : m.nodes) layer += mesh.X[n], count += 1.0;
-  }
-  if (count > 0.0) {
-    side = layer / count - body;
-    side -= side.dot(n_given) * n_given;  // across the actuator, not along it
-  }
-  if (model.angle.mirror_axis >= 0) side[model.angle.mirror_axis] = 0.0;  // a half model bends in its symmetry plane
-  if (bend_free) {
-    // The default direction made perpendicular to the normal is kept when it points within 10 deg of
-    // the layer's side (a translated deck keeps the built-in's exact axes: the centroid of an
-    // asymmetric section is a little off its bending plane); otherwise the side of the layer; without
-    // a stiff layer the default, else the coordinate axis most perpendicular to the normal.
-    Eigen::Vector3d d0 = model.angle.bend_direction - model.angle.bend_direction.dot(n_given) * n_given;
-    const bool d0_ok = d0.norm() >= 1e-3 * model.angle.bend_direction.norm();
-    Eigen::Vector3d d = side;
-    if (d0_ok && (side.norm() == 0.0 || d0.normalized().dot(side.normalized()) > std::cos(10.0 * std::numbers::pi / 180.0))) {
-      d = d0;
-    } else if (side.norm() == 0.0) {
-      Eigen::Index k = 0;
-      n_given.cwiseAbs().minCoeff(&k);
-      d = Eigen::Vector3d::Unit(k) - n_given[k] * n_given;
-    }
-    d.normalize();
-    if (d.dot(model.angle.bend_direction.normalized()) < 1.0 - 1e-9) {
-      model.angle.bend_direction = d;
-      warnings.push_back("angle.bend_direction taken from the mesh: " + vec_text(d) +
-                         (side.norm() > 0.0 ? std::string(" (towards the inextensible layer, so angles are positive)")
-                                            : std::string(" (no part is 100x stiffer than another, so the side the actuator "
-                                                          "bends to is not known from the mesh: check the sign of the angles)")) +
-                         "; set angle.bend_direction to choose another");
-    }
-    return;
-  }
-  const Eigen::Vector3d d = model.angle.bend_direction.normalized();
-  if (side.norm() > 0.0 && d.dot(side.normalized()) < -0.5)
-    warnings.push_back("angle.bend_direction " + vec_text(d) + " points away from the inextensible layer (towards " +
-                       vec_text(-side.normalized()) + "), to which the actuator curls: its angles will come out "
-                       "negative; set angle.bend_direction = " + vec_text(side.normalized()) +
-                       " for the usual positive convention");
-}
-
-/// The free end face of a deck: the node set mesh.tip_set; when the scene leaves that key at its
-/// default and the deck has no such set, the boundary nodes farthest from the clamp, with a note. The
-/// clamp's side is the outward normal of the clamped nodes' plane face (all three dofs fixed); the tip
-/// face is then the set of boundary nodes within 0.1 % of the body's length of the farthest one along
-/// the opposite direction, which must hold at least three nodes that are not on one line (a flat end
-/// face; a rounded end gives its cap, whose fitted plane still turns with the tip).
-std::vector<int> deck_tip_nodes(const Scene& s, const Model& model, std::vector<std::string>& warnings) {
-  const Mesh& mesh = model.mesh;
-  const std::string name = s.string("mesh.tip_set");
-  std::string upper = name;
-  std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
-  if (s.origin("mesh.tip_set") != "default scene" || mesh.node_sets.count(name) || mesh.node_sets.count(upper))
-    return node_set(s, mesh, "mesh.tip_set");
-  auto give_up = [&](const std::string& why) -> std::vector<int> {
-    std::string avail;
-    for (const auto& [k, v] : mesh.node_sets) avail += (avail.empty() ? "" : ", ") + k;
-    s.fail("mesh.tip_set", "node set '" + name + "' not found in the mesh (available: " + (avail.empty() ? "(none)" : avail) +
-                               ") and the free end face cannot be found from the mesh: " + why +
-                               "; name the node set of the free end face in mesh.tip_set");
-  };
-  std::vector<Eigen::Vector3d> clamped;
-  for (int n = 0; n < mesh.num_nodes(); ++n)
-    if (model.fixed[3 * n] && model.fixed[3 * n + 1] && model.fixed[3 * n + 2]) clamped.push_back(mesh.X[n]);
-  if (clamped.size() < 3) return give_up("fewer than three clamped nodes");
-  Eigen::Vector3d c = Eigen::Vector3d::Zero(), body = Eigen::Vector3d::Zero();
-  for (const auto& x : clamped) c += x;
-  c /= static_cast<double>(clamped.size());
-  for (const auto& x : mesh.X) body += x;
-  body /= static_cast<double>(mesh.num_nodes());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& x : clamped) cov += (x - c) * (x - c).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);  // ascending eigenvalues
-  if (!(es.eigenvalues()[0] <= 1e-4 * es.eigenvalues()[2] && es.eigenvalues()[1] > 0.0))
-    return give_up("the clamped nodes are not one plane face");
-  Eigen::Vector3d axis = -es.eigenvectors().col(0);  // into the body, towards the tip
-  if (axis.dot(body - c) < 0.0) axis = -axis;
-  std::vector<char> on_boundary(mesh.num_nodes(), 0);
-  for (const FaceRef& f : boundary_faces(mesh)) {
-    const int* local = face_local_nodes(mesh.type, f.local_face);
-    for (int a = 0; a < nodes_per_face(mesh.type); ++a) on_boundary[mesh.element(f.element)[local[a]]] = 1;
-  }
-  double lo = INFINITY, hi = -INFINITY;
-  for (int n = 0; n < mesh.num_nodes(); ++n) {
-    const double t = axis.dot(mesh.X[n] - c);
-    lo = std::min(lo, t);
-    hi = std::max(hi, t);
-  }
-  std::vector<int> tip;
-  for (int n = 0; n < mesh.num_nodes(); ++n)
-    if (on_boundary[n] && axis.dot(mesh.X[n] - c) >= hi - 1e-3 * (hi - lo)) tip.push_back(n);
-  Eigen::Vector3d t0 = Eigen::Vector3d::Zero();
-  for (int n : tip) t0 += mesh.X[n];
-  t0 /= std::max<double>(1.0, static_cast<double>(tip.size()));
-  Eigen::Matrix3d tcov = Eigen::Matrix3d::Zero();
-  for (int n : tip) tcov += (mesh.X[n] - t0) * (mesh.X[n] - t0).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ts(tcov);
-  if (tip.size() < 3 || !(ts.eigenvalues()[1] > 1e-12 * ts.eigenvalues()[2]))
-    return give_up("the boundary nodes farthest from the clamp do not span a face");
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%zu boundary nodes at %.4g mm from the clamped face", tip.size(), hi * 1e3);
-  warnings.push_back("mesh.tip_set: the deck has no node set '" + name + "'; the free end face was taken from the mesh (" +
-                     buf + "); name a node set in mesh.tip_set to choose another");
-  return tip;
-}
-
-/// gravity.rig_angle_deg >= 0: the rig's orientation relative to the actuator, in its angle frame
-/// (so a deck in any orientation, whose frame may come from the mesh, hangs the same way):
-/// g = 9.81 (cos(phi) a + sin(phi) d), a = -angle.fixed_normal (along the actuator, away from the
-/// clamp), d = the bend direction made perpendicular to a. For the built-in frame a = +y, d = -z, so
-/// g = [0, 9.81 cos(phi), -9.81 sin(phi)] to the bit (components below 1e-12 g are exactly 0).
-void set_rig_gravity(const Scene& s, Model& model) {
-  const double phi_deg = s.number("gravity.rig_angle_deg");
-  if (!std::isfinite(phi_deg)) s.fail("gravity.rig_angle_deg", "must be a number (< 0: off)");
-  if (phi_deg < 0.0) return;
-  if (phi_deg > 180.0) s.fail("gravity.rig_angle_deg", "must lie in [0, 180] deg (or < 0: off)");
-  if (model.gravity_m_s2.norm() > 0.0)
-    s.fail("gravity.rig_angle_deg", "and gravity.g_m_s2 both give gravity: set g_m_s2 = [0.0, 0.0, 0.0] or "
-                                    "rig_angle_deg = -1.0");
-  constexpr double g = 9.81;
-  const double phi = phi_deg * std::numbers::pi / 180.0;
-  const Eigen::Vector3d a = -model.angle.fixed_normal_out.normalized();
-  const Eigen::Vector3d d = (model.angle.bend_direction - model.angle.bend_direction.dot(a) * a).normalized();
-  const double ga = g * std::cos(phi), gd = g * std::sin(phi);
-  for (int k = 0; k < 3; ++k) {
-    const double v = ga * a[k] + gd * d[k];
-    model.gravity_m_s2[k] = std::abs(v) < 1e-12 * g ? 0.0 : v;
-  }
-}
-
-}  // namespace
-
-Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
-  const std::string source = s.string("mesh.source");
+/// The mesh of mesh.source (`source`): the built-in pneu-net, or a deck, which is kept in `deck`
+/// (its *BOUNDARY dofs and pressure faces are read later) with its notes in `warnings`. Unlike
+/// build_mesh, a deck of several unconnected instances is refused, and a promotion to Tet10 carries
+/// the deck's *BOUNDARY dofs to the new mid-edge nodes.
+Mesh read_model_mesh(const Scene& s, const std::string& source, InpDeck& deck, std::vector<std::string>& warnings) {
   if (source == "pneunet") {
     PneuNetParams p = pneunet_params(s);
     p.validate();
@@ -637,64 +197,27 @@ Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
   const std::string file = s.string("mesh.file");
   if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
-  InpDeck deck = read_inp(s.resolve_path(file), length_unit(s));
-  if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
-  Mesh mesh = std::move(deck.mesh);
-  if (s.boolean("mesh.promote_to_tet10")) mesh = promote_to_tet10(mesh);
-  return mesh;
+  deck = read_inp(s.resolve_path(file), length_unit(s));
+  warnings = deck.warnings;
+  if (deck.solid_instances.size() > 1)
+    s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
+                            " instances (" + inp::join_names(deck.solid_instances) +
+                            ") that share no node, so the model is not connected (ties are not applied); "
+                            "pneufem needs one conforming mesh: merge the instances in Abaqus (Merge/Cut "
+                            "Instances) so the mesh is conforming");
+  if (s.boolean("mesh.promote_to_tet10")) {
+    if (deck.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
+      warnings.push_back("mesh.promote_to_tet10: *DLOAD faces are kept (faces map one to one)");
+    promote_deck_to_tet10(deck);  // also the *BOUNDARY dofs of the new mid-edge nodes
+  }
+  return std::move(deck.mesh);
 }
 
-LoadHistory inlet_load(const Scene& s) {
-  LoadHistory load;
-  const std::string protocol = s.string("load.protocol");
-  if (protocol == "staircase") {
-    load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
-                     s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"), s.number("load.rest_s"),
-                     s.number("load.output_every_s"));
-  } else if (protocol == "csv") {
-    const std::string csv = s.string("load.csv");
-    if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
-    load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
-    if (s.number("load.rest_s") > 0) load.rest_between_trials_s = s.number("load.rest_s");
-  } else {
-    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
-  }
-  return load;
-}
-
-std::unique_ptr<BuiltModel> build_model(const Scene& s) {
-  auto out = std::make_unique<BuiltModel>();
-  Model& model = out->model;
-  const std::string source = s.string("mesh.source");
-  InpDeck deck;
-  if (source == "pneunet") {
-    PneuNetParams p = pneunet_params(s);
-    p.validate();
-    model.mesh = build_pneunet(p);
-  } else if (source == "inp") {
-    const std::string file = s.string("mesh.file");
-    if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
-    deck = read_inp(s.resolve_path(file), length_unit(s));
-    out->warnings = deck.warnings;
-    if (deck.solid_instances.size() > 1)
-      s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
-                              " instances (" + inp::join_names(deck.solid_instances) +
-                              ") that share no node, so the model is not connected (ties are not applied); "
-                              "pneufem needs one conforming mesh: merge the instances in Abaqus (Merge/Cut "
-                              "Instances) so the mesh is conforming");
-    if (s.boolean("mesh.promote_to_tet10")) {
-      if (deck.mesh.type == ElementType::Tet4 && !deck.pressure_faces.empty())
-        out->warnings.push_back("mesh.promote_to_tet10: *DLOAD faces are kept (faces map one to one)");
-      promote_deck_to_tet10(deck);  // also the *BOUNDARY dofs of the new mid-edge nodes
-    }
-    model.mesh = std::move(deck.mesh);
-  } else {
-    s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
-  }
+/// mesh.regions (element sets of a deck as regions), then the [[parts]]: every element gets one part,
+/// the elements of a region with a stiffness scale a part of their own. With a membrane fabric an
+/// empty element set (FABRIC) makes no part.
+void assign_parts(const Scene& s, Model& model, bool membrane_fabric) {
   Mesh& mesh = model.mesh;
-  mesh.ensure_ids();
-  const bool membrane_fabric = fabric_is_membrane(s);
-
   // Regions from element sets (decks): mesh.regions = { ELSET = "region" }.
   for (const std::string& elset : s.table_keys("mesh.regions")) {
     const std::vector<int>* els = find_elset(mesh, elset);
@@ -751,30 +274,12 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   for (int e = 0; e < mesh.num_elements(); ++e)
     if (model.element_part[e] < 0)
       s.fail("parts", mesh.element_label(e) + " belongs to no part; add its element set to a [[parts]] entry");
+}
 
-  // Boundary conditions.
-  model.fixed.assign(3 * mesh.num_nodes(), 0);
-  const bool is_inp = source == "inp";
-  const std::string fixed_key = "mesh.fixed_set";
-  if (!is_inp || !s.string(fixed_key).empty() || deck.fixed_dofs.empty())
-    for (int n : node_set(s, mesh, fixed_key))
-      for (int d = 0; d < 3; ++d) model.fixed[3 * n + d] = 1;
-  if (is_inp && s.boolean("mesh.use_deck_boundary"))
-    for (const auto& [n, d] : deck.fixed_dofs) model.fixed[3 * n + d] = 1;
-  const bool half = is_inp ? !s.string("mesh.symmetry_set").empty() : s.boolean("mesh.half");
-  if (half) {
-    const std::vector<int>& sym = is_inp ? node_set(s, mesh, "mesh.symmetry_set") : mesh.node_sets.at("SYMMETRY");
-    const double L = (compute_stats(mesh).bbox_max - compute_stats(mesh).bbox_min).norm();
-    for (int n : sym) {
-      if (std::abs(mesh.X[n].x()) > 1e-6 * L)
-        s.fail("mesh.symmetry_set", "node " + mesh.node_name(n) +
-                                        " is not on the plane x = 0; the symmetry plane must be x = 0");
-      model.fixed[3 * n] = 1;
-    }
-    model.angle.mirror_axis = 0;
-  }
-
-  // Cavity faces.
+/// The pressure faces: surface mesh.cavity_surface (for a deck also "DLOAD", its own pressure load,
+/// which a deck without the default surface takes with a note), all on the boundary of the solid.
+void set_cavity_faces(const Scene& s, Model& model, const InpDeck& deck, bool is_inp, std::vector<std::string>& warnings) {
+  const Mesh& mesh = model.mesh;
   const std::string cav = is_inp ? s.string("mesh.cavity_surface") : "CAVITY";
   if (is_inp && (cav == "DLOAD" || cav == "dload")) {
     if (deck.pressure_faces.empty())
@@ -788,9 +293,9 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
     } else if (is_inp && s.origin("mesh.cavity_surface") == "default scene" && !deck.pressure_faces.empty()) {
       // No surface of the default name: the deck's own pressure load marks the chambers.
       for (const auto& pf : deck.pressure_faces) model.pressure_faces.push_back(pf.face);
-      out->warnings.push_back("mesh.cavity_surface: the deck has no surface '" + cav + "'; the faces of its pressure load (" +
-                              std::to_string(deck.pressure_faces.size()) + " *DLOAD/*DSLOAD P faces) are the cavity; name a " +
-                              "surface in mesh.cavity_surface to choose another");
+      warnings.push_back("mesh.cavity_surface: the deck has no surface '" + cav + "'; the faces of its pressure load (" +
+                         std::to_string(deck.pressure_faces.size()) + " *DLOAD/*DSLOAD P faces) are the cavity; name a " +
+                         "surface in mesh.cavity_surface to choose another");
     } else {
       s.fail("mesh.cavity_surface", "surface '" + cav + "' not found; name a *SURFACE of the deck or use \"DLOAD\"");
     }
@@ -808,35 +313,11 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
                                           ", shared by two tetrahedra): the cavity must be the chambers' boundary; "
                                           "name the surface of the chamber walls");
   }
+}
 
-  // Bending angle.
-  model.angle.tip_nodes = is_inp ? deck_tip_nodes(s, model, out->warnings) : node_set(s, mesh, "mesh.tip_set");
-  model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
-  model.angle.bend_direction = s.vec3("angle.bend_direction");
-  if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");
-  model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
-  if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
-  validate(model);
-  resolve_angle_frame(s, model, is_inp, out->warnings);
-  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
-    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
-  set_rig_gravity(s, model);
-  out->stats = compute_stats(mesh);
-
-  // Load.
-  out->load = inlet_load(s);
-  // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
-  // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
-  // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
-  const double lag_s = s.number("load.pressure_lag_s");
-  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
-    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
-  if (lag_s > 0.0)
-    out->load = apply_pressure_lag(out->load, lag_s,
-                                   s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
-
-  // Solver.
-  SolverSettings& sv = out->solver;
+/// The [solver] keys, each checked.
+SolverSettings solver_settings(const Scene& s) {
+  SolverSettings sv;
   sv.mode = choice<SolverSettings::Mode>(s, "solver.mode", {{"quasi_static", SolverSettings::Mode::QuasiStatic},
                                                            {"explicit", SolverSettings::Mode::Explicit}});
   sv.quasi_static.method = choice<EquilibriumMethod>(s, "solver.method", {{"newton", EquilibriumMethod::Newton},
@@ -872,6 +353,108 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
   sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
   sv.time_scale = positive(s, "solver.time_scale");
+  return sv;
+}
+
+}  // namespace
+
+Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
+  const std::string source = s.string("mesh.source");
+  if (source == "pneunet") {
+    PneuNetParams p = pneunet_params(s);
+    p.validate();
+    return build_pneunet(p);
+  }
+  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
+  const std::string file = s.string("mesh.file");
+  if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
+  InpDeck deck = read_inp(s.resolve_path(file), length_unit(s));
+  if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
+  Mesh mesh = std::move(deck.mesh);
+  if (s.boolean("mesh.promote_to_tet10")) mesh = promote_to_tet10(mesh);
+  return mesh;
+}
+
+LoadHistory inlet_load(const Scene& s) {
+  LoadHistory load;
+  const std::string protocol = s.string("load.protocol");
+  if (protocol == "staircase") {
+    load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
+                     s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"), s.number("load.rest_s"),
+                     s.number("load.output_every_s"));
+  } else if (protocol == "csv") {
+    const std::string csv = s.string("load.csv");
+    if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
+    load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+    if (s.number("load.rest_s") > 0) load.rest_between_trials_s = s.number("load.rest_s");
+  } else {
+    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
+  }
+  return load;
+}
+
+std::unique_ptr<BuiltModel> build_model(const Scene& s) {
+  auto out = std::make_unique<BuiltModel>();
+  Model& model = out->model;
+  const std::string source = s.string("mesh.source");
+  InpDeck deck;
+  model.mesh = read_model_mesh(s, source, deck, out->warnings);
+  Mesh& mesh = model.mesh;
+  mesh.ensure_ids();
+  const bool membrane_fabric = fabric_is_membrane(s);
+  assign_parts(s, model, membrane_fabric);
+
+  // Boundary conditions.
+  model.fixed.assign(3 * mesh.num_nodes(), 0);
+  const bool is_inp = source == "inp";
+  const std::string fixed_key = "mesh.fixed_set";
+  if (!is_inp || !s.string(fixed_key).empty() || deck.fixed_dofs.empty())
+    for (int n : node_set(s, mesh, fixed_key))
+      for (int d = 0; d < 3; ++d) model.fixed[3 * n + d] = 1;
+  if (is_inp && s.boolean("mesh.use_deck_boundary"))
+    for (const auto& [n, d] : deck.fixed_dofs) model.fixed[3 * n + d] = 1;
+  const bool half = is_inp ? !s.string("mesh.symmetry_set").empty() : s.boolean("mesh.half");
+  if (half) {
+    const std::vector<int>& sym = is_inp ? node_set(s, mesh, "mesh.symmetry_set") : mesh.node_sets.at("SYMMETRY");
+    const double L = (compute_stats(mesh).bbox_max - compute_stats(mesh).bbox_min).norm();
+    for (int n : sym) {
+      if (std::abs(mesh.X[n].x()) > 1e-6 * L)
+        s.fail("mesh.symmetry_set", "node " + mesh.node_name(n) +
+                                        " is not on the plane x = 0; the symmetry plane must be x = 0");
+      model.fixed[3 * n] = 1;
+    }
+    model.angle.mirror_axis = 0;
+  }
+
+  set_cavity_faces(s, model, deck, is_inp, out->warnings);
+
+  // Bending angle.
+  model.angle.tip_nodes = is_inp ? deck_tip_nodes(s, model, out->warnings) : node_set(s, mesh, "mesh.tip_set");
+  model.angle.fixed_normal_out = s.vec3("angle.fixed_normal");
+  model.angle.bend_direction = s.vec3("angle.bend_direction");
+  if (model.angle.fixed_normal_out.norm() < 1e-12) s.fail("angle.fixed_normal", "must be a nonzero vector");
+  model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
+  if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
+  validate(model);
+  resolve_angle_frame(s, model, is_inp, out->warnings);
+  if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
+    s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
+  set_rig_gravity(s, model);
+  out->stats = compute_stats(mesh);
+
+  // Load.
+  out->load = inlet_load(s);
+  // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
+  // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
+  // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
+  const double lag_s = s.number("load.pressure_lag_s");
+  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
+    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
+  if (lag_s > 0.0)
+    out->load = apply_pressure_lag(out->load, lag_s,
+                                   s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+
+  out->solver = solver_settings(s);
 
   out->output.vtu = s.string("output.vtu");
   if (out->output.vtu != "steps" && out->output.vtu != "all" && out->output.vtu != "none")
