@@ -184,20 +184,28 @@ std::map<std::string, double> region_scales(const Scene& s, const Mesh& mesh) {
   return out;
 }
 
+/// The built-in pneu-net of the scene's [geometry] and [mesh] keys.
+Mesh built_in_mesh(const Scene& s) {
+  PneuNetParams p = pneunet_params(s);
+  p.validate();
+  return build_pneunet(p);
+}
+
+/// The deck of mesh.file, as read (mesh.source must be "inp" when it is not "pneunet").
+InpDeck scene_deck(const Scene& s, const std::string& source) {
+  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
+  const std::string file = s.string("mesh.file");
+  if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
+  return read_inp(s.resolve_path(file), length_unit(s));
+}
+
 /// The mesh of mesh.source (`source`): the built-in pneu-net, or a deck, which is kept in `deck`
 /// (its *BOUNDARY dofs and pressure faces are read later) with its notes in `warnings`. Unlike
 /// build_mesh, a deck of several unconnected instances is refused, and a promotion to Tet10 carries
 /// the deck's *BOUNDARY dofs to the new mid-edge nodes.
 Mesh read_model_mesh(const Scene& s, const std::string& source, InpDeck& deck, std::vector<std::string>& warnings) {
-  if (source == "pneunet") {
-    PneuNetParams p = pneunet_params(s);
-    p.validate();
-    return build_pneunet(p);
-  }
-  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
-  const std::string file = s.string("mesh.file");
-  if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
-  deck = read_inp(s.resolve_path(file), length_unit(s));
+  if (source == "pneunet") return built_in_mesh(s);
+  deck = scene_deck(s, source);
   warnings = deck.warnings;
   if (deck.solid_instances.size() > 1)
     s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
@@ -360,15 +368,8 @@ SolverSettings solver_settings(const Scene& s) {
 
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   const std::string source = s.string("mesh.source");
-  if (source == "pneunet") {
-    PneuNetParams p = pneunet_params(s);
-    p.validate();
-    return build_pneunet(p);
-  }
-  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
-  const std::string file = s.string("mesh.file");
-  if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
-  InpDeck deck = read_inp(s.resolve_path(file), length_unit(s));
+  if (source == "pneunet") return built_in_mesh(s);
+  InpDeck deck = scene_deck(s, source);
   if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
   Mesh mesh = std::move(deck.mesh);
   if (s.boolean("mesh.promote_to_tet10")) mesh = promote_to_tet10(mesh);
