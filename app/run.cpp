@@ -290,6 +290,8 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
           .add("stiff_layer_factorizations", static_cast<double>(st.stiff_factorizations))
           .add("last_factor_steps", static_cast<double>(st.last_factor_steps))
           .add("energy_line_search_cuts", static_cast<double>(st.energy_cuts))
+          .add("release_attempts", static_cast<double>(st.release_attempts))
+          .add("direct_releases", static_cast<double>(st.direct_releases))
           .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
           .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
           .add("assembly_s", st.assembly_s)

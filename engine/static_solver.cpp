@@ -398,6 +398,32 @@ NewtonReport StaticSolver::solve_first_with_weight(double p, const TimeStep& ts,
   return r;
 }
 
+// An instantaneous release to zero pressure (t1 == t0, as between the trials of a staircase) leaves
+// the history where it is: no rate law evolves in zero time, and a Prony term's overstress changes by
+// gamma times the change of the stress whatever the path (Q += gamma (S - S_old) telescopes), so the
+// end state does not depend on the way down (only a Mullins point whose energy rose above its
+// maximum part-way down and fell again would notice; a release unloads the walls). Continuation
+// back down from the top of the staircase retraces the hardest part of the climb, near the limit
+// point: with the rest that follows, 40-50 % of each trial's wall time in the ten-trial story
+// (BENCHMARKS §7). At zero load the reference configuration is a far better start: one Newton solve
+// from it, and the caller continues along the path as before when it does not converge.
+bool StaticSolver::release_from_reference(double p0, double t, std::vector<double>& state,
+                                          std::vector<double>& trial, Eigen::VectorXd& u) {
+  if (p0 == 0.0 || !has_equilibrium_) return false;
+  Eigen::VectorXd u_try = Eigen::VectorXd::Zero(u.size());  // fixed dofs are prescribed zero (model.h)
+  const NewtonReport r = solve(0.0, TimeStep{t, 0.0}, state, trial, u_try);
+  ++stats_.release_attempts;
+  if (!r.converged) return false;
+  ++stats_.increments;
+  ++stats_.direct_releases;
+  u = u_try;
+  state.swap(trial);
+  asm_.update_nonlocal(u, state);
+  path_p_.assign(1, 0.0);  // the path down was not followed: extrapolate from here only
+  path_u_.assign(1, u);
+  return true;
+}
+
 void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vector<double>& state,
                            Eigen::VectorXd& u) {
   const double span = p1 - p0;
@@ -420,6 +446,7 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
     asm_.update_nonlocal(u, state);
     return;
   }
+  if (p1 == 0.0 && t1 == t0 && release_from_reference(p0, t1, state, trial, u)) return;
   double s_done = 0.0;  // fraction of the increment completed
   double ds = std::min(1.0, opt_.max_increment_Pa / std::abs(span));
   while (s_done < 1.0 - 1e-12) {

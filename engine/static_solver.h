@@ -68,6 +68,8 @@ struct StaticStats {
   long stiff_factorizations = 0;  ///< factorisations of the stiff-layer block
   long last_factor_steps = 0;     ///< iterations stepped with the last PD factor (tangent not PD)
   long energy_cuts = 0;           ///< line-search cuts because the potential energy rose
+  long release_attempts = 0;      ///< releases to zero pressure tried from the reference configuration
+  long direct_releases = 0;       ///< of which converged (the others followed the path down)
   double assembly_s = 0.0;
   double factor_s = 0.0;
 };
@@ -107,7 +109,8 @@ class StaticSolver {
 
   /// Moves the equilibrium from (p0, t0) to (p1, t1) in adaptive sub-increments, committing the
   /// material state after each accepted one (pressure and time advance together). Throws
-  /// PhysicsError when the increment falls below min_increment_Pa (e.g. at a limit point).
+  /// PhysicsError when the increment falls below min_increment_Pa (e.g. at a limit point). A release
+  /// to zero pressure in zero time (t1 == t0) is first tried as one solve from the reference configuration.
   void advance(double p0_Pa, double p1_Pa, double t0_s, double t1_s, std::vector<double>& state,
                Eigen::VectorXd& u);
 
@@ -138,6 +141,10 @@ class StaticSolver {
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
   bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
   bool factorize_current(NewtonReport& rep);
+  /// advance() from p0 to zero pressure in zero time: one Newton solve from the reference
+  /// configuration; false (u and the state unchanged) when it does not converge. See static_solver.cpp.
+  bool release_from_reference(double p0, double t, std::vector<double>& state, std::vector<double>& trial,
+                              Eigen::VectorXd& u);
   /// Relaxes the stiff dofs of u (the others held) given R = R(u); updates u and R in place.
   /// Never throws: a relaxation step that fails or does not reduce |R| is not taken.
   void relax_stiff_layer(double p_Pa, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,

@@ -178,6 +178,54 @@ TEST(Creep, ErrorControlConvergesWithFewerStepsThanTheChangeLimit) {
   EXPECT_LT(states[1], change.states);
 }
 
+// An instantaneous release to zero pressure (between the trials of a staircase) is solved in one
+// Newton solve from the reference configuration instead of following the load path down
+// (StaticSolver::release_from_reference). With the history frozen the end state does not depend on
+// the path, so both must reach the same equilibrium and the same history: here a block loaded to
+// ~20 % strain, held for tau (a Prony overstress half relaxed, so the released block keeps
+// gamma / (1 + gamma) (1 - exp(-tau / tau_c)) ~ 16 % of its strain), with Mullins softening under
+// the Prony term. A solver that has no equilibrium of its own yet does not try the direct solve,
+// which gives the path-followed release to compare with.
+TEST(Creep, ReleaseFromTheReferenceReachesThePathFollowedEquilibrium) {
+  constexpr double kLoad = 0.2 * kMu;  // follower tension (Pa): ~20 % strain, Mullins energy ~m
+  const Model model = tension_block(
+      ElementType::Tet10, make_viscoelastic(make_mullins(neo_hookean(kMu, 1e3 * kMu), MullinsParams{2.0, 2e3, 0.1}),
+                                            ViscoParams{{kGamma}, {kTau}}));
+  const Assembler asmb(model);
+  const StaticOptions so{.rel_tol = 1e-8, .max_increment_Pa = kLoad / 4};
+  StaticSolver solver(asmb, so);
+  std::vector<double> state = asmb.initial_state();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(asmb.num_dofs());
+  solver.advance(0.0, -kLoad, 0.0, 0.5, state, u);           // ramp
+  solver.advance(-kLoad, -kLoad, 0.5, 0.5 + kTau, state, u);  // hold: the overstress relaxes
+  const Eigen::VectorXd u_loaded = u;
+  std::vector<double> state_path = state;
+  Eigen::VectorXd u_path = u;
+
+  solver.advance(-kLoad, 0.0, 0.5 + kTau, 0.5 + kTau, state, u);
+  EXPECT_EQ(solver.stats().release_attempts, 1);
+  EXPECT_EQ(solver.stats().direct_releases, 1);
+
+  StaticSolver fresh(asmb, so);
+  fresh.advance(-kLoad, 0.0, 0.5 + kTau, 0.5 + kTau, state_path, u_path);
+  EXPECT_EQ(fresh.stats().release_attempts, 0);
+  EXPECT_GE(fresh.stats().increments, 2);  // followed the path down (first step kLoad / 4, then growing)
+
+  // The release is not trivial: the block keeps a residual strain (~16 % of the loaded one).
+  EXPECT_GT(u_path.norm(), 0.1 * u_loaded.norm());
+  // Same equilibrium within the Newton tolerance: |R| <= 1e-8 of the force scale moves the
+  // displacement by ~1e-8 of its size; 1e-5 leaves room for the conditioning of K (K / mu = 1e3).
+  EXPECT_LT((u - u_path).norm(), 1e-5 * u_path.norm());
+  ASSERT_EQ(state.size(), state_path.size());
+  double scale = 0.0, diff = 0.0;
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    scale = std::max(scale, std::abs(state_path[i]));
+    diff = std::max(diff, std::abs(state[i] - state_path[i]));
+  }
+  EXPECT_LT(diff, 1e-5 * scale);
+}
+
+
 // A staircase of equal ramps (0.5 s, sigma0/4 each) and holds of 6 tau: every hold relaxes the
 // block, so every ramp is the same problem. The hold's steps grow to max_dt_s, so without memory
 // every ramp would first be tried whole and rejected for its history change (a wasted solve of
