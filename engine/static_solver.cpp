@@ -405,8 +405,10 @@ NewtonReport StaticSolver::solve_first_with_weight(double p, const TimeStep& ts,
 // maximum part-way down and fell again would notice; a release unloads the walls). Continuation
 // back down from the top of the staircase retraces the hardest part of the climb, near the limit
 // point: with the rest that follows, 40-50 % of each trial's wall time in the ten-trial story
-// (BENCHMARKS §7). At zero load the reference configuration is a far better start: one Newton solve
-// from it, and the caller continues along the path as before when it does not converge.
+// (BENCHMARKS §7). At zero load the reference configuration is the natural start: one Newton solve
+// from it, and the caller continues along the path as before when it does not converge (it does not
+// when the released actuator keeps a large bend from a Prony overstress: 1 of 3 releases converged in
+// a four-trial A/B of the story, so the gain is a few percent so far).
 bool StaticSolver::release_from_reference(double p0, double t, std::vector<double>& state,
                                           std::vector<double>& trial, Eigen::VectorXd& u) {
   if (p0 == 0.0 || !has_equilibrium_) return false;
