@@ -9,7 +9,7 @@
 #include <memory>
 #include <system_error>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem::csv {
 

@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "analysis/csv_scan.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "analysis/robust.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

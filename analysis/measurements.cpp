@@ -12,8 +12,8 @@
 #include <system_error>
 
 #include "analysis/csv_scan.h"
-#include "materials/atomic_file.h"
-#include "materials/errors.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
 
 namespace pneufem {
 
@@ -247,7 +247,7 @@ class CanonicalReader {
     }
     if (column_[kPressure] < 0 && !header_with_stem(names, kColumns[kPressure])) {
       // Angles alone (video tracking of a commanded protocol, as the seed paper's): the caller drives
-      // the model with the scene's own [load] (app/drive.h, fill_commanded_pressure). A header that
+      // the model with the scene's own [load] (app/simulate/drive.h, fill_commanded_pressure). A header that
       // names a pressure in an unknown unit is still an error below: that column was meant.
       no_pressure_column_ = true;
       conversions_.push_back(source_ + ": no pressure column: only angles were recorded; the model is driven by the "

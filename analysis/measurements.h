@@ -53,7 +53,7 @@ struct Recording {
   std::vector<TrialRecording> trials;  ///< sorted by trial number, each number once
   std::string source;                  ///< file the data came from
   /// false: the file has no pressure column (angles of a commanded protocol only); every trial's
-  /// pressure series is empty until app/drive.h's fill_commanded_pressure samples the scene's load.
+  /// pressure series is empty until app/simulate/drive.h's fill_commanded_pressure samples the scene's load.
   bool pressure_recorded = true;
   std::vector<std::string> warnings;   ///< "<file>: ..." notes that did not stop the read
 };

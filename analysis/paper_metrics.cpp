@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -6,7 +6,7 @@
 
 #include "analysis/csv_scan.h"
 #include "analysis/robust.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

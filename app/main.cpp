@@ -10,15 +10,17 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/compare_cli.h"
-#include "app/diagnose_cli.h"
-#include "app/run.h"
-#include "app/sweep.h"
-#include "app/synth.h"
-#include "materials/errors.h"
+#include "app/compare/cli.h"
+#include "app/diagnose/cli.h"
+#include "app/simulate/command.h"
+#include "app/sweep/command.h"
+#include "app/synth/command.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/version.h"
+#include "engine/assembly.h"
 #include "scenes/build_model.h"
-#include "scenes/inp.h"
-#include "scenes/inp_export.h"
+#include "scenes/calculix_deck.h"
 #include "viz/vtk_output.h"
 
 namespace fs = std::filesystem;

@@ -32,7 +32,7 @@
 #include <span>
 #include <string>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/material.h"
 
 namespace pneufem::detail {

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "damage/effects.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

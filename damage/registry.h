@@ -5,7 +5,7 @@
 // makes it available, by name, to
 //   * scenes:    [materials.<m>.<name>] enabled = true, <param> = value   (scenes/scene_materials.cpp)
 //   * sweep:     --param materials.<m>.<name>.<param>=LO:HI:N
-//   * compare / diagnose / synth: as a candidate effect with the registered bounds (app/effect_catalog.h).
+//   * compare / diagnose / synth: as a candidate effect with the registered bounds (app/diagnose/effect_catalog.h).
 //
 // Decoration order. Effects are applied around the (stiffness-scaled) hyperelastic base in
 // ascending `order`, ties in registration order. The built-ins have

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/invariant_kernel.h"
 
 namespace pneufem {

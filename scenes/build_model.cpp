@@ -13,16 +13,16 @@
 #include <set>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/scaled.h"
 #include "scenes/angle_frame.h"
-#include "scenes/inp.h"
-#include "scenes/inp_assembly.h"
+#include "scenes/inp/deck.h"
+#include "scenes/inp/assembly.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
 #include "scenes/scene_keys.h"
-#include "scenes/solid_split.h"
+#include "scenes/inp/solid_split.h"
 
 namespace pneufem {
 

@@ -14,7 +14,7 @@
 #include <Eigen/Geometry>
 #include <openvdb/openvdb.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 // How the mesh is built
 // ---------------------

@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "scenes/default_scene_text.h"
 
 namespace pneufem {

@@ -52,7 +52,7 @@ class Scene {
   std::string to_json() const;
   /// to_toml() without the tables switched off (`enabled = false`, e.g. a disabled effect), whose
   /// other keys do not change the model: equal strings for scenes that build the same model, the
-  /// key of caches (the ideal model of app/ideal_cache.h, diagnose's elastic curves).
+  /// key of caches (the ideal model of app/simulate/ideal_cache.h, diagnose's elastic curves).
   std::string model_toml() const;
 
   /// A copy with more overrides applied (used by sweeps and diagnosis).

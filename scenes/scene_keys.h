@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/mesh.h"
-#include "scenes/inp_assembly.h"
+#include "scenes/inp/assembly.h"
 #include "scenes/scene.h"
 
 namespace pneufem::detail {
@@ -25,7 +25,7 @@ void require_keys(const Scene& scene, const std::string& table, const std::set<s
 double positive(const Scene& scene, const std::string& key);
 
 /// A name `key` gives that the mesh lacks but that several instances of a deck define (stored as
-/// "INSTANCE.NAME" each, inp_assembly.h): a failure listing the qualified names to choose from.
+/// "INSTANCE.NAME" each, scenes/inp/assembly.h): a failure listing the qualified names to choose from.
 template <class V>
 void reject_ambiguous(const Scene& s, const std::string& key, const std::map<std::string, V>& names,
                       const std::string& name, const std::string& what) {

@@ -10,7 +10,7 @@
 
 #include "damage/effects.h"
 #include "damage/registry.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
 #include "materials/scaled.h"

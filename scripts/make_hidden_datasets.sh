@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the hidden-effect datasets of tests/app/test_diagnose.cpp with `pneufem synth`
+# Regenerates the hidden-effect datasets of tests/app/diagnose/test_command.cpp with `pneufem synth`
 # (full FEM, noise, controller overshoot, outlier frames). Small scene so the tests fit in CI;
 # truth values chosen so each effect changes the angle well above the tracking noise on it.
 # Usage: scripts/make_hidden_datasets.sh [path/to/pneufem]   (takes ~20 min on 2 cores)

@@ -9,7 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "materials/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace pneufem::svg {
 

@@ -33,7 +33,7 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "analysis/hampel.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/analysis/synthetic.h"
 
 namespace pneufem {

@@ -12,7 +12,7 @@
 
 #include "analysis/csv_scan.h"
 #include "analysis/measurements.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/analysis/synthetic.h"
 
 namespace pneufem {

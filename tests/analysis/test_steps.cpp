@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "analysis/steps.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/analysis/synthetic.h"
 
 namespace pneufem {

@@ -116,7 +116,8 @@ TEST(Cli, KilledRunResumesToTheUninterruptedResult) {
 
 // diagnose --cache on the command line: the second run reads the elastic path the first stored and
 // writes the same diagnosis; a cache directory that cannot be made is bad input (exit 2, nothing
-// written). (The cache itself: test_result_cache.cpp, DiagnoseCache in test_diagnose.cpp.)
+// written). (The cache itself: tests/app/simulate/test_result_cache.cpp, DiagnoseCache in
+// tests/app/diagnose/test_command.cpp.)
 TEST(Cli, DiagnoseReadsItsCacheOnTheSecondRun) {
   const std::string data = std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/stiffness.csv";
   const std::string args = " --set geometry.chambers=5 --set mesh.h_mm=6.0 --set load.max_kPa=30.0 --set load.step_kPa=10.0"

@@ -16,7 +16,7 @@
 #include "engine/path_model.h"
 #include "engine/quasi_static.h"
 #include "engine/static_solver.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -111,7 +111,7 @@ TEST(PathModel, ElasticReferenceBetweenSamplesNearTheLimitPoint) {
   auto ref = build_model(Scene::load("", {"geometry.chambers=3", "mesh.h_mm=6.0"}));
   const double p_max = 46e3;  // Pa: as a recording's peak, 45 kPa plus overshoot
   PathModelOptions po;
-  po.p_top_Pa = 1.8 * p_max;  // as diagnose (app/diagnose_model.cpp)
+  po.p_top_Pa = 1.8 * p_max;  // as diagnose (app/diagnose/evaluator.cpp)
   po.dp_Pa = p_max / 40.0;
   const PathModel rom(ref->model, po);
   // FEM equilibria at 36.5, 37.5, ..., 45.5 kPa: between samples (1.15 kPa apart), top quarter.

@@ -11,7 +11,7 @@
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "engine/static_solver.h"
 #include "scenes/build_model.h"
 #include "tests/engine/test_meshes.h"

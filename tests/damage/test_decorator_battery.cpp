@@ -19,7 +19,7 @@
 
 #include "damage/effects.h"
 #include "damage/material_point.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/scaled.h"
 

@@ -13,7 +13,7 @@
 #include "damage/effects.h"
 #include "damage/registry.h"
 #include "engine/quasi_static.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "scenes/build_model.h"
 

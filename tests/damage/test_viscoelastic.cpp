@@ -9,7 +9,7 @@
 
 #include "damage/effects.h"
 #include "damage/material_point.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 
 namespace pneufem {

@@ -10,7 +10,7 @@
 
 #include "damage/effects.h"
 #include "engine/angle.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "materials/hyperelastic.h"
 #include "tests/engine/test_meshes.h"

@@ -13,7 +13,7 @@
 
 #include "damage/effects.h"
 #include "engine/quasi_static.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/engine/test_meshes.h"
 
 namespace pneufem {

@@ -13,7 +13,7 @@
 
 #include "engine/assembly.h"
 #include "engine/membrane.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/engine/test_meshes.h"
 
 namespace pneufem {

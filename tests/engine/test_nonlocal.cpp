@@ -16,7 +16,7 @@
 #include "engine/assembly.h"
 #include "engine/nonlocal.h"
 #include "engine/quasi_static.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "test_meshes.h"
 
 namespace pneufem {

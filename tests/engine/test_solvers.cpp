@@ -11,7 +11,7 @@
 
 #include "engine/explicit.h"
 #include "engine/static_solver.h"
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "tests/engine/test_meshes.h"
 #include "tests/engine/thick_cylinder.h"
 

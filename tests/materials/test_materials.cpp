@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
 #include "materials/scaled.h"

@@ -12,9 +12,9 @@
 
 #include <Eigen/Geometry>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "scenes/build_model.h"
-#include "scenes/inp_export.h"
+#include "scenes/calculix_deck.h"
 #include "scenes/pneunet.h"
 
 namespace pneufem {

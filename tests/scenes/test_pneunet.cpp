@@ -18,7 +18,7 @@
 
 #include <Eigen/Geometry>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "scenes/pneunet.h"
 
 namespace pneufem {

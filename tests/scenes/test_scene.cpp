@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/scene.h"
 

@@ -32,7 +32,7 @@
 #include <vtkXMLDataParser.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 #include "materials/hyperelastic.h"
 
 namespace pneufem {

@@ -1,0 +1,121 @@
+#include "app/diagnose/cli.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "core/errors.h"
+
+namespace pneufem {
+
+std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
+  auto c = std::make_unique<DiagnoseCommand>();
+  c->cmd = app.add_subcommand(
+      "diagnose",
+      "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, mullins, "
+      "fatigue, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
+      "them by the error they remove with an information criterion, and writes diagnosis.json and fitted.toml");
+  c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
+      ->check(CLI::ExistingFile);
+  c->cmd->add_option("--data", c->options.data_path, "Measurements: canonical CSV trial,time_s,pressure_kPa,angle_deg (without pressure_kPa the scene's [load] drives the model)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->cmd->add_option("--out", c->options.out_dir, "Output directory (diagnosis.json, fitted.toml, diagnosis.csv, history.jsonl)")
+      ->required();
+  c->cmd->add_option("--set", c->sets, "Override a scene key, e.g. --set mesh.h_mm=4 (repeatable)");
+  c->cmd->add_option("--candidates", c->candidates, "Comma-separated candidate effects to try (default: all)");
+  c->cmd->add_option("--max-effects", c->options.max_effects, "Greedy forward selection: at most this many effects")
+      ->check(CLI::Range(1, 6))
+      ->capture_default_str();
+  c->cmd->add_option("--evaluations", c->options.max_evaluations, "Reduced-model runs per candidate calibration")
+      ->check(CLI::Range(5, 1000))
+      ->capture_default_str();
+  c->cmd->add_option("--aic-threshold", c->options.aic_threshold, "A candidate must lower the AIC by at least this")
+      ->capture_default_str();
+  c->cmd->add_option("--min-removed", c->options.min_removed,
+                     "... and remove at least this fraction of the squared error above the noise floor")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  c->cmd->add_flag_callback(
+      "--all-rounds", [o = &c->options] { o->stop_at_noise_floor = false; },
+      "Run every forward-selection round, even when the residual is already at the noise floor");
+  c->cmd->add_flag("--trust-elastic-model", c->options.trust_elastic_model,
+                   "The elastic response is known to be right (converged mesh of the measured geometry, calibrated "
+                   "material): an effect after the first may then be one that only corrects the static angle curve "
+                   "(stiffness, gravity). Default: it must explain error beyond a static misfit, which a coarse mesh "
+                   "or an approximate geometry leaves too");
+  c->cmd->add_option("--rom-points", c->options.rom_points, "Material points of the reduced model")
+      ->check(CLI::Range(100, 10000000))
+      ->capture_default_str();
+  c->cmd->add_flag("--verify", c->options.verify, "Also run the baseline and the fitted scene with the full FEM");
+  c->cmd->add_option("--refine", c->options.refine,
+                     "Full-FEM corrections of the selected effects' constants (space mapping: N corrections cost N + 1 "
+                     "FEM runs of the recording, plus one of the baseline); recommended for damage effects (mullins, "
+                     "fatigue)")
+      ->check(CLI::Range(0, 5))
+      ->capture_default_str();
+  c->cmd->add_option("--fem-calibrate", c->options.fem_calibration_runs,
+                     "Then calibrate the selected effects' constants directly on the full FEM, locally from the "
+                     "reduced-model (or refined) ones, with at most this many FEM runs per effect (~20 for two "
+                     "constants); for effects the reduced model misjudges (fatigue)")
+      ->check(CLI::Range(0, 200))
+      ->capture_default_str();
+  c->cmd->add_option("--calibration-h", c->options.calibration_h_mm,
+                     "Calibrate on the built-in mesher at this element size (mm, e.g. 6) instead of the scene's mesh, "
+                     "with an elastic correction from one static sweep of the scene's mesh: for large meshes "
+                     "(BENCHMARKS.md: same ranking as the default mesh); --verify/--refine/--fem-calibrate and "
+                     "fitted.toml keep the scene's mesh. Default: 3x the scene's element size when its built-in mesh "
+                     "has more than 50k dof (the default actuator: 6), else the scene's mesh; 0 = the scene's mesh")
+      ->check(CLI::Range(0.0, 1000.0));
+  c->cmd->add_option("--cache", c->options.cache_dir,
+                     "Keep the elastic FEM work that depends only on the actuator (the reduced model's elastic path, "
+                     "the scene mesh's sweep, static curves with gravity) in this directory and reuse it in later runs "
+                     "on the same actuator and peak pressure: identical results (the default scene: 527 s, re-run 50 s)");
+  c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
+  c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
+  return c;
+}
+
+int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
+  c.options.command_line = command_line;
+  c.options.progress = c.progress || isatty(2);
+  c.options.candidates.clear();
+  std::string cur;
+  for (char ch : c.candidates + ",") {
+    if (ch == ',') {
+      if (!cur.empty()) c.options.candidates.push_back(cur);
+      cur.clear();
+    } else if (ch != ' ') {
+      cur += ch;
+    }
+  }
+  const Scene scene = Scene::load(c.scene_path, c.sets);
+  const DiagnosisResult r = run_diagnosis(scene, c.options);
+  std::printf("diagnose: baseline NRMSE %.4f (noise floor %.4f)\n", r.baseline_nrmse, r.noise_floor_nrmse);
+  for (const CandidateResult& k : r.candidates) {
+    std::string bound;
+    for (const std::string& n : k.at_bound) bound += (bound.empty() ? "  (at the edge of its range: " : ", ") + n;
+    if (!bound.empty()) bound += ")";
+    std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  beyond static %.4f  %s%s\n", k.round, k.effect.c_str(), k.nrmse,
+                k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
+  }
+  if (const std::string k = selected_constants_text(r); !k.empty()) std::printf("constants of the selected effects:\n%s", k.c_str());
+  if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
+  if (r.verified_fitted_nrmse >= 0)
+    std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
+  if (!r.fem_error.empty()) std::printf("full FEM: %s\n", r.fem_error.c_str());
+  if (!r.missing_history_effect.empty() && r.missing_history_effect != r.missing_effect)
+    std::printf("missing history effect: %s (after %s, which takes the larger, static part of the misfit)\n",
+                r.missing_history_effect.c_str(), r.missing_effect.c_str());
+  std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json and fitted.toml\n",
+              r.missing_effect.empty() ? "none" : r.missing_effect.c_str(), r.selected.size(), r.final_nrmse, r.wall_s,
+              c.options.out_dir.c_str());
+  if (c.options.cache_dir.empty() && r.elastic_wall_s > 20.0)
+    std::printf("note: %.0f s of this run was elastic FEM work that depends only on the actuator and the peak pressure; "
+                "--cache DIR keeps it for re-runs (README, \"Re-runs\")\n",
+                r.elastic_wall_s);
+  return 0;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,218 @@
+#pragma once
+// `pneufem diagnose`: which physical effect is the model missing?
+//
+// 1. The recording (analysis/measurements.h) is compared with the scene's model (the baseline):
+//    residual = model - measured at every kept frame (outlier frames dropped, analysis/model_vs_measured.h).
+// 2. Every candidate effect of the catalog (app/diagnose/effect_catalog.h: stiffness, viscoelastic,
+//    mullins, fatigue, pressure_lag, gravity and any registered material effect) is added to the
+//    scene and its few bounded parameters are calibrated (NLopt BOBYQA in [0, 1]-scaled, log where
+//    the catalog says so, after a coarse start grid) to minimise the residual sum of squares.
+// 3. Candidates are ranked by the error they leave. An information criterion makes extra
+//    parameters earn their place: AIC = n_eff ln(RSS / n_eff) + 2 k, where n_eff is the number of
+//    frames corrected for the residual's autocorrelation (AR(1): n (1 - rho) / (1 + rho)): 30 fps
+//    frames of a smooth model error are not independent, and counting them as such would make
+//    any parameter "significant". A candidate is significant when delta AIC <= aic_threshold
+//    (-10: "essentially no support" for the worse model, Burnham & Anderson) AND it removes at
+//    least min_removed of the baseline's error above the noise floor (in squared NRMSE), so a
+//    statistically detectable but physically negligible gain is not reported as a missing effect;
+//    and its NRMSE gain must be at least min_gain_of_floor x the noise floor (near the floor the
+//    excess is tiny and fitting noise can remove much of it).
+// 4. Greedy forward selection: the best significant candidate is added (with its calibrated
+//    constants) and the remaining candidates are tried again on top of it, up to max_effects,
+//    unless the residual is already at the noise floor (within min_gain_of_floor: the third test
+//    of 3. could then only pass by fitting noise; the discrepancy principle of inverse problems).
+//    From round 2 on the tests are applied beyond a static misfit (fit_static_discrepancy below;
+//    history effects calibrated with it profiled out) and a constant at the edge of its range
+//    disqualifies: what the first effect leaves of a recording made by other means is mostly a
+//    misfit of the elastic response, and effects fitted to it are stand-ins. Such a history effect
+//    is then re-fitted jointly with the earlier effects' constants (local search, raw error). In round 1 a history
+//    effect that fails the raw tests is calibrated again that way and may pass beyond the misfit.
+//    --trust-elastic-model restores the raw tests in later rounds.
+// 5. Every candidate gets a plain-words reason built from the residual's signature (growth over
+//    trials, creep inside holds, first-trial vs later, lag after steps, offset at rest,
+//    proportional error) and the error it removes; a significant one with two or more constants
+//    also the range over which they trade off (trade_lo/trade_hi: the fit within 25 % of its RSS
+//    along its flattest direction), since a rate law's two constants are often fixed by the data
+//    only in combination.
+//
+// Calibration runs the reduced path model (engine/path_model.h: 1-dof Ritz model on the elastic
+// FEM path of the same mesh, using the scene's own material code), hundreds of times faster than
+// the FEM; `verify` re-runs the baseline and the fitted scene through the full FEM
+// (app/simulate/drive.h) and reports those NRMSEs too.
+//
+// Outputs in out_dir: diagnosis.json (schema in the README), fitted.toml (the scene plus the
+// selected effects; `pneufem compare fitted.toml --data FILE` shows the drop), diagnosis.csv
+// (one row per candidate and round), calibration.csv (every reduced-model evaluation of every
+// calibration: parameters, RSS or the error that made it fail), and one line in history.jsonl per
+// model variant.
+#include <string>
+#include <vector>
+
+#include "analysis/model_vs_measured.h"
+#include "analysis/measurements.h"
+#include "app/diagnose/effect_catalog.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+struct DiagnoseOptions {
+  std::string data_path;
+  std::string out_dir;
+  std::vector<std::string> candidates;  ///< names to try (empty = the whole catalog)
+  int max_effects = 2;                  ///< greedy forward selection depth
+  int max_evaluations = 60;             ///< reduced-model runs per candidate calibration
+  double aic_threshold = -10.0;
+  double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
+  double min_gain_of_floor = 0.1;       ///< ... and NRMSE gain of at least this times the noise floor
+  /// Skip later rounds once the residual is within min_gain_of_floor of the noise floor (no effect
+  /// could then be significant without fitting below the floor); false = run every round.
+  bool stop_at_noise_floor = true;
+  /// From round 2 on a candidate must also explain error beyond a static misfit of the angle curve
+  /// (fit_static_discrepancy); true = the elastic response is known to be right (a converged mesh of
+  /// the measured geometry, a calibrated material), so a static remainder may be named as an effect.
+  bool trust_elastic_model = false;
+  int rom_points = 2000;                ///< material points of the reduced model
+  bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
+  int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
+  /// Full-FEM runs for a final local calibration of each selected effect's constants directly on the
+  /// FEM (bounded derivative-free search from the reduced-model or refined constants); 0 = none.
+  int fem_calibration_runs = 0;
+  /// > 0: calibrate on the built-in mesher at this element size (mm) instead of the scene's mesh,
+  /// with an elastic mesh correction from one static sweep of each mesh (see RomEvaluator in
+  /// app/diagnose/evaluator.h); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh;
+  /// < 0 = auto: 3x the scene's element size for a built-in mesh of more than 50k dof, else the
+  /// scene's mesh (a note on stderr says which).
+  double calibration_h_mm = -1.0;
+  int threads = 0;
+  bool progress = false;
+  /// Cache directory for the actuator's elastic FEM results (app/simulate/result_cache.h); "" = none.
+  std::string cache_dir;
+  std::string command_line;
+};
+
+/// One reduced-model evaluation of a calibration (written to calibration.csv: the landscape the
+/// optimiser saw, so a user can tell a flat objective from failed evaluations).
+struct CalibrationPoint {
+  std::vector<double> params;
+  double rss_deg2 = 0.0;  ///< +inf when the evaluation failed
+  std::string error;      ///< why it failed (empty when it did not)
+};
+
+struct CandidateResult {
+  std::string effect;
+  int round = 1;                        ///< 1 = on the baseline, 2 = on top of the first selection, ...
+  std::vector<std::string> param_names; ///< "<name>_<unit>"-free names, as in the catalog
+  std::vector<double> params;
+  std::vector<std::string> sets;        ///< scene overrides that add it with these values
+  double nrmse = 0.0;                   ///< pooled full time-series NRMSE with the effect
+  std::vector<double> nrmse_per_trial;
+  double rss_deg2 = 0.0;
+  double delta_aic = 0.0;               ///< vs the model of this round without it
+  double removed = 0.0;                 ///< fraction of the excess squared error removed
+  bool significant = false;
+  int evaluations = 0;
+  double wall_s = 0.0;                  ///< calibration wall time (s)
+  std::vector<CalibrationPoint> trace;  ///< every evaluation, in order
+  std::string why;
+  std::string error;                    ///< non-empty when the calibration failed
+  std::vector<std::string> at_bound;    ///< parameters calibrated at the edge of their range (params_at_bounds)
+  /// Significant candidates with two or more constants: the range of each constant along the
+  /// direction in which the fit worsens slowest, while its RSS stays within (1 + trade_rss_tol) of
+  /// the best (app/diagnose/detail.h, trade_off). Empty when not computed.
+  std::vector<double> trade_lo, trade_hi;
+  double trade_rss_tol = 0.0;
+  /// The same three tests after a static correction of both models (fit_static_discrepancy): what
+  /// the effect explains beyond a smooth misfit of the angle curve. Rounds >= 2 require it.
+  double nrmse_beyond_static = 0.0;
+  double delta_aic_beyond_static = 0.0;
+  double removed_beyond_static = 0.0;
+  bool beyond_static = false;
+  /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
+  /// always for history effects from round 2 on; in round 1 when only that calibration passes.
+  bool profiled = false;
+  /// From round 2 on, for a history effect: the constants of the effects selected before it,
+  /// re-fitted jointly with its own (in selection order; empty = not re-fitted). Selected, they
+  /// replace the earlier values in the model and in fitted.toml.
+  std::vector<double> refit_selected;
+};
+
+struct DiagnosisResult {
+  double baseline_nrmse = 0.0;
+  std::vector<double> baseline_nrmse_per_trial;
+  double noise_floor_nrmse = 0.0;
+  std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
+  std::vector<std::string> selected;
+  std::string missing_effect;               ///< "" = none significant
+  /// The first selected effect that depends on the load history (creep, damage, lag: the catalog's
+  /// `history`), "" = none: under a large static misfit `missing_effect` can be the misfit (as
+  /// stiffness) with the history effect second; this names the latter directly.
+  std::string missing_history_effect;
+  std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
+  double final_nrmse = 0.0;                 ///< reduced model with the selected effects
+  /// The final residual after a static correction (fit_static_discrepancy), and the share of the
+  /// final error above the noise floor that it removes (in squared NRMSE; 0 when at the floor):
+  /// near 1, what is left is a misfit of the elastic response, not a missing history effect.
+  double final_nrmse_beyond_static = 0.0;
+  double static_share = 0.0;
+  std::string static_note;                  ///< what the static share says, in words ("" = nothing left)
+  double verified_baseline_nrmse = -1.0;    ///< full FEM (verify), -1 when not run
+  double verified_fitted_nrmse = -1.0;
+  /// Why a full-FEM run of --verify / --refine failed ("" = none failed). The diagnosis itself is
+  /// still written: the reduced-model result does not depend on it.
+  std::string fem_error;
+  std::vector<std::vector<double>> refined_params;  ///< per selected effect, after refinement
+  std::string fitted_toml;
+  double wall_s = 0.0;
+  /// Wall time of the elastic FEM work before the calibrations (path trace, scene-mesh sweep;
+  /// near 0 when read from --cache).
+  double elastic_wall_s = 0.0;
+  long rom_runs = 0;
+};
+
+/// True when one of the candidate's trade-off ranges spans more than a factor of 2: the recording
+/// then fixes a combination of its constants more than each one (`why` and the console say so).
+bool constants_trade_off(const CandidateResult& c);
+
+/// The constants of the selected effects as the console prints them, one line per effect: the
+/// final values (re-fitted jointly by a later round, or refined with the FEM, when that happened)
+/// and, for values straight from their own calibration, the trade-off ranges. "" = none selected.
+std::string selected_constants_text(const DiagnosisResult& r);
+
+/// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
+/// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more
+/// than 50k dof, else 0 (the scene's mesh; for a large deck with a note suggesting a coarser one).
+/// What was chosen and why goes to `notes`.
+double resolve_calibration_h(const Scene& scene, double requested_mm, std::vector<std::string>& notes);
+
+/// Runs the diagnosis of `scene` against the recording in options.data_path and writes the
+/// outputs. Throws InputError for bad data/options, PhysicsError when the baseline cannot be run.
+DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options);
+
+/// Names of the parameters of `c` whose calibrated `values` lie within 1 % of the calibrated range
+/// (in the calibration coordinate, log or linear) of either bound. A constant pushed to the edge of
+/// its physical range is the mark of an effect standing in for a misfit of another kind (measured:
+/// a recording made on a finer mesh than the model's, diagnosed on the coarse one, selects Mullins
+/// with r = 1.1, its lower bound, in round 2). The rig angle is exempt: 0 and 180 deg are real rigs.
+std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::vector<double>& values);
+
+/// A static model-form discrepancy (the delta(x) of Kennedy & O'Hagan 2001, here a cubic in the
+/// model's own angle) fitted to the residual model - measured of `frames` by least squares:
+/// delta = a0 + a1 x + a2 x^2 + a3 x^3, x = model angle / its largest magnitude, one function for
+/// every trial and time. A misfit of the elastic response (the mesh, the geometry, the hyperelastic
+/// law, the stiffness, the weight) moves the angle as a smooth function of the state, and the state
+/// of a staircase is, to first order, the model angle; history effects (creep within a hold,
+/// softening after the first trial, growth over trials, lag after a step) do not: at one model
+/// angle they differ between holds, trials or times. An effect selected after another must explain
+/// error that this fit cannot (app/diagnose/command.cpp), else it is a stand-in for a static misfit.
+struct StaticFit {
+  double rss_deg2 = 0.0;                   ///< residual sum of squares after the fit (deg^2)
+  std::vector<double> residual_deg;        ///< model - measured - delta, per frame
+  std::vector<double> coefficients_deg;    ///< a0 ... a3
+};
+StaticFit fit_static_discrepancy(const std::vector<ComparedFrame>& frames);
+
+/// AR(1) effective sample size of a residual sequence (segments = trials): n (1 - rho)/(1 + rho),
+/// rho the lag-1 autocorrelation within segments, clamped to [min(n, 10), n].
+double effective_sample_size(const std::vector<double>& residual, const std::vector<int>& segment);
+
+}  // namespace pneufem

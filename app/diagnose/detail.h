@@ -1,0 +1,145 @@
+#pragma once
+// What the files of `pneufem diagnose` (app/diagnose/command.h) share; internal to them:
+//   command.cpp             run_diagnosis: the baseline, the rounds of forward selection and their
+//                           significance tests, then the FEM stages and the outputs below;
+//   evaluator.h/.cpp        RomEvaluator, the reduced-model replay of the recording;
+//   calibrate.cpp           parameter scaling, interpolation nodes and the calibration of a
+//                           candidate's constants (grid, then golden section or BOBYQA);
+//   evidence.cpp            the residual's signature and the plain-words reason per candidate;
+//   fem.cpp                 the full-FEM stages: space-mapping refinement (--refine), FEM
+//                           calibration (--fem-calibrate) and verification (--verify);
+//   output.cpp              diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv, history.
+// Beside them: effect_catalog (the candidates; `pneufem synth` hides the same ones),
+// elastic_curve (static angle curves and the interpolation nodes of the catalog's constants) and
+// cli (the command line).
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "analysis/model_vs_measured.h"
+#include "analysis/measurements.h"
+#include "app/diagnose/command.h"
+#include "app/diagnose/effect_catalog.h"
+#include "scenes/scene.h"
+
+namespace pneufem::diagnose_detail {
+
+class RomEvaluator;
+
+/// The selected effects with their calibrated constants, in the order they were selected.
+using ChosenEffects = std::vector<std::pair<const CandidateEffect*, std::vector<double>>>;
+
+inline double sq(double v) { return v * v; }
+
+inline std::string fmt(const char* f, double a) {
+  char b[96];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+
+// ---- calibration (calibrate.cpp)
+
+double rss_of(const std::vector<double>& model, const std::vector<ComparedFrame>& frames);
+
+std::vector<double> initial_values(const CandidateEffect& c);
+
+/// Value of a catalog parameter at the scaled coordinate x in [0, 1].
+double unscale(const CandidateParameter& p, double x);
+double scale(const CandidateParameter& p, double v);
+
+/// Parameter values of the interpolation nodes (app/diagnose/elastic_curve.h): the rig angle's five angles
+/// (deg), or Chebyshev-Lobatto nodes of the calibration coordinate (log or linear over the bounds).
+std::vector<double> interpolation_nodes(ParameterInterpolation how, const CandidateParameter& p);
+
+struct Calibration {
+  std::vector<double> values;
+  double rss = std::numeric_limits<double>::infinity();
+  int evaluations = 0;
+  std::string error;
+  std::vector<CalibrationPoint> trace;
+};
+
+/// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
+/// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
+/// (several) from the best grid point, until the trust region is 1e-4 of the calibration scale,
+/// a step gains less than 1e-4 in log RSS, or `budget` runs are spent. Two constants that trade
+/// off leave a narrow valley that BOBYQA walks down in small steps: the default budget (60,
+/// DiagnoseOptions) is sized for that walk (Calibrate.WalksDownALogSpaceValleyWithinTheDefaultBudget).
+/// The optimiser sees log(rss), which has the same minimiser: near a limit point the RSS of
+/// neighbouring constants spans six decades (a softened model that snaps through is off by tens
+/// of degrees), and BOBYQA's quadratic models of the raw RSS are then dominated by those points.
+/// A failed evaluation (no equilibrium) is recorded as +infinity but scores as one decade worse
+/// than the worst finite RSS seen, so it repels the search without breaking the model.
+Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                      int budget, const std::vector<double>* start = nullptr);
+
+/// How far a calibration's constants can move together without worsening the fit much: the
+/// range of each constant along the direction in which the RSS rises slowest (the smallest
+/// curvature of a finite-difference Hessian in the calibration scale), walked both ways from the
+/// best point while the RSS stays within (1 + rss_tol) of the best. Two constants of a rate law
+/// often trade off (a lower fatigue threshold with a slower rate; a larger Prony gamma with a
+/// shorter tau): the recording then fixes a combination, not each constant, and the calibrated
+/// point is wherever along that valley the model's own error puts it.
+struct TradeOff {
+  std::vector<double> lo, hi;  ///< per parameter (catalog units); empty when not computed
+  double rss_tol = 0.0;
+  int evaluations = 0;
+};
+
+/// The trade-off of `values` (the calibrated point, RSS `rss_best`) for a candidate with two or
+/// more parameters (empty for one). Walk resolution: steps double from 0.05 in the calibration
+/// scale, then two bisections, so each end is found to within a quarter of its last step.
+TradeOff trade_off(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                   const std::vector<double>& values, double rss_best, double rss_tol);
+
+// ---- evidence (evidence.cpp)
+
+/// Residual signature of a comparison: numbers the reasons are made of.
+struct Signature {
+  std::vector<double> trial_rmse;     ///< per trial
+  double growth = 1.0;                ///< rmse of the last trial / first
+  double creep_top_deg = 0.0;         ///< mean (measured - model) spread at the top third of the levels
+  double creep_low_deg = 0.0;         ///< ... at the other levels
+  double creep_first_deg = 0.0, creep_last_deg = 0.0;  ///< mean spread difference, first / last trial
+  double first_vs_rest = 0.0;         ///< mean residual of trial 1 minus that of the others
+  double early_deg = 0.0, late_deg = 0.0;  ///< mean residual in the first 0.5 s of steps / after the mark
+  double rest_deg = 0.0;              ///< mean residual on steps at (near) zero pressure
+  double proportional = 0.0;          ///< correlation of mark residual with the measured mark angle
+};
+
+Signature signature_of(const Comparison& c);
+
+/// The sentence about the residual feature that `effect` explains.
+std::string evidence(const std::string& effect, const Signature& s);
+
+// ---- full FEM (fem.cpp)
+
+/// --refine and --fem-calibrate: re-calibrates the constants of `chosen` against the full FEM of
+/// `scene` (space mapping on the reduced model of `cal_scene`, N + 1 FEM runs for --refine N, then
+/// local FEM calibration), and keeps those of the best complete FEM run. Updates `chosen`,
+/// `selected_sets` (the scene overrides of `chosen`), `rom_runs` and out.fem_error /
+/// out.refined_params; `fitted_fem` (if given) gets the FEM angle traces of the kept constants when
+/// a refinement run computed them (else it is left empty). Does nothing when neither is asked for
+/// or nothing was selected.
+void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
+                     const std::vector<ComparedFrame>& frames, const RomEvaluator& rom, const DiagnoseOptions& opt,
+                     ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
+                     DiagnosisResult& out, std::vector<Series>* fitted_fem = nullptr);
+
+/// --verify: the full-FEM NRMSEs of the baseline `scene` and of `fitted` (out.verified_*; -1 and a
+/// note in out.fem_error when a run fails). `fitted_fem`, when non-empty, are the FEM traces of
+/// `fitted` already computed (by refine_with_fem): its run is not repeated.
+void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& rec, const DiagnoseOptions& opt,
+                     DiagnosisResult& out, const std::vector<Series>* fitted_fem = nullptr);
+
+// ---- outputs (output.cpp)
+
+/// Writes diagnosis.json, fitted.toml, diagnosis.csv and calibration.csv to opt.out_dir and
+/// appends the baseline and the fitted model to its history.jsonl.
+void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator& rom, const ChosenEffects& chosen,
+                     const DiagnoseOptions& opt, const DiagnosisResult& out);
+
+}  // namespace pneufem::diagnose_detail

@@ -1,0 +1,55 @@
+#pragma once
+// The candidate effects that `pneufem diagnose` tries and `pneufem synth --hidden` hides in
+// synthetic data: each is a physical effect the base model may be missing, with its calibration
+// parameters and the scene overrides that add it to a scene.
+//
+// Built-ins: stiffness, viscoelastic, mullins, fatigue, pressure_lag, gravity; then every effect
+// of the material-effect registry (damage/registry.h) that is not a built-in, with the registry's
+// parameters and bounds (truth = initial = the registered default). Material effects apply to every
+// soft material of the scene's parts (model != "linear_elastic"; the fabric is not softened).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+/// none: run by run; rig_angle: the parameter is the rig angle in [0, 180] deg (trigonometric
+/// basis); smooth: a smooth response over the bounds (polynomial on Chebyshev nodes of the
+/// calibration coordinate, log or linear).
+enum class ParameterInterpolation { none, rig_angle, smooth };
+
+struct CandidateParameter {
+  std::string name;   ///< e.g. "tau_s"
+  std::string unit;   ///< e.g. "s"
+  double lo, hi;      ///< calibration bounds
+  double initial;     ///< start of calibration
+  double truth;       ///< value `pneufem synth --hidden` uses by default
+  bool log = false;   ///< calibrate/sample in log space
+};
+
+struct CandidateEffect {
+  std::string name;         ///< "stiffness", "viscoelastic", ... or a registered material effect
+  std::string description;  ///< one line, plain words
+  std::string signature;    ///< residual signature it explains, plain words (diagnose's "why")
+  bool history = false;     ///< the response depends on the load history (creep, damage)
+  /// How diagnose may interpolate the model over this candidate's single parameter when every run
+  /// costs a static FEM sweep (an elastic model with gravity); see app/diagnose/elastic_curve.h.
+  ParameterInterpolation interpolation = ParameterInterpolation::none;
+  std::vector<CandidateParameter> params;
+  /// `--set` overrides (key=value) that add the effect with these parameter values (one per param,
+  /// in order) to `scene`. Throws InputError for a wrong number of values.
+  std::function<std::vector<std::string>(const Scene& scene, const std::vector<double>& values)> sets;
+};
+
+/// Built-ins then every registered material effect (rebuilt when effects were registered since).
+const std::vector<CandidateEffect>& candidate_effects();
+
+/// The candidate called `name`; throws InputError listing the valid names.
+const CandidateEffect& candidate_effect(const std::string& name);
+
+/// Names of the soft materials of the scene's parts (model != "linear_elastic"), in part order.
+std::vector<std::string> soft_materials(const Scene& scene);
+
+}  // namespace pneufem

@@ -1,0 +1,207 @@
+// The files a diagnosis writes (app/diagnose/detail.h; schema of diagnosis.json in the README):
+// diagnosis.json, fitted.toml, diagnosis.csv (one row per candidate and round), calibration.csv
+// (every evaluation of every calibration) and the history lines. Apart from the diagnosis because
+// it only formats a finished DiagnosisResult; nothing here changes a number.
+#include <algorithm>
+#include <cstdio>
+#include <cmath>
+#include <filesystem>
+
+#include "app/compare/history.h"
+#include "app/diagnose/detail.h"
+#include "app/diagnose/evaluator.h"
+#include "core/json_writer.h"
+#include "core/atomic_file.h"
+#include "core/version.h"
+
+namespace fs = std::filesystem;
+
+namespace pneufem::diagnose_detail {
+
+void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator& rom, const ChosenEffects& chosen,
+                     const DiagnoseOptions& opt, const DiagnosisResult& out) {
+  fs::create_directories(opt.out_dir);
+  json::Object root;
+  root.add_str("version", version_string());
+  root.add_str("command", opt.command_line);
+  root.add_str("data", opt.data_path);
+  json::Object b;
+  b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
+  if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
+  root.add("baseline", b.str(2));
+  std::string cs = "[";
+  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
+    const CandidateResult& c = out.candidates[i];
+    json::Object p;
+    for (std::size_t j = 0; j < c.params.size(); ++j) p.add(c.param_names[j], c.params[j]);
+    json::Object o;
+    o.add_str("effect", c.effect).add("round", c.round).add("nrmse", c.nrmse);
+    o.add("nrmse_per_trial", json::array(c.nrmse_per_trial)).add("params", c.params.empty() ? "{}" : p.str(6));
+    std::string sets = "[";
+    for (std::size_t j = 0; j < c.sets.size(); ++j) sets += (j ? ", " : "") + json::quote(c.sets[j]);
+    o.add("sets", sets + "]").add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
+    o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add("wall_s", c.wall_s);
+    o.add_str("why", c.why);
+    std::string ab = "[";
+    for (std::size_t j = 0; j < c.at_bound.size(); ++j) ab += (j ? ", " : "") + json::quote(c.at_bound[j]);
+    o.add("at_bound", ab + "]");
+    o.add("nrmse_beyond_static", c.nrmse_beyond_static).add("delta_aic_beyond_static", c.delta_aic_beyond_static);
+    o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
+    o.add("profiled", c.profiled ? "true" : "false");
+    if (!c.refit_selected.empty()) o.add("refit_selected_params", json::array(c.refit_selected));
+    if (!c.trade_lo.empty()) {
+      json::Object ranges;
+      for (std::size_t j = 0; j < c.trade_lo.size(); ++j) ranges.add(c.param_names[j], json::array({c.trade_lo[j], c.trade_hi[j]}));
+      json::Object t;
+      t.add("rss_within", c.trade_rss_tol).add("ranges", ranges.str(8));
+      o.add("trade_off", t.str(6));
+    }
+    if (!c.error.empty()) o.add_str("error", c.error);
+    cs += (i ? ",\n    " : "\n    ") + o.str(4);
+  }
+  root.add("candidates", cs + "\n  ]");
+  root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
+  root.add("missing_history_effect", out.missing_history_effect.empty() ? "null" : json::quote(out.missing_history_effect));
+  if (!out.stopped.empty()) root.add("stopped", json::quote(out.stopped));
+  std::string sel = "[";
+  for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
+  root.add("selected", sel + "]");
+  if (!out.refined_params.empty()) {
+    std::string rp = "{";
+    for (std::size_t j = 0; j < chosen.size(); ++j) {
+      json::Object p;
+      for (std::size_t i = 0; i < chosen[j].first->params.size(); ++i) p.add(chosen[j].first->params[i].name, chosen[j].second[i]);
+      rp += (j ? ", " : "") + json::quote(chosen[j].first->name) + ": " + p.str(4);
+    }
+    root.add("refined_params", rp + "}");
+  }
+  root.add("noise_floor_nrmse", out.noise_floor_nrmse);
+  root.add("final_nrmse", out.final_nrmse);
+  if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
+  json::Object sr;
+  sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
+  root.add("static_remainder", sr.str(2));
+  if (!out.fem_error.empty()) root.add_str("fem_error", out.fem_error);
+  json::Object method;
+  method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
+                                  " material points, elastic path to " +
+                                  fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add_str("elastic_path_source", rom.path_source());
+  if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
+  if (opt.calibration_h_mm > 0.0) {
+    // The calibration mesh and its correction, so a reader can judge its size against the effects'.
+    json::Object cm;
+    const std::vector<double>& f = rom.fine_curve();
+    const std::vector<double>& c = rom.coarse_curve();
+    std::vector<double> p;
+    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.inlet_max_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
+    cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
+    std::vector<double> m;
+    for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
+    cm.add("pressure_kPa", json::array(p)).add("scene_mesh_angle_deg", json::array(f)).add("calibration_mesh_angle_deg", json::array(c));
+    cm.add("mapped_pressure_kPa", json::array(m));
+    cm.add_str("scene_mesh_sweep_source", rom.fine_source());
+    method.add("calibration_mesh", cm.str(4));
+  }
+  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);
+  method.add("trust_elastic_model", opt.trust_elastic_model ? "true" : "false");
+  method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
+  root.add("method", method.str(2));
+  root.add("scene", scene.to_json());
+  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
+  write_file_atomic((fs::path(opt.out_dir) / "fitted.toml").string(), out.fitted_toml);
+  std::string csv = "round,effect,nrmse,delta_aic,removed_fraction,significant,evaluations,params,nrmse_beyond_static,beyond_static\n";
+  for (const CandidateResult& c : out.candidates) {
+    std::string p;
+    for (std::size_t j = 0; j < c.params.size(); ++j) p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.params[j]);
+    csv += std::to_string(c.round) + "," + c.effect + "," + json::num(c.nrmse) + "," + json::num(c.delta_aic) + "," +
+           json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "," +
+           json::num(c.nrmse_beyond_static) + "," + (c.beyond_static ? "1" : "0") + "\n";
+  }
+  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.csv").string(), csv);
+  std::string tr = "round,effect,evaluation,params,rss_deg2,error\n";
+  for (const CandidateResult& c : out.candidates)
+    for (std::size_t i = 0; i < c.trace.size(); ++i) {
+      std::string p;
+      for (std::size_t j = 0; j < c.trace[i].params.size(); ++j)
+        p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.trace[i].params[j]);
+      std::string e = c.trace[i].error;
+      std::replace(e.begin(), e.end(), '"', '\'');
+      tr += std::to_string(c.round) + "," + c.effect + "," + std::to_string(i + 1) + "," + p + "," +
+            (std::isfinite(c.trace[i].rss_deg2) ? json::num(c.trace[i].rss_deg2) : std::string("inf")) + ",\"" + e + "\"\n";
+    }
+  write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
+  HistoryEntry h;
+  h.time_utc = utc_now();
+  h.source = "diagnose";
+  h.label = "diagnose baseline (reduced model)";
+  h.scene_hash = scene_hash(scene);
+  h.nrmse = out.baseline_nrmse;
+  h.trial_nrmse = out.baseline_nrmse_per_trial;
+  append_history(opt.out_dir, h);
+  if (!out.selected.empty()) {
+    h.label = "diagnose + " + out.selected.front() + (out.selected.size() > 1 ? " + " + out.selected[1] : "") +
+              " (reduced model)";
+    h.scene_hash = scene_hash(fitted);
+    h.nrmse = out.final_nrmse;
+    h.trial_nrmse.clear();
+    append_history(opt.out_dir, h);
+  }
+}
+
+}  // namespace pneufem::diagnose_detail
+
+namespace pneufem {
+
+bool constants_trade_off(const CandidateResult& c) {
+  for (std::size_t j = 0; j < c.trade_lo.size() && j < c.trade_hi.size(); ++j)
+    if (c.trade_hi[j] > 2.0 * c.trade_lo[j]) return true;
+  return false;
+}
+
+std::string selected_constants_text(const DiagnosisResult& r) {
+  struct Entry {
+    const CandidateResult* c;
+    std::vector<double> values;
+    std::string how;  ///< "" = its own calibration (ranges apply)
+  };
+  std::vector<Entry> e;
+  for (std::size_t i = 0; i < r.selected.size(); ++i) {
+    const auto it = std::find_if(r.candidates.begin(), r.candidates.end(), [&](const CandidateResult& c) {
+      return c.effect == r.selected[i] && c.round == static_cast<int>(i) + 1;
+    });
+    if (it == r.candidates.end()) continue;
+    std::size_t o = 0;  // a joint re-fit replaces the constants of the effects selected before
+    for (Entry& before : e)
+      for (double& v : before.values)
+        if (o < it->refit_selected.size()) v = it->refit_selected[o++], before.how = "re-fitted with " + it->effect;
+    e.push_back({&*it, it->params, ""});
+  }
+  if (r.refined_params.size() == e.size())
+    for (std::size_t i = 0; i < e.size(); ++i) e[i].values = r.refined_params[i], e[i].how = "refined with the FEM";
+  std::string out;
+  for (const Entry& x : e) {
+    std::string line = "  " + x.c->effect + ":";
+    const bool ranges = x.how.empty() && x.c->trade_lo.size() == x.values.size();
+    for (std::size_t j = 0; j < x.values.size(); ++j) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s %s %.4g", j ? "," : "", x.c->param_names[j].c_str(), x.values[j]);
+      line += buf;
+      if (ranges) {
+        std::snprintf(buf, sizeof buf, " (%.4g to %.4g)", x.c->trade_lo[j], x.c->trade_hi[j]);
+        line += buf;
+      }
+    }
+    if (!x.how.empty()) line += " (" + x.how + ")";
+    if (ranges) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "; ranges: RSS within %.0f %% of the best%s", 100.0 * x.c->trade_rss_tol,
+                    constants_trade_off(*x.c) ? ", the constants trade off" : "");
+      line += buf;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,383 @@
+#include "app/simulate/command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "analysis/paper_metrics.h"
+#include "app/simulate/ideal_cache.h"
+#include "core/json_writer.h"
+#include "core/version.h"
+#include "core/atomic_file.h"
+#include "damage/registry.h"
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/explicit.h"
+#include "core/errors.h"
+#include "scenes/build_model.h"
+#include "viz/vtk_output.h"
+
+namespace pneufem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string mesh_stats_json(const MeshStats& s) {
+  json::Object regions;
+  for (const auto& [name, n] : s.elements_per_region) regions.add(name, static_cast<double>(n));
+  json::Object o;
+  o.add("nodes", static_cast<double>(s.nodes))
+      .add("elements", static_cast<double>(s.elements))
+      .add_str("element_type", s.element_type)
+      .add("dofs", 3.0 * s.nodes)
+      .add("volume_m3", s.volume_m3)
+      .add("min_edge_m", s.min_edge_m)
+      .add("max_edge_m", s.max_edge_m)
+      .add("min_quality_radius_ratio", s.min_quality)
+      .add("mean_quality_radius_ratio", s.mean_quality)
+      .add("bbox_min_m", json::array({s.bbox_min.x(), s.bbox_min.y(), s.bbox_min.z()}))
+      .add("bbox_max_m", json::array({s.bbox_max.x(), s.bbox_max.y(), s.bbox_max.z()}))
+      .add("elements_per_region", regions.str(4));
+  return o.str(2);
+}
+
+std::string states_csv(const std::vector<StateRecord>& recs) {
+  std::string s = "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm\n";
+  char line[256];
+  for (const StateRecord& r : recs) {
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n", r.trial, r.time_s, r.global_time_s,
+                  r.pressure_Pa * 1e-3, r.angle_deg, r.cavity_volume_m3 * 1e9, r.plane_rms_m * 1e3);
+    s += line;
+  }
+  return s;
+}
+
+/// Angles of one trial at each step's mark and end (records at those exact report times).
+StepAngles step_angles(const TrialLoad& tl, int trial, const std::vector<StateRecord>& recs) {
+  StepAngles s;
+  s.trial = trial;
+  auto at = [&](double t) {
+    for (const StateRecord& r : recs)
+      if (r.trial == trial && std::abs(r.time_s - t) < 1e-9) return r.angle_deg;
+    throw InputError("metrics: no report at t = " + std::to_string(t) + " s of trial " + std::to_string(trial));
+  };
+  for (std::size_t k = 0; k < tl.step_start_s.size(); ++k) {
+    s.level_kPa.push_back(tl.step_level_Pa[k] * 1e-3);
+    s.at_mark_deg.push_back(at(tl.step_start_s[k] + tl.mark_s));
+    s.at_end_deg.push_back(at(tl.step_end_s[k]));
+  }
+  return s;
+}
+
+/// Scene keys that switch off every inelastic effect (the "ideal" elastic model of the paper).
+std::vector<std::string> ideal_overrides(const Scene& scene, bool& any_effect) {
+  std::vector<std::string> sets;
+  any_effect = false;
+  for (const std::string& m : scene.table_keys("materials"))
+    for (const MaterialEffect* fx : material_effects()) {  // built-in and registered (damage/registry.h)
+      const std::string key = "materials." + m + "." + fx->name + ".enabled";
+      if (scene.has(key) && scene.boolean(key)) {
+        any_effect = true;
+        sets.push_back(key + "=false");
+      }
+    }
+  return sets;
+}
+
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool on) : on_(on) {}
+  void update(const StateRecord& r, int trials, const char* what) {
+    if (!on_) return;
+    std::fprintf(stderr, "\r  %s trial %d/%d  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", what, r.trial, trials,
+                 r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (on_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool on_;
+};
+
+// Application part of a checkpoint: the reports so far and the VTU series.
+struct AppCheckpoint {
+  std::vector<StateRecord> records;
+  std::vector<std::pair<double, std::string>> vtu;
+};
+
+void write_app_section(std::ostream& os, const AppCheckpoint& a) {
+  const std::uint64_t nr = a.records.size(), nv = a.vtu.size();
+  os.write(reinterpret_cast<const char*>(&nr), sizeof nr);
+  for (const StateRecord& r : a.records) os.write(reinterpret_cast<const char*>(&r), sizeof r);
+  os.write(reinterpret_cast<const char*>(&nv), sizeof nv);
+  for (const auto& [t, f] : a.vtu) {
+    const std::uint64_t len = f.size();
+    os.write(reinterpret_cast<const char*>(&t), sizeof t);
+    os.write(reinterpret_cast<const char*>(&len), sizeof len);
+    os.write(f.data(), static_cast<std::streamsize>(len));
+  }
+}
+
+AppCheckpoint read_app_section(std::istream& is) {
+  AppCheckpoint a;
+  std::uint64_t nr = 0, nv = 0;
+  auto check = [&] {
+    if (!is) throw InputError("checkpoint: file is truncated; the run cannot be resumed (start it again)");
+  };
+  is.read(reinterpret_cast<char*>(&nr), sizeof nr);
+  check();
+  a.records.resize(nr);
+  for (auto& r : a.records) is.read(reinterpret_cast<char*>(&r), sizeof r);
+  is.read(reinterpret_cast<char*>(&nv), sizeof nv);
+  check();
+  for (std::uint64_t i = 0; i < nv; ++i) {
+    double t = 0;
+    std::uint64_t len = 0;
+    is.read(reinterpret_cast<char*>(&t), sizeof t);
+    is.read(reinterpret_cast<char*>(&len), sizeof len);
+    check();
+    std::string f(len, '\0');
+    is.read(f.data(), static_cast<std::streamsize>(len));
+    a.vtu.emplace_back(t, f);
+  }
+  check();
+  return a;
+}
+
+/// Quasi-static run of a scene with no outputs (the ideal model of the metrics).
+std::vector<StateRecord> records_of(const Scene& scene) {
+  std::unique_ptr<BuiltModel> bm = build_model(scene);
+  const Assembler asmb(bm->model);
+  QuasiStaticRun run(asmb, bm->solver.quasi_static);
+  std::vector<StateRecord> recs;
+  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) { recs.push_back(r); });
+  return recs;
+}
+
+}  // namespace
+
+RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  const fs::path dir(opt.out_dir);
+  const Scene scene = opt.resume ? Scene::load((dir / "scene.toml").string()) : scene_arg;
+  if (opt.resume && !fs::exists(dir / "checkpoint.bin"))
+    throw InputError("--resume " + opt.out_dir + ": no checkpoint.bin there (was the run started with this directory?)");
+  fs::create_directories(dir);
+  if (!fs::is_directory(dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
+
+  const auto t_build = std::chrono::steady_clock::now();
+  std::unique_ptr<BuiltModel> bm = build_model(scene);
+  const Assembler asmb(bm->model);
+  const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
+  if (!opt.resume) write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
+
+  RunResult result;
+  ProgressLine progress(opt.progress);
+  const int ntrials = static_cast<int>(bm->load.trials.size());
+  json::Object solver_stats;
+  std::exception_ptr failure;
+
+  // The ideal elastic model (effects off, one trial) for the paper's metrics.
+  bool any_effect = false;
+  const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
+  const bool staircase = scene.string("load.protocol") == "staircase";
+  std::vector<StateRecord> ideal;
+  std::string ideal_source = "computed";
+  if (opt.compare_ideal && any_effect && staircase && bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
+    if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
+      ideal = read_angles_csv((dir / "ideal_angles.csv").string());
+      ideal_source = "ideal_angles.csv of the resumed run";
+    } else {
+      std::vector<std::string> sets = ideal_sets;
+      sets.push_back("load.trials=1");
+      const Scene ideal_scene = scene.with(sets);
+      auto compute = [&] {
+        if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
+        return records_of(ideal_scene);
+      };
+      if (opt.ideal_cache_dir.empty()) {
+        ideal = compute();
+      } else {
+        IdealResult r = cached_ideal(opt.ideal_cache_dir, ideal_cache_key(ideal_scene, bm->model, version_string()),
+                                     ideal_scene, bm->load.trials[0].output_s, compute, bm->warnings);
+        ideal = std::move(r.records);
+        ideal_source = r.source;
+      }
+      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal, true));
+    }
+  }
+
+  const bool want_vtu = bm->output.vtu != "none";
+  if (want_vtu) fs::create_directories(dir / "vtu");
+  PvdSeries pvd((dir / "results.pvd").string());
+  AppCheckpoint app;
+  std::unique_ptr<QuasiStaticCheckpoint> resume_from;
+  if (opt.resume) {
+    std::ifstream in(dir / "checkpoint.bin", std::ios::binary);
+    resume_from = std::make_unique<QuasiStaticCheckpoint>(
+        QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
+    app = read_app_section(in);
+    for (const auto& [t, f] : app.vtu) pvd.add(t, f);
+  }
+  std::vector<StateRecord>& records = app.records;
+
+  auto is_step_end = [&](const StateRecord& r) {
+    const TrialLoad& tl = bm->load.trials[r.trial - 1];
+    for (double e : tl.step_end_s)
+      if (std::abs(e - r.time_s) < 1e-9) return true;
+    return tl.step_end_s.empty();
+  };
+  auto observe = [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
+    records.push_back(r);
+    if (want_vtu && (bm->output.vtu == "all" || is_step_end(r))) {
+      char name[64];
+      std::snprintf(name, sizeof name, "vtu/state_%04zu.vtu", app.vtu.size());
+      write_vtu((dir / name).string(), bm->model, compute_fields(asmb, u, state), r.global_time_s, r.trial,
+                r.pressure_Pa * 1e-3, r.angle_deg);
+      pvd.add(r.global_time_s, name);
+      app.vtu.emplace_back(r.global_time_s, name);
+    }
+    progress.update(r, ntrials, "");
+  };
+  int checkpoints = 0;
+  auto last_ckpt = std::chrono::steady_clock::now();
+  auto sink = [&](const QuasiStaticCheckpoint& c) {
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt).count();
+    if (since < opt.checkpoint_every_s) return;
+    std::ostringstream os(std::ios::binary);
+    c.write(os);
+    write_app_section(os, app);
+    write_file_atomic((dir / "checkpoint.bin").string(), os.str());
+    write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
+    last_ckpt = std::chrono::steady_clock::now();
+    if (opt.abort_after_checkpoints >= 0 && ++checkpoints >= opt.abort_after_checkpoints) std::_Exit(137);
+  };
+
+  const auto t_solve = std::chrono::steady_clock::now();
+  try {
+    if (bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
+      QuasiStaticRun run(asmb, bm->solver.quasi_static);
+      try {
+        run.run(bm->load, observe, sink, resume_from.get());
+      } catch (...) {
+        solver_stats.add("states", static_cast<double>(run.stats().states));
+        throw;
+      }
+      const StaticStats& st = run.static_solver().stats();
+      solver_stats.add_str("mode", "quasi_static")
+          .add_str("method", bm->solver.quasi_static.method == EquilibriumMethod::Newton ? "newton" : "relaxation")
+          .add("states", static_cast<double>(run.stats().states))
+          .add("rejected_time_steps", static_cast<double>(run.stats().rejected_steps))
+          .add("increments", static_cast<double>(st.increments))
+          .add("cutbacks", static_cast<double>(st.cutbacks))
+          .add("newton_iterations", static_cast<double>(st.iterations))
+          .add("chord_steps", static_cast<double>(st.chord_steps))
+          .add("factorizations", static_cast<double>(st.factorizations))
+          .add("krylov_iterations", static_cast<double>(st.krylov_iterations))
+          .add("stiff_layer_relaxations", static_cast<double>(st.stiff_relaxations))
+          .add("stiff_layer_factorizations", static_cast<double>(st.stiff_factorizations))
+          .add("last_factor_steps", static_cast<double>(st.last_factor_steps))
+          .add("energy_line_search_cuts", static_cast<double>(st.energy_cuts))
+          .add("release_attempts", static_cast<double>(st.release_attempts))
+          .add("direct_releases", static_cast<double>(st.direct_releases))
+          .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
+          .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
+          .add("assembly_s", st.assembly_s)
+          .add("factor_solve_s", st.factor_s)
+          .add("resumed", opt.resume ? 1.0 : 0.0);
+    } else {
+      if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
+      // Explicit dynamics through the concatenated trials; time_scale > 1 compresses the
+      // protocol (quasi-static by time scaling) and the reported times are protocol times.
+      ExplicitIntegrator ex(asmb, bm->solver.explicit_dynamics);
+      const double ts = bm->solver.time_scale;
+      double t0_protocol = 0.0, last_angle = 0.0;
+      for (int k = 0; k < ntrials; ++k) {
+        const TrialLoad& tl = bm->load.trials[k];
+        const double trial_start = t0_protocol;
+        auto pressure = [&](double tau) { return tl.pressure(tau * ts - trial_start); };
+        for (double t_out : tl.output_s) {
+          ex.run((trial_start + t_out) / ts, pressure, 1 << 30, nullptr);
+          StateRecord r;
+          r.trial = k + 1;
+          r.time_s = t_out;
+          r.global_time_s = trial_start + t_out;
+          r.pressure_Pa = tl.pressure(t_out);
+          const AngleResult a = bending_angle(bm->model, ex.u());
+          r.angle_deg = unwrap_deg(a.angle_deg, last_angle);
+          last_angle = r.angle_deg;
+          r.plane_rms_m = a.plane_rms_m;
+          r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
+          observe(r, ex.u(), ex.state());
+        }
+        t0_protocol += tl.duration() + bm->load.rest_between_trials_s;
+      }
+      solver_stats.add_str("mode", "explicit")
+          .add("steps", static_cast<double>(ex.stats().steps))
+          .add("dt_s", ex.stats().dt_s)
+          .add("dt_min_s", ex.stats().dt_min_s)
+          .add("time_scale", ts)
+          .add("physical_mass_kg", ex.stats().physical_mass_kg)
+          .add("added_mass_kg", ex.stats().added_mass_kg)
+          .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
+          .add("energy_kinetic_J", ex.energy().kinetic_J)
+          .add("energy_internal_J", ex.energy().internal_J)
+          .add("energy_external_work_J", ex.energy().external_work_J)
+          .add("energy_damping_J", ex.energy().damping_J)
+          .add("energy_balance_relative_error", ex.energy().relative_error());
+    }
+  } catch (const std::exception& e) {
+    result.status = e.what();
+    failure = std::current_exception();
+  }
+  progress.done();
+  const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  result.records = records;
+
+  write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
+  write_file_atomic((dir / "states.csv").string(), states_csv(records));
+  std::string metrics_note = "null";
+  if (!ideal.empty() && !failure) {
+    const StepAngles ref = step_angles(bm->load.trials[0], 1, ideal);
+    std::vector<TrialMetrics> per_trial;
+    for (int k = 0; k < ntrials; ++k) per_trial.push_back(paper_metrics(step_angles(bm->load.trials[k], k + 1, records), ref));
+    write_file_atomic((dir / "metrics.json").string(), metrics_json(per_trial, ref.level_kPa));
+    metrics_note = json::quote("metrics.json");
+  }
+  std::string warnings = "[";
+  for (std::size_t i = 0; i < bm->warnings.size(); ++i) warnings += (i ? ", " : "") + json::quote(bm->warnings[i]);
+  warnings += "]";
+  json::Object timings;
+  timings.add("build_s", build_s).add("solve_s", solve_s).add("total_s", result.wall_s);
+  json::Object summary;
+  summary.add_str("pneufem_version", version_string())
+      .add_str("status", result.status)
+      .add_str("command_line", opt.command_line)
+      .add("threads", static_cast<double>(threads))
+      .add_str("load", bm->load.description)
+      .add("mesh", mesh_stats_json(bm->stats))
+      .add("solver", solver_stats.str(2))
+      .add("timings", timings.str(2))
+      .add("warnings", warnings)
+      .add("metrics", metrics_note)
+      .add_str("ideal_model", ideal.empty() ? "none" : ideal_source)
+      .add("states_reported", static_cast<double>(records.size()))
+      .add("scene", scene.to_json());
+  write_file_atomic((dir / "summary.json").string(), summary.str() + "\n");
+  if (failure) std::rethrow_exception(failure);
+  return result;
+}
+
+}  // namespace pneufem

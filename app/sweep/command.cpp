@@ -1,0 +1,702 @@
+#include "app/sweep/command.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include <tbb/info.h>
+
+#include "core/json_writer.h"
+#include "core/atomic_file.h"
+#include "core/version.h"
+#include "core/errors.h"
+#include "scenes/scene.h"
+#include "viz/svg_plot.h"
+
+namespace pneufem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kParamForm =
+    "expected KEY=LO:HI:N[:log], e.g. --param materials.silicone.fatigue.tau_s=100:1000:5:log";
+constexpr std::size_t kMaxPoints = 100000;
+
+std::optional<double> parse_double(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::optional<long long> parse_int(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (end != s.c_str() + s.size() || errno != 0) return std::nullopt;
+  return v;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return {};
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// --- reading the run outputs (flat, known documents written by app/simulate/command.cpp; no general parser) ---
+
+/// Position just after `"key":` (and spaces) at its first occurrence, or npos.
+std::size_t json_value_at(const std::string& text, const std::string& key, std::size_t from = 0) {
+  const std::string pat = json::quote(key);
+  for (std::size_t p = text.find(pat, from); p != std::string::npos; p = text.find(pat, p + 1)) {
+    std::size_t q = p + pat.size();
+    while (q < text.size() && std::isspace(static_cast<unsigned char>(text[q]))) ++q;
+    if (q < text.size() && text[q] == ':') {
+      ++q;
+      while (q < text.size() && std::isspace(static_cast<unsigned char>(text[q]))) ++q;
+      return q;
+    }
+  }
+  return std::string::npos;
+}
+
+std::optional<std::string> json_string(const std::string& text, const std::string& key) {
+  std::size_t p = json_value_at(text, key);
+  if (p == std::string::npos || text[p] != '"') return std::nullopt;
+  std::string out;
+  for (++p; p < text.size() && text[p] != '"'; ++p) {
+    if (text[p] != '\\' || p + 1 >= text.size()) {
+      out += text[p];
+      continue;
+    }
+    const char e = text[++p];
+    switch (e) {
+      case 'n': out += '\n'; break;
+      case 't': out += '\t'; break;
+      case 'r': out += '\r'; break;
+      case 'u': out += '?', p += 4; break;  // only control characters are escaped this way
+      default: out += e;
+    }
+  }
+  return out;
+}
+
+/// Every value of `key` in document order (null = NaN).
+std::vector<double> json_numbers(const std::string& text, const std::string& key) {
+  std::vector<double> out;
+  for (std::size_t p = json_value_at(text, key); p != std::string::npos; p = json_value_at(text, key, p)) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str() + p, &end);
+    out.push_back(end == text.c_str() + p ? kNaN : v);
+  }
+  return out;
+}
+
+double last_angle(const fs::path& angles_csv) {
+  std::ifstream in(angles_csv);
+  std::string line, last;
+  std::getline(in, line);  // header
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  double angle = kNaN;
+  int trial = 0;
+  double t = 0, p = 0;
+  if (!last.empty() && std::sscanf(last.c_str(), "%d,%lf,%lf,%lf", &trial, &t, &p, &angle) != 4) angle = kNaN;
+  return angle;
+}
+
+/// The last non-empty lines of a log, joined, at most `max_chars` (the reason a worker failed).
+std::string log_tail(const fs::path& log, std::size_t max_lines = 3, std::size_t max_chars = 400) {
+  std::vector<std::string> lines;
+  std::istringstream in(slurp(log));
+  for (std::string l; std::getline(in, l);) {
+    if (const auto cr = l.rfind('\r'); cr != std::string::npos) l = l.substr(cr + 1);  // progress lines
+    if (l.find_first_not_of(" \t") != std::string::npos) lines.push_back(l);
+  }
+  std::string s;
+  for (std::size_t i = lines.size() > max_lines ? lines.size() - max_lines : 0; i < lines.size(); ++i)
+    s += (s.empty() ? "" : " | ") + lines[i];
+  if (s.size() > max_chars) s = "..." + s.substr(s.size() - max_chars);
+  return s;
+}
+
+std::string point_name(int index) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%04d", index);
+  return buf;
+}
+
+/// Fills a point's outcome from its run directory. `exit_code` < 0: not run now (resume check).
+void read_point(SweepPoint& pt, const fs::path& dir, int exit_code, double measured_s) {
+  const std::string summary = slurp(dir / "summary.json");
+  const std::optional<std::string> status = json_string(summary, "status");
+  const std::vector<double> total = json_numbers(summary, "total_s");
+  pt.wall_s = !total.empty() && std::isfinite(total[0]) ? total[0] : measured_s;
+  pt.nrmse = json_numbers(slurp(dir / "metrics.json"), "nrmse");
+  pt.final_angle_deg = last_angle(dir / "angles.csv");
+  if (status && *status == "ok" && exit_code <= 0) {
+    pt.status = "ok";
+    pt.error.clear();
+    return;
+  }
+  pt.status = "failed";
+  if (status && *status != "ok") {
+    pt.error = *status;
+  } else {
+    const std::string tail = log_tail(dir / "log.txt");
+    pt.error = (exit_code >= 128 ? "killed by signal " + std::to_string(exit_code - 128)
+                                 : "exit code " + std::to_string(exit_code)) +
+               (tail.empty() ? "" : ": " + tail);
+  }
+}
+
+/// The worker's exit code (128 + signal when it was killed).
+int exit_code_of(int wait_status) {
+  if (WIFEXITED(wait_status)) return WEXITSTATUS(wait_status);
+  if (WIFSIGNALED(wait_status)) return 128 + WTERMSIG(wait_status);
+  return 1;
+}
+
+/// Starts `argv` with stdout and stderr going to `log`. The worker dies with the sweep (a killed
+/// sweep must not leave workers writing into directories the next invocation reruns).
+pid_t launch(const std::vector<std::string>& argv, const fs::path& log) {
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const std::string log_path = log.string();
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("sweep: cannot start a worker process (fork failed): " + std::string(strerror(errno)));
+  if (pid == 0) {
+    // Child: async-signal-safe calls only until exec.
+    const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, STDOUT_FILENO);
+      dup2(fd, STDERR_FILENO);
+      close(fd);
+    }
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(137);
+    execv(args[0], args.data());
+    const char msg[] = "sweep: cannot execute the pneufem binary\n";
+    (void)!write(STDERR_FILENO, msg, sizeof msg - 1);
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Holds DIR/.sweep.lock for the lifetime of the sweep: two sweeps must not share a directory.
+class DirLock {
+ public:
+  explicit DirLock(const fs::path& dir) {
+    const std::string path = (dir / ".sweep.lock").string();
+    fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError("--out " + dir.string() + ": cannot create " + path + " (is the directory writable?)");
+    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      close(fd_);
+      throw InputError("--out " + dir.string() +
+                       ": another pneufem sweep is running in this directory; wait for it or choose another --out");
+    }
+  }
+  ~DirLock() { close(fd_); }
+  DirLock(const DirLock&) = delete;
+  DirLock& operator=(const DirLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+std::string csv_num(double v, const char* fmt = nullptr) {
+  if (!std::isfinite(v)) return "";
+  if (!fmt) return json::num(v);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::string csv_quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += "\"\"";
+    else if (c == '\n' || c == '\r') out += ' ';
+    else out += c;
+  }
+  return out + "\"";
+}
+
+std::size_t max_trials(const std::vector<SweepPoint>& points) {
+  std::size_t k = 0;
+  for (const SweepPoint& p : points) k = std::max(k, p.nrmse.size());
+  return k;
+}
+
+double final_nrmse(const SweepPoint& p) { return p.nrmse.empty() ? kNaN : p.nrmse.back(); }
+
+std::string sweep_csv(const std::vector<ParamSpec>& params, const std::vector<SweepPoint>& points) {
+  const std::size_t K = max_trials(points);
+  std::string s = "point";
+  for (const ParamSpec& p : params) s += "," + (p.key.find_first_of(",\"") == std::string::npos ? p.key : csv_quote(p.key));
+  s += ",status,wall_s,final_nrmse";
+  for (std::size_t k = 1; k <= K; ++k) s += ",nrmse_trial_" + std::to_string(k);
+  s += ",final_angle_deg,error\n";
+  // Field by field (appending, not concatenating temporaries).
+  const auto field = [&s](const std::string& f) {
+    s += ',';
+    s += f;
+  };
+  for (const SweepPoint& pt : points) {
+    s += std::to_string(pt.index);
+    for (const std::string& t : pt.texts) field(t);
+    const bool done = pt.status != "pending";
+    field(pt.status);
+    field(done ? csv_num(pt.wall_s, "%.3f") : "");
+    field(csv_num(final_nrmse(pt)));
+    for (std::size_t k = 0; k < K; ++k) field(k < pt.nrmse.size() ? csv_num(pt.nrmse[k]) : "");
+    field(done ? csv_num(pt.final_angle_deg) : "");
+    field(pt.error.empty() ? "" : csv_quote(pt.error));
+    s += '\n';
+  }
+  return s;
+}
+
+/// A file-name friendly form of a scene key.
+std::string file_key(const std::string& key) {
+  std::string s = key;
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  return s;
+}
+
+/// Final-trial NRMSE (or, without metrics, the final angle) against parameter j.
+void write_plot(const fs::path& file, const std::vector<ParamSpec>& params, std::size_t j,
+                const std::vector<SweepPoint>& points) {
+  const ParamSpec& p = params[j];
+  const bool have_nrmse = std::any_of(points.begin(), points.end(), [](const SweepPoint& q) { return !q.nrmse.empty(); });
+  auto metric = [&](const SweepPoint& q) { return have_nrmse ? final_nrmse(q) : q.final_angle_deg; };
+  std::vector<std::pair<double, double>> ok;
+  std::vector<double> failed_x;
+  for (const SweepPoint& q : points) {
+    if (q.status == "ok" && std::isfinite(metric(q))) ok.emplace_back(q.values[j], metric(q));
+    if (q.status == "failed") failed_x.push_back(q.values[j]);
+  }
+  std::sort(ok.begin(), ok.end());
+  std::vector<double> x, y;
+  for (const auto& [a, b] : ok) x.push_back(a), y.push_back(b);
+
+  svg::Figure fig(640, 420);
+  svg::Axes& ax = fig.axes();
+  ax.title((have_nrmse ? "final-trial NRMSE vs " : "final angle vs ") + p.key)
+      .xlabel(p.key)
+      .ylabel(have_nrmse ? "NRMSE of the final trial (vs ideal elastic)" : "final bending angle (deg)")
+      .xlog(p.log);
+  // The x range is the swept range, whatever the outcome of its points.
+  const svg::Ticks xt = p.log ? svg::log_ticks(p.lo, p.hi, true) : svg::linear_ticks(p.lo, p.hi, 6, true);
+  ax.xlim(xt.lo, xt.hi);
+  double ylo = 0.0, yhi = 1.0;
+  if (!y.empty()) {
+    const auto [mn, mx] = std::minmax_element(y.begin(), y.end());
+    const svg::Ticks yt = svg::linear_ticks(have_nrmse ? std::min(0.0, *mn) : *mn, *mx, 5, true);
+    ylo = yt.lo, yhi = yt.hi;
+  }
+  ax.ylim(ylo, yhi);
+  svg::Style ok_style;
+  ok_style.color = "#0072B2";
+  ok_style.marker = svg::Marker::Circle;
+  if (params.size() == 1)
+    ax.line(x, y, "ok", ok_style);
+  else
+    ax.scatter(x, y, "ok (all other parameters)", ok_style);
+  if (!failed_x.empty()) {
+    svg::Style failed_style;
+    failed_style.color = "#D55E00";
+    failed_style.marker = svg::Marker::Cross;
+    failed_style.marker_size = 5.0;
+    ax.scatter(failed_x, std::vector<double>(failed_x.size(), ylo), "failed", failed_style);
+  }
+  if (x.empty()) ax.note(failed_x.empty() ? "no finished points yet" : "no point succeeded");
+  fig.save(file.string());
+}
+
+std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& params, const SweepResult& r,
+                       const std::vector<std::string>& plots) {
+  json::Object head;
+  std::string ps = "[";
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    json::Object q;
+    q.add_str("key", params[j].key).add_str("spec", params[j].text).add("lo", params[j].lo).add("hi", params[j].hi);
+    q.add("n", o.lhs > 0 ? json::num(o.lhs) : json::num(params[j].n)).add("log", params[j].log ? "true" : "false");
+    q.add("integer", params[j].integer ? "true" : "false");
+    ps += (j ? ", " : "") + q.str(4);
+  }
+  ps += "]";
+  std::string sets = "[";
+  for (std::size_t i = 0; i < o.sets.size(); ++i) sets += (i ? ", " : "") + json::quote(o.sets[i]);
+  sets += "]";
+  const bool have_nrmse = std::any_of(r.points.begin(), r.points.end(), [](const SweepPoint& q) { return !q.nrmse.empty(); });
+  const SweepPoint* best = nullptr;
+  for (const SweepPoint& q : r.points)
+    if (q.status == "ok" && std::isfinite(final_nrmse(q)) && (!best || final_nrmse(q) < final_nrmse(*best))) best = &q;
+  std::string pts = "[";
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    const SweepPoint& q = r.points[i];
+    json::Object values;
+    for (std::size_t j = 0; j < params.size(); ++j) values.add(params[j].key, q.values[j]);
+    json::Object e;
+    e.add("point", q.index)
+        .add_str("dir", "points/" + point_name(q.index))
+        .add("values", values.str(6))
+        .add_str("status", q.status)
+        .add("skipped", q.skipped ? "true" : "false")
+        .add("wall_s", q.status == "pending" ? kNaN : q.wall_s)
+        .add("final_nrmse", final_nrmse(q))
+        .add("nrmse_trials", json::array(q.nrmse))
+        .add("final_angle_deg", q.final_angle_deg)
+        .add_str("error", q.error);
+    pts += (i ? ",\n    " : "\n    ") + e.str(4);
+  }
+  pts += "\n  ]";
+  std::string plot_list = "[";
+  for (std::size_t i = 0; i < plots.size(); ++i) plot_list += (i ? ", " : "") + json::quote(plots[i]);
+  plot_list += "]";
+  head.add_str("pneufem_version", version_string())
+      .add_str("command_line", o.command_line)
+      .add_str("scene", o.scene_path.empty() ? "(built-in default)" : o.scene_path)
+      .add_str("mode", o.lhs > 0 ? "lhs" : "grid")
+      .add("seed", o.lhs > 0 ? json::num(static_cast<double>(o.seed)) : "null")
+      .add("params", ps)
+      .add("sets", sets)
+      .add("jobs", o.jobs)
+      .add("threads_per_job", o.threads_per_job)
+      .add("points_total", static_cast<double>(r.points.size()))
+      .add("ok", r.ok)
+      .add("failed", r.failed)
+      .add("skipped", r.skipped)
+      .add("wall_s", r.wall_s)
+      .add_str("metric", have_nrmse ? "final_nrmse" : "final_angle_deg")
+      .add("best_point", best ? json::num(best->index) : "null")
+      .add("plots", plot_list)
+      .add("points", pts);
+  return head.str() + "\n";
+}
+
+void say(std::FILE* log, const std::string& line) {
+  if (!log) return;
+  std::fprintf(log, "%s\n", line.c_str());
+  std::fflush(log);
+}
+
+std::string describe(const std::vector<ParamSpec>& params, const SweepPoint& pt) {
+  std::string s;
+  for (std::size_t j = 0; j < params.size(); ++j) s += (j ? " " : "") + params[j].key + "=" + pt.texts[j];
+  return s;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+ParamSpec parse_param_spec(const std::string& text) {
+  ParamSpec p;
+  p.text = text;
+  const auto fail = [&](const std::string& why) { throw InputError("--param " + text + ": " + why); };
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) fail(kParamForm);
+  p.key = text.substr(0, eq);
+  if (p.key.find_first_of(" \t\"'[]") != std::string::npos) fail("'" + p.key + "' is not a scene key; " + kParamForm);
+  std::vector<std::string> f;
+  std::stringstream ss(text.substr(eq + 1));
+  for (std::string t; std::getline(ss, t, ':');) f.push_back(t);
+  if (!text.empty() && text.back() == ':') f.emplace_back();
+  if (f.size() < 2 || f.size() > 4) fail(kParamForm);
+  const std::optional<double> lo = parse_double(f[0]), hi = parse_double(f[1]);
+  if (!lo) fail("LO '" + f[0] + "' is not a number; " + kParamForm);
+  if (!hi) fail("HI '" + f[1] + "' is not a number; " + kParamForm);
+  p.lo = *lo;
+  p.hi = *hi;
+  std::size_t next = 2;
+  if (f.size() > 2 && f[2] != "log" && f[2] != "lin") {
+    const std::optional<long long> n = parse_int(f[2]);
+    if (!n) fail("N '" + f[2] + "' is not a whole number; " + kParamForm);
+    if (*n < 1) fail("N must be at least 1 (the number of values), got " + f[2]);
+    if (*n > static_cast<long long>(kMaxPoints)) fail("N = " + f[2] + " is too many values");
+    p.n = static_cast<int>(*n);
+    next = 3;
+  }
+  if (next < f.size()) {
+    if (f[next] != "log" && f[next] != "lin") fail("the spacing '" + f[next] + "' must be 'log' or 'lin'; " + kParamForm);
+    p.log = f[next] == "log";
+    if (++next < f.size()) fail(kParamForm);
+  }
+  if (p.lo > p.hi) fail("LO (" + f[0] + ") is greater than HI (" + f[1] + "); give the range as LO:HI");
+  if (p.log && p.lo <= 0.0) fail("a log range needs LO > 0, got " + f[0] + " (use linear spacing, or a positive LO)");
+  return p;
+}
+
+std::vector<double> grid_values(const ParamSpec& p) {
+  const int n = std::max(1, p.n);
+  std::vector<double> v;
+  for (int i = 0; i < n; ++i) {
+    double x = p.lo;
+    if (i == n - 1 && n > 1) {
+      x = p.hi;
+    } else if (i > 0) {
+      const double t = static_cast<double>(i) / (n - 1);
+      x = p.log ? std::pow(10.0, std::log10(p.lo) + t * (std::log10(p.hi) - std::log10(p.lo))) : p.lo + t * (p.hi - p.lo);
+    }
+    if (p.integer) x = std::round(x);
+    if (v.empty() || x != v.back()) v.push_back(x);
+  }
+  return v;
+}
+
+std::vector<std::vector<double>> grid_points(const std::vector<ParamSpec>& params) {
+  std::vector<std::vector<double>> axes;
+  std::size_t total = 1;
+  for (const ParamSpec& p : params) {
+    if (p.n < 1)
+      throw InputError("--param " + p.text + ": give the number of values N (KEY=LO:HI:N), or sample with --lhs");
+    axes.push_back(grid_values(p));
+    total *= axes.back().size();
+    if (total > kMaxPoints)
+      throw InputError("--param: the grid has more than " + std::to_string(kMaxPoints) +
+                       " points; use fewer values or --lhs N");
+  }
+  std::vector<std::vector<double>> points;
+  if (params.empty()) return points;
+  std::vector<std::size_t> idx(params.size(), 0);
+  for (std::size_t k = 0; k < total; ++k) {
+    std::vector<double> pt(params.size());
+    for (std::size_t j = 0; j < params.size(); ++j) pt[j] = axes[j][idx[j]];
+    points.push_back(pt);
+    for (std::size_t j = params.size(); j-- > 0;) {
+      if (++idx[j] < axes[j].size()) break;
+      idx[j] = 0;
+    }
+  }
+  return points;
+}
+
+std::vector<std::vector<double>> lhs_points(const std::vector<ParamSpec>& params, int n, std::uint64_t seed) {
+  if (n < 1) throw InputError("--lhs " + std::to_string(n) + ": the number of samples must be at least 1");
+  if (static_cast<std::size_t>(n) > kMaxPoints) throw InputError("--lhs " + std::to_string(n) + ": too many samples");
+  std::mt19937_64 rng(seed);
+  const auto uniform01 = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };  // [0, 1)
+  std::vector<std::vector<double>> points(n, std::vector<double>(params.size()));
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    const ParamSpec& p = params[j];
+    std::vector<int> perm(n);
+    for (int i = 0; i < n; ++i) perm[i] = i;
+    for (int i = n - 1; i > 0; --i) std::swap(perm[i], perm[rng() % static_cast<std::uint64_t>(i + 1)]);  // Fisher-Yates
+    for (int i = 0; i < n; ++i) {
+      const double u = (perm[i] + uniform01()) / n;
+      double x = p.log ? std::pow(10.0, std::log10(p.lo) + u * (std::log10(p.hi) - std::log10(p.lo))) : p.lo + u * (p.hi - p.lo);
+      if (p.integer) x = std::round(x);
+      points[i][j] = x;
+    }
+  }
+  return points;
+}
+
+std::string format_value(double v, bool integer) {
+  if (integer) return std::to_string(std::llround(v));
+  std::string s = json::num(v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+SweepResult run_sweep(const SweepOptions& o) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (o.params.empty())
+    throw InputError("--param: give at least one parameter to sweep, e.g. --param materials.silicone.fatigue.tau_s=100:1000:5:log");
+  if (o.jobs < 0) throw InputError("--jobs " + std::to_string(o.jobs) + ": the number of worker processes must be at least 1");
+  if (o.threads_per_job < 1)
+    throw InputError("--threads-per-job " + std::to_string(o.threads_per_job) + ": must be at least 1");
+  if (o.lhs < 0) throw InputError("--lhs " + std::to_string(o.lhs) + ": the number of samples must be at least 1");
+  if (o.out_dir.empty() && !o.dry_run) throw InputError("--out DIR is required");
+
+  // The parameters, checked against the scene: existing numeric keys, each once.
+  const Scene base = Scene::load(o.scene_path, o.sets);
+  std::vector<ParamSpec> params;
+  for (const std::string& text : o.params) {
+    ParamSpec p = parse_param_spec(text);
+    for (const ParamSpec& q : params)
+      if (q.key == p.key) throw InputError("--param " + text + ": the key '" + p.key + "' is already swept by --param " + q.text);
+    if (!base.has(p.key))
+      throw InputError("--param " + text + ": unknown scene key '" + p.key +
+                       "' (`pneufem scene --defaults` lists every key; a material's keys are materials.NAME.KEY)");
+    try {
+      base.number(p.key);
+    } catch (const InputError&) {
+      throw InputError("--param " + text + ": the scene key '" + p.key + "' is not a number; only numeric keys can be swept");
+    }
+    try {
+      base.integer(p.key);
+      p.integer = true;
+    } catch (const InputError&) {
+    }
+    params.push_back(p);
+  }
+  const std::vector<std::vector<double>> values = o.lhs > 0 ? lhs_points(params, o.lhs, o.seed) : grid_points(params);
+
+  // Each point's resolved scene: what the worker will run, and the key of the resume check.
+  SweepResult result;
+  std::vector<std::string> scene_text;
+  std::vector<std::vector<std::string>> overrides;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    SweepPoint pt;
+    pt.index = static_cast<int>(i) + 1;
+    pt.values = values[i];
+    pt.final_angle_deg = kNaN;
+    std::vector<std::string> ov;
+    for (std::size_t j = 0; j < params.size(); ++j) {
+      pt.texts.push_back(format_value(values[i][j], params[j].integer));
+      ov.push_back(params[j].key + "=" + pt.texts[j]);
+    }
+    ov.emplace_back("output.vtu=\"none\"");
+    try {
+      scene_text.push_back(base.with(ov).to_toml());
+    } catch (const InputError& e) {
+      std::string which;
+      for (const ParamSpec& p : params) which += (which.empty() ? "" : ", ") + p.text;
+      throw InputError("--param " + which + ": point " + std::to_string(pt.index) + ": " + e.what());
+    }
+    overrides.push_back(ov);
+    result.points.push_back(pt);
+  }
+
+  const int jobs = o.jobs > 0 ? o.jobs : std::max(1, tbb::info::default_concurrency());
+  if (o.dry_run) {
+    say(o.log, std::to_string(result.points.size()) + " points (" + (o.lhs > 0 ? "Latin hypercube" : "grid") + "), " +
+                   std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s):");
+    for (const SweepPoint& pt : result.points) say(o.log, "  " + point_name(pt.index) + "  " + describe(params, pt));
+    return result;
+  }
+  if (o.exe.empty()) throw std::logic_error("run_sweep: SweepOptions::exe (the pneufem binary) is not set");
+
+  const fs::path out(o.out_dir);
+  fs::create_directories(out / "points");
+  if (!fs::is_directory(out)) throw InputError("--out " + o.out_dir + ": cannot create the directory");
+  const DirLock lock(out);
+  const std::string scene_abs = o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string();
+
+  // Resume: points already done by an earlier invocation with the same resolved scene.
+  std::vector<std::size_t> queue;
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    SweepPoint& pt = result.points[i];
+    const fs::path dir = out / "points" / point_name(pt.index);
+    const std::optional<std::string> status = json_string(slurp(dir / "summary.json"), "status");
+    if (status && *status == "ok" && slurp(dir / "scene.toml") == scene_text[i]) {
+      read_point(pt, dir, -1, 0.0);
+      pt.skipped = true;
+      ++result.ok;
+      ++result.skipped;
+      say(o.log, "point " + point_name(pt.index) + " skipped (already done): " + describe(params, pt));
+    } else {
+      queue.push_back(i);
+    }
+  }
+  const fs::path csv = out / "sweep.csv";
+  write_file_atomic(csv.string(), sweep_csv(params, result.points));
+  say(o.log, std::to_string(result.points.size()) + " points, " + std::to_string(queue.size()) + " to run with " +
+                 std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s)");
+
+  struct Running {
+    pid_t pid;
+    std::size_t i;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::vector<Running> running;
+  std::size_t next = 0;
+  int finished = result.skipped;
+  const int total = static_cast<int>(result.points.size());
+  while (next < queue.size() || !running.empty()) {
+    while (next < queue.size() && static_cast<int>(running.size()) < jobs) {
+      const std::size_t i = queue[next++];
+      const fs::path dir = out / "points" / point_name(result.points[i].index);
+      fs::remove_all(dir);  // an interrupted, failed or changed point starts clean
+      fs::create_directories(dir);
+      std::vector<std::string> argv = {o.exe, "simulate"};
+      if (!scene_abs.empty()) argv.push_back(scene_abs);
+      // The points share one ideal elastic model per actuator (app/simulate/ideal_cache.h): a sweep over
+      // damage constants computes it once instead of once per point.
+      for (const std::string& a : {std::string("--out"), dir.string(), std::string("--threads"),
+                                   std::to_string(o.threads_per_job), std::string("--ideal-cache"),
+                                   (out / "ideal_cache").string()})
+        argv.push_back(a);
+      for (const std::string& s : o.sets) argv.insert(argv.end(), {"--set", s});
+      for (const std::string& s : overrides[i]) argv.insert(argv.end(), {"--set", s});
+      running.push_back({launch(argv, dir / "log.txt"), i, std::chrono::steady_clock::now()});
+    }
+    bool any = false;
+    for (std::size_t r = 0; r < running.size();) {
+      int st = 0;
+      const pid_t w = waitpid(running[r].pid, &st, WNOHANG);
+      if (w == 0 || (w < 0 && errno == EINTR)) {
+        ++r;
+        continue;
+      }
+      any = true;
+      const Running done = running[r];
+      running.erase(running.begin() + static_cast<std::ptrdiff_t>(r));
+      SweepPoint& pt = result.points[done.i];
+      const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - done.start).count();
+      read_point(pt, out / "points" / point_name(pt.index), w < 0 ? 1 : exit_code_of(st), measured);
+      (pt.status == "ok" ? result.ok : result.failed)++;
+      ++finished;
+      char head[64];
+      std::snprintf(head, sizeof head, "[%d/%d] point %s ", finished, total, point_name(pt.index).c_str());
+      std::string line = head + describe(params, pt) + ": " + pt.status;
+      char tail[96];
+      std::snprintf(tail, sizeof tail, ", %.1f s", pt.wall_s);
+      line += tail;
+      if (!pt.nrmse.empty()) {
+        std::snprintf(tail, sizeof tail, ", final NRMSE %.4g", pt.nrmse.back());
+        line += tail;
+      }
+      if (!pt.error.empty()) line += ": " + pt.error;
+      say(o.log, line);
+      write_file_atomic(csv.string(), sweep_csv(params, result.points));
+    }
+    if (!any && !running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+
+  std::vector<std::string> plots;
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    const std::string name = "sweep_" + file_key(params[j].key) + ".svg";
+    write_plot(out / name, params, j, result.points);
+    plots.push_back(name);
+  }
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  SweepOptions recorded = o;
+  recorded.jobs = jobs;
+  write_file_atomic((out / "sweep.json").string(), sweep_json(recorded, params, result, plots));
+  return result;
+}
+
+}  // namespace pneufem
