@@ -1,0 +1,62 @@
+#include "app/sweep/cli.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "core/errors.h"
+
+namespace pneufem {
+
+namespace fs = std::filesystem;
+
+std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app) {
+  auto c = std::make_unique<SweepCommand>();
+  SweepOptions& sweep = c->options;
+  CLI::App* sw = c->cmd = app.add_subcommand(
+      "sweep", "Run a scene over a grid or Latin hypercube of scene-key values, one worker process per point; "
+               "tabulate the metrics (sweep.csv) and plot them (sweep_<key>.svg). Re-running continues a sweep");
+  sw->add_option("scene", sweep.scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
+      ->check(CLI::ExistingFile);
+  sw->add_option("--param", sweep.params,
+                 "KEY=LO:HI:N[:log]: sweep a numeric scene key over N values from LO to HI, evenly or log spaced, "
+                 "e.g. materials.silicone.fatigue.tau_s=100:1000:5:log (repeatable; the grid is their product)")
+      ->required()
+      ->check(CLI::Validator(
+          [](std::string& spec) {
+            try {
+              parse_param_spec(spec);
+              return std::string();
+            } catch (const InputError& e) {
+              return std::string(e.what()).substr(8);  // CLI11 adds the "--param: " itself
+            }
+          },
+          "KEY=LO:HI:N[:log]"));
+  sw->add_option("--lhs", sweep.lhs, "Latin-hypercube design of N samples over the --param ranges instead of the grid "
+                                     "(each --param's N is then ignored and may be left out)")
+      ->check(CLI::Range(1, 100000));
+  sw->add_option("--seed", sweep.seed, "Random seed of --lhs (same seed, same samples)")->capture_default_str();
+  sw->add_option("--out", sweep.out_dir, "Sweep directory: points/NNNN/, sweep.csv, sweep_<key>.svg, sweep.json")
+      ->required();
+  sw->add_option("--jobs", sweep.jobs, "Worker processes at a time (default: number of cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
+  sw->add_option("--threads-per-job", sweep.threads_per_job, "Threads of each worker process")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  sw->add_option("--set", sweep.sets, "Override a scene key at every point, e.g. --set load.trials=10 (repeatable)");
+  sw->add_flag("--dry-run", sweep.dry_run, "List the points and exit without running them");
+  return c;
+}
+
+int run_sweep_command(SweepCommand& c, const std::string& command_line) {
+  SweepOptions& sweep = c.options;
+  sweep.exe = fs::read_symlink("/proc/self/exe").string();
+  sweep.command_line = command_line;
+  const SweepResult r = run_sweep(sweep);
+  if (sweep.dry_run) return 0;
+  std::printf("sweep: %zu points, %d ok (%d skipped), %d failed, %.1f s; table %s\n", r.points.size(), r.ok, r.skipped,
+              r.failed, r.wall_s, (fs::path(sweep.out_dir) / "sweep.csv").c_str());
+  if (r.failed > 0) std::fprintf(stderr, "error: %d of %zu points failed (their errors are in sweep.csv)\n", r.failed, r.points.size());
+  return r.failed > 0 ? 1 : 0;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,26 @@
+#pragma once
+// CLI registration of `pneufem sweep` (app/sweep/command.h). Exit codes: 0 every point ran, 1 some
+// point failed (its error is in sweep.csv), 2 bad input (main's handler).
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "app/sweep/command.h"
+
+namespace pneufem {
+
+struct SweepCommand {
+  CLI::App* cmd = nullptr;
+  SweepOptions options;
+};
+
+/// Adds `sweep [SCENE.toml] --param KEY=LO:HI:N[:log] ... --out DIR [--lhs N] [--seed S] [--jobs N]
+/// [--threads-per-job N] [--set k=v ...] [--dry-run]` to `app`; --param is validated at parse time.
+std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app);
+
+/// Runs a parsed sweep command (its workers are this executable) and prints a one-line summary;
+/// returns the exit code.
+int run_sweep_command(SweepCommand& c, const std::string& command_line);
+
+}  // namespace pneufem
