@@ -1,5 +1,5 @@
 #pragma once
-// Minimal JSON writing helpers for the run outputs.
+// Minimal JSON writing helpers for the run outputs (read back with nlohmann/json, a parser).
 #include <cmath>
 #include <cstdio>
 #include <map>

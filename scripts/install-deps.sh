@@ -6,7 +6,7 @@ PKGS=(
   libeigen3-dev libtbb-dev libcli11-dev libtomlplusplus-dev
   libvtk9-dev libopenvdb-dev libboost-iostreams-dev
   libsuitesparse-dev libopenblas-dev libnlopt-cxx-dev
-  libgtest-dev libgmock-dev
+  libgtest-dev libgmock-dev nlohmann-json3-dev
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -1,13 +1,14 @@
 #include "app/compare/history.h"
 
 #include <cmath>
-#include <cstdlib>
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/json_writer.h"
@@ -44,44 +45,22 @@ std::string history_line(const HistoryEntry& e) {
          ", \"trial_nrmse\": " + json::array(e.trial_nrmse) + ", \"source\": " + json::quote(e.source) + "}";
 }
 
-/// Value of a top-level string field of one of our own JSON lines ("" when absent).
-std::string string_field(const std::string& line, const std::string& key) {
-  const std::string k = "\"" + key + "\": \"";
-  const std::size_t p = line.find(k);
-  if (p == std::string::npos) return "";
-  std::string out;
-  for (std::size_t i = p + k.size(); i < line.size() && line[i] != '"'; ++i) {
-    if (line[i] == '\\' && i + 1 < line.size()) ++i;
-    out += line[i];
+/// A number of a history line: JSON has no NaN, so json::num wrote a non-finite value as null.
+bool read_number(const nlohmann::json& v, double& out) {
+  if (v.is_number()) {
+    out = v.get<double>();
+    return true;
   }
-  return out;
+  if (v.is_null()) {
+    out = std::nan("");
+    return true;
+  }
+  return false;
 }
 
-/// Numbers after "key": (a number or an array of numbers; null -> NaN).
-std::vector<double> number_field(const std::string& line, const std::string& key) {
-  const std::string k = "\"" + key + "\": ";
-  const std::size_t p = line.find(k);
-  std::vector<double> out;
-  if (p == std::string::npos) return out;
-  std::size_t i = p + k.size();
-  const bool array = i < line.size() && line[i] == '[';
-  if (array) ++i;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == ',')) ++i;
-    if (i >= line.size() || line[i] == ']' || line[i] == '}') break;
-    if (line.compare(i, 4, "null") == 0) {
-      out.push_back(std::nan(""));
-      i += 4;
-    } else {
-      char* end = nullptr;
-      const double v = std::strtod(line.c_str() + i, &end);
-      if (end == line.c_str() + i) break;
-      out.push_back(v);
-      i = static_cast<std::size_t>(end - line.c_str());
-    }
-    if (!array) break;
-  }
-  return out;
+std::string string_member(const nlohmann::json& line, const char* key) {
+  const auto it = line.find(key);
+  return it != line.end() && it->is_string() ? it->get<std::string>() : std::string();
 }
 
 }  // namespace
@@ -105,15 +84,21 @@ std::vector<HistoryEntry> read_history(const std::string& dir) {
   std::vector<HistoryEntry> out;
   std::ifstream in(fs::path(dir) / "history.jsonl");
   for (std::string line; std::getline(in, line);) {
-    const std::vector<double> n = number_field(line, "nrmse");
-    if (n.size() != 1) continue;
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object()) continue;  // a damaged or foreign line
     HistoryEntry e;
-    e.time_utc = string_field(line, "time_utc");
-    e.label = string_field(line, "label");
-    e.scene_hash = string_field(line, "scene_hash");
-    e.source = string_field(line, "source");
-    e.nrmse = n[0];
-    e.trial_nrmse = number_field(line, "trial_nrmse");
+    const auto nrmse = j.find("nrmse");
+    if (nrmse == j.end() || !read_number(*nrmse, e.nrmse)) continue;
+    e.time_utc = string_member(j, "time_utc");
+    e.label = string_member(j, "label");
+    e.scene_hash = string_member(j, "scene_hash");
+    e.source = string_member(j, "source");
+    if (const auto trials = j.find("trial_nrmse"); trials != j.end() && trials->is_array())
+      for (const nlohmann::json& v : *trials) {
+        double x = 0.0;
+        if (!read_number(v, x)) break;
+        e.trial_nrmse.push_back(x);
+      }
     out.push_back(e);
   }
   return out;

@@ -22,6 +22,7 @@
 #include <sstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
 #include <tbb/info.h>
 
 #include "core/json_writer.h"
@@ -67,53 +68,30 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// --- reading the run outputs (flat, known documents written by app/simulate/command.cpp; no general parser) ---
+// --- reading the run outputs (summary.json and metrics.json of a point's run directory) ---
 
-/// Position just after `"key":` (and spaces) at its first occurrence, or npos.
-std::size_t json_value_at(const std::string& text, const std::string& key, std::size_t from = 0) {
-  const std::string pat = json::quote(key);
-  for (std::size_t p = text.find(pat, from); p != std::string::npos; p = text.find(pat, p + 1)) {
-    std::size_t q = p + pat.size();
-    while (q < text.size() && std::isspace(static_cast<unsigned char>(text[q]))) ++q;
-    if (q < text.size() && text[q] == ':') {
-      ++q;
-      while (q < text.size() && std::isspace(static_cast<unsigned char>(text[q]))) ++q;
-      return q;
-    }
-  }
-  return std::string::npos;
+/// The JSON document in file `p`; null when the file is missing or is not valid JSON.
+nlohmann::json read_json(const fs::path& p) {
+  nlohmann::json j = nlohmann::json::parse(slurp(p), nullptr, /*allow_exceptions=*/false);
+  return j.is_discarded() ? nlohmann::json() : j;
 }
 
-std::optional<std::string> json_string(const std::string& text, const std::string& key) {
-  std::size_t p = json_value_at(text, key);
-  if (p == std::string::npos || text[p] != '"') return std::nullopt;
-  std::string out;
-  for (++p; p < text.size() && text[p] != '"'; ++p) {
-    if (text[p] != '\\' || p + 1 >= text.size()) {
-      out += text[p];
-      continue;
-    }
-    const char e = text[++p];
-    switch (e) {
-      case 'n': out += '\n'; break;
-      case 't': out += '\t'; break;
-      case 'r': out += '\r'; break;
-      case 'u': out += '?', p += 4; break;  // only control characters are escaped this way
-      default: out += e;
-    }
-  }
-  return out;
+/// The member `key` of `object`, or null when `object` is not an object or lacks it.
+const nlohmann::json& member(const nlohmann::json& object, const char* key) {
+  static const nlohmann::json kNull;
+  if (!object.is_object()) return kNull;
+  const auto it = object.find(key);
+  return it == object.end() ? kNull : *it;
 }
 
-/// Every value of `key` in document order (null = NaN).
-std::vector<double> json_numbers(const std::string& text, const std::string& key) {
-  std::vector<double> out;
-  for (std::size_t p = json_value_at(text, key); p != std::string::npos; p = json_value_at(text, key, p)) {
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str() + p, &end);
-    out.push_back(end == text.c_str() + p ? kNaN : v);
-  }
-  return out;
+/// A number of a run output; json::num writes a non-finite one as null, read back as NaN.
+double number_or_nan(const nlohmann::json& v) { return v.is_number() ? v.get<double>() : kNaN; }
+
+/// summary.json's "status" ("ok" or the error that stopped the run), when it has one.
+std::optional<std::string> run_status(const nlohmann::json& summary) {
+  const nlohmann::json& status = member(summary, "status");
+  if (!status.is_string()) return std::nullopt;
+  return status.get<std::string>();
 }
 
 double last_angle(const fs::path& angles_csv) {
@@ -152,11 +130,15 @@ std::string point_name(int index) {
 
 /// Fills a point's outcome from its run directory. `exit_code` < 0: not run now (resume check).
 void read_point(SweepPoint& pt, const fs::path& dir, int exit_code, double measured_s) {
-  const std::string summary = slurp(dir / "summary.json");
-  const std::optional<std::string> status = json_string(summary, "status");
-  const std::vector<double> total = json_numbers(summary, "total_s");
-  pt.wall_s = !total.empty() && std::isfinite(total[0]) ? total[0] : measured_s;
-  pt.nrmse = json_numbers(slurp(dir / "metrics.json"), "nrmse");
+  const nlohmann::json summary = read_json(dir / "summary.json");
+  const std::optional<std::string> status = run_status(summary);
+  const double total_s = number_or_nan(member(member(summary, "timings"), "total_s"));
+  pt.wall_s = std::isfinite(total_s) ? total_s : measured_s;
+  pt.nrmse.clear();  // metrics.json (analysis/paper_metrics.h): {"trials": [{"trial", "nrmse", ...}], ...}
+  const nlohmann::json metrics = read_json(dir / "metrics.json");
+  const nlohmann::json& trials = member(metrics, "trials");
+  if (trials.is_array())
+    for (const nlohmann::json& t : trials) pt.nrmse.push_back(number_or_nan(member(t, "nrmse")));
   pt.final_angle_deg = last_angle(dir / "angles.csv");
   if (status && *status == "ok" && exit_code <= 0) {
     pt.status = "ok";
@@ -610,7 +592,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   for (std::size_t i = 0; i < result.points.size(); ++i) {
     SweepPoint& pt = result.points[i];
     const fs::path dir = out / "points" / point_name(pt.index);
-    const std::optional<std::string> status = json_string(slurp(dir / "summary.json"), "status");
+    const std::optional<std::string> status = run_status(read_json(dir / "summary.json"));
     if (status && *status == "ok" && slurp(dir / "scene.toml") == scene_text[i]) {
       read_point(pt, dir, -1, 0.0);
       pt.skipped = true;
