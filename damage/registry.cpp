@@ -5,8 +5,8 @@
 #include <set>
 #include <sstream>
 
-#include "damage/effects.h"
 #include "core/errors.h"
+#include "damage/effects.h"
 
 namespace pneufem {
 

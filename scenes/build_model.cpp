@@ -17,12 +17,12 @@
 #include "materials/hyperelastic.h"
 #include "materials/scaled.h"
 #include "scenes/angle_frame.h"
-#include "scenes/inp/deck.h"
 #include "scenes/inp/assembly.h"
+#include "scenes/inp/deck.h"
+#include "scenes/inp/solid_split.h"
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
 #include "scenes/scene_keys.h"
-#include "scenes/inp/solid_split.h"
 
 namespace pneufem {
 

@@ -8,9 +8,9 @@
 #include <optional>
 #include <set>
 
+#include "core/errors.h"
 #include "damage/effects.h"
 #include "damage/registry.h"
-#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
 #include "materials/scaled.h"

@@ -10,10 +10,10 @@
 
 #include "app/compare/dlc_map.h"
 #include "app/compare/report.h"
-#include "core/json_writer.h"
 #include "core/atomic_file.h"
-#include "core/version.h"
 #include "core/errors.h"
+#include "core/json_writer.h"
+#include "core/version.h"
 
 namespace pneufem {
 

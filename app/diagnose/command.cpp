@@ -18,13 +18,13 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include "analysis/model_vs_measured.h"
 #include "analysis/measurements.h"
+#include "analysis/model_vs_measured.h"
 #include "app/diagnose/detail.h"
-#include "app/diagnose/evaluator.h"
-#include "app/simulate/drive.h"
 #include "app/diagnose/effect_catalog.h"
 #include "app/diagnose/elastic_curve.h"
+#include "app/diagnose/evaluator.h"
+#include "app/simulate/drive.h"
 #include "core/errors.h"
 #include "scenes/build_model.h"
 

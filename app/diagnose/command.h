@@ -48,8 +48,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/model_vs_measured.h"
 #include "analysis/measurements.h"
+#include "analysis/model_vs_measured.h"
 #include "app/diagnose/effect_catalog.h"
 #include "scenes/scene.h"
 

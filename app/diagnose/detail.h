@@ -19,8 +19,8 @@
 #include <utility>
 #include <vector>
 
-#include "analysis/model_vs_measured.h"
 #include "analysis/measurements.h"
+#include "analysis/model_vs_measured.h"
 #include "app/diagnose/command.h"
 #include "app/diagnose/effect_catalog.h"
 #include "scenes/scene.h"

@@ -7,8 +7,8 @@
 #include <memory>
 #include <mutex>
 
-#include "damage/registry.h"
 #include "core/errors.h"
+#include "damage/registry.h"
 
 namespace pneufem {
 

@@ -12,8 +12,8 @@
 #include <tbb/parallel_invoke.h>
 
 #include "app/diagnose/detail.h"
-#include "app/simulate/drive.h"
 #include "app/diagnose/elastic_curve.h"
+#include "app/simulate/drive.h"
 #include "app/simulate/result_cache.h"
 #include "core/errors.h"
 #include "scenes/pressure_lag.h"

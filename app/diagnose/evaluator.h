@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/model_vs_measured.h"
 #include "analysis/measurements.h"
+#include "analysis/model_vs_measured.h"
 #include "engine/load_history.h"
 #include "engine/path_model.h"
 #include "scenes/build_model.h"

@@ -10,8 +10,8 @@
 #include "app/compare/history.h"
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
-#include "core/json_writer.h"
 #include "core/atomic_file.h"
+#include "core/json_writer.h"
 #include "core/version.h"
 
 namespace fs = std::filesystem;

@@ -12,14 +12,14 @@
 
 #include "analysis/paper_metrics.h"
 #include "app/simulate/ideal_cache.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
 #include "core/json_writer.h"
 #include "core/version.h"
-#include "core/atomic_file.h"
 #include "damage/registry.h"
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/explicit.h"
-#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "viz/vtk_output.h"
 

@@ -14,9 +14,9 @@
 
 #include "analysis/hampel.h"
 #include "analysis/steps.h"
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
-#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
 #include "viz/vtk_output.h"

@@ -13,9 +13,9 @@
 
 #include <tbb/task_arena.h>
 
-#include "core/version.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/version.h"
 
 namespace pneufem {
 

@@ -25,10 +25,10 @@
 #include <nlohmann/json.hpp>
 #include <tbb/info.h>
 
-#include "core/json_writer.h"
 #include "core/atomic_file.h"
-#include "core/version.h"
 #include "core/errors.h"
+#include "core/json_writer.h"
+#include "core/version.h"
 #include "scenes/scene.h"
 #include "viz/svg_plot.h"
 

@@ -12,11 +12,11 @@
 #include <tbb/info.h>
 
 #include "app/diagnose/effect_catalog.h"
-#include "core/json_writer.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/json_writer.h"
 #include "core/version.h"
 #include "engine/assembly.h"
-#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
 

@@ -23,10 +23,10 @@
 #include <vector>
 
 #include "core/errors.h"
-#include "scenes/inp/deck.h"
 #include "scenes/inp/assembly.h"
-#include "scenes/inp/text.h"
+#include "scenes/inp/deck.h"
 #include "scenes/inp/solid_split.h"
+#include "scenes/inp/text.h"
 
 namespace pneufem::inp {
 

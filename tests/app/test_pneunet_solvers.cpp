@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
-#include "core/errors.h"
 #include "engine/static_solver.h"
 #include "scenes/build_model.h"
 #include "tests/engine/test_meshes.h"

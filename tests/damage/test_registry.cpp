@@ -10,10 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "damage/effects.h"
 #include "damage/registry.h"
 #include "engine/quasi_static.h"
-#include "core/errors.h"
 #include "materials/hyperelastic.h"
 #include "scenes/build_model.h"
 

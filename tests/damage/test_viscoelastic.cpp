@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "damage/effects.h"
 #include "damage/material_point.h"
-#include "core/errors.h"
 #include "materials/hyperelastic.h"
 
 namespace pneufem {

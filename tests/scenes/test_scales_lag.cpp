@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/quasi_static.h"
 #include "core/errors.h"
+#include "engine/quasi_static.h"
 #include "materials/hyperelastic.h"
 #include "materials/scaled.h"
 #include "scenes/build_model.h"

@@ -15,8 +15,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "analysis/model_vs_measured.h"
 #include "analysis/csv_scan.h"
+#include "analysis/model_vs_measured.h"
 #include "app/compare/command.h"
 #include "app/compare/dlc_map.h"
 #include "app/diagnose/command.h"

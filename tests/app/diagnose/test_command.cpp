@@ -23,12 +23,12 @@
 
 #include "analysis/measurements.h"
 #include "app/diagnose/command.h"
+#include "app/diagnose/effect_catalog.h"
 #include "app/simulate/drive.h"
 #include "app/synth/command.h"
+#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/inp/deck.h"
-#include "app/diagnose/effect_catalog.h"
-#include "core/errors.h"
 #include "scenes/scene.h"
 #include "tests/app/recording_helpers.h"
 

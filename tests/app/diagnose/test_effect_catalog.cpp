@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "app/diagnose/effect_catalog.h"
-#include "damage/registry.h"
 #include "core/errors.h"
+#include "damage/registry.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {

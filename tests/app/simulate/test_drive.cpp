@@ -14,8 +14,8 @@
 
 #include "analysis/steps.h"
 #include "app/simulate/drive.h"
-#include "engine/assembly.h"
 #include "core/errors.h"
+#include "engine/assembly.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
 

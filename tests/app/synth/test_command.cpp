@@ -12,9 +12,9 @@
 #include "analysis/measurements.h"
 #include "analysis/steps.h"
 #include "app/diagnose/effect_catalog.h"
-#include "core/json_writer.h"
 #include "app/synth/command.h"
 #include "core/errors.h"
+#include "core/json_writer.h"
 #include "tests/app/cli_helpers.h"
 
 namespace pneufem {

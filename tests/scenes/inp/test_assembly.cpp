@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
-#include "core/errors.h"
 #include "scenes/build_model.h"
-#include "scenes/inp/deck.h"
 #include "scenes/inp/assembly.h"
+#include "scenes/inp/deck.h"
 
 namespace pneufem {
 namespace {

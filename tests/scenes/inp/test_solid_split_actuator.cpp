@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
-#include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/inp/deck.h"
 #include "scenes/scene.h"
