@@ -27,12 +27,12 @@
 #include <cmath>
 #include <cstddef>
 #include <initializer_list>
-#include <sstream>
 #include <utility>
 #include <span>
 #include <string>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 #include "materials/material.h"
 
 namespace pneufem::detail {
@@ -93,12 +93,6 @@ inline void require_split_base(const MaterialPtr& base, const std::string& effec
 /// applied outside: the canonical order is viscoelastic(fatigue(mullins(base))). Defined in decorator.cpp.
 void require_potential_base(const MaterialPtr& base, const std::string& effect);
 
-inline std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 inline void require(bool ok, const std::string& effect, const std::string& msg) {
   if (!ok) throw InputError(effect + ": " + msg);
 }
@@ -106,7 +100,7 @@ inline void require(bool ok, const std::string& effect, const std::string& msg) 
 inline void require_finite(const std::string& effect,
                            std::initializer_list<std::pair<const char*, double>> values) {
   for (const auto& [key, v] : values)
-    if (!std::isfinite(v)) throw InputError(effect + ": " + key + " must be a finite number, got " + num(v));
+    if (!std::isfinite(v)) throw InputError(effect + ": " + key + " must be a finite number, got " + short_num(v));
 }
 
 /// Combines two stiffness losses acting in series on the isochoric stress: the stiffness

@@ -142,21 +142,21 @@ FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(s
     detail::require_finite(me, {{"W_th", p.W_th_Pa}});
     detail::require(p.W_th_Pa > 0.0, me,
                     "W_th must be > 0 Pa (threshold isochoric energy density below which no damage grows), got " +
-                        detail::num(p.W_th_Pa));
+                        short_num(p.W_th_Pa));
   } else {
     detail::require_finite(me, {{"lambda_th", p.lambda_th}});
     detail::require(p.lambda_th > 1.0, me,
-                    "lambda_th must be > 1 (threshold largest principal stretch), got " + detail::num(p.lambda_th));
+                    "lambda_th must be > 1 (threshold largest principal stretch), got " + short_num(p.lambda_th));
   }
-  detail::require(p.tau_s > 0.0, me, "tau must be > 0 s (time scale of the damage rate), got " + detail::num(p.tau_s));
+  detail::require(p.tau_s > 0.0, me, "tau must be > 0 s (time scale of the damage rate), got " + short_num(p.tau_s));
   detail::require(p.q >= 1.0, me,
                   "q must be >= 1 (exponent of the threshold excess; q > 1 gives a continuous tangent), got " +
-                      detail::num(p.q));
+                      short_num(p.q));
   detail::require(p.n >= 1.0 && p.n <= 20.0, me,
                   "n must lie in [1, 20] (integrity exponent: 1 = first-order kinetics, larger saturates "
-                  "sooner), got " + detail::num(p.n));
+                  "sooner), got " + short_num(p.n));
   detail::require(p.d_fail > 0.0 && p.d_fail < 1.0, me,
-                  "d_fail must lie in (0, 1) (damage at which a point counts as failed), got " + detail::num(p.d_fail));
+                  "d_fail must lie in (0, 1) (damage at which a point counts as failed), got " + short_num(p.d_fail));
 }
 
 void FatigueDamage::init_state(std::span<double> state) const {

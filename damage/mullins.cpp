@@ -27,9 +27,9 @@ Mullins::Mullins(MaterialPtr base, const MullinsParams& p) : base_(std::move(bas
   detail::require_split_base(base_, me);
   detail::require_potential_base(base_, me);
   detail::require_finite(me, {{"r", p.r}, {"m", p.m_Pa}, {"beta", p.beta}});
-  detail::require(p.r > 1.0, me, "r must be > 1 (the largest stress softening is 1/r), got " + detail::num(p.r));
-  detail::require(p.m_Pa >= 0.0, me, "m must be >= 0 Pa (an energy density), got " + detail::num(p.m_Pa));
-  detail::require(p.beta >= 0.0, me, "beta must be >= 0, got " + detail::num(p.beta));
+  detail::require(p.r > 1.0, me, "r must be > 1 (the largest stress softening is 1/r), got " + short_num(p.r));
+  detail::require(p.m_Pa >= 0.0, me, "m must be >= 0 Pa (an energy density), got " + short_num(p.m_Pa));
+  detail::require(p.beta >= 0.0, me, "beta must be >= 0, got " + short_num(p.beta));
   detail::require(p.m_Pa > 0.0 || p.beta > 0.0, me,
                   "m and beta cannot both be 0 (the erf argument would divide by zero); set m > 0 Pa, the "
                   "energy-density scale over which the softening develops");

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <deque>
 #include <set>
-#include <sstream>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 #include "damage/effects.h"
 
 namespace pneufem {
@@ -78,12 +78,6 @@ std::vector<MaterialEffect> builtins() {
   return v;
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 void validate(const MaterialEffect& e, const std::deque<MaterialEffect>& known) {
   const std::string who = "material effect '" + e.name + "'";
   if (e.name.empty()) throw InputError("register_material_effect: the effect needs a name");
@@ -102,9 +96,9 @@ void validate(const MaterialEffect& e, const std::deque<MaterialEffect>& known) 
     if (p.name.empty() || p.name == "enabled") throw InputError(pw + ": a parameter needs a name other than 'enabled'");
     if (!seen.insert(p.name).second) throw InputError(pw + ": given twice");
     if (!(std::isfinite(p.lo) && std::isfinite(p.hi) && p.lo < p.hi))
-      throw InputError(pw + ": calibration bounds need finite lo < hi, got [" + num(p.lo) + ", " + num(p.hi) + "]");
+      throw InputError(pw + ": calibration bounds need finite lo < hi, got [" + short_num(p.lo) + ", " + short_num(p.hi) + "]");
     if (!(p.default_value >= p.lo && p.default_value <= p.hi))
-      throw InputError(pw + ": default " + num(p.default_value) + " lies outside [" + num(p.lo) + ", " + num(p.hi) + "]");
+      throw InputError(pw + ": default " + short_num(p.default_value) + " lies outside [" + short_num(p.lo) + ", " + short_num(p.hi) + "]");
     if (p.log && !(p.lo > 0.0)) throw InputError(pw + ": a log-scale parameter needs lo > 0");
   }
 }

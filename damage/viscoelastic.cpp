@@ -97,12 +97,12 @@ ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<do
   double sum = 0.0;
   for (std::size_t i = 0; i < g.size(); ++i) {
     detail::require(std::isfinite(g[i]) && g[i] >= 0.0, me,
-                    term("g", i) + " must be >= 0 (Abaqus relative modulus), got " + detail::num(g[i]));
+                    term("g", i) + " must be >= 0 (Abaqus relative modulus), got " + short_num(g[i]));
     sum += g[i];
   }
   detail::require(sum < 1.0, me,
                   "the Abaqus g_i must sum to < 1 (the long-term modulus G_0 (1 - sum g) must stay positive), got " +
-                      detail::num(sum));
+                      short_num(sum));
   ViscoParams p{g, tau_s};
   for (double& gi : p.gamma) gi /= 1.0 - sum;
   return p;
@@ -118,9 +118,9 @@ Viscoelastic::Viscoelastic(MaterialPtr base, const ViscoParams& p) : base_(std::
   for (std::size_t i = 0; i < n; ++i) {
     detail::require(std::isfinite(p.gamma[i]) && p.gamma[i] >= 0.0, me,
                     term("gamma", i) + " must be >= 0 (stiffness of the branch relative to the long-term law), got " +
-                        detail::num(p.gamma[i]));
+                        short_num(p.gamma[i]));
     detail::require(std::isfinite(p.tau_s[i]) && p.tau_s[i] > 0.0, me,
-                    term("tau", i) + " must be > 0 s (relaxation time), got " + detail::num(p.tau_s[i]));
+                    term("tau", i) + " must be > 0 s (relaxation time), got " + short_num(p.tau_s[i]));
     gamma_[i] = p.gamma[i];
     tau_[i] = p.tau_s[i];
     gamma_sum_ += p.gamma[i];

@@ -2,9 +2,9 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 
 namespace pneufem {
 
@@ -12,24 +12,19 @@ namespace {
 void require(bool ok, const std::string& law, const std::string& msg) {
   if (!ok) throw InputError(law + ": " + msg);
 }
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 }  // namespace
 
 double bulk_from_ratio(double mu0, double K_over_mu) {
   if (!(K_over_mu > 0.0))
-    throw InputError("K0/mu0 must be > 0 (got " + num(K_over_mu) + "); typical silicone values are 100-1000");
+    throw InputError("K0/mu0 must be > 0 (got " + short_num(K_over_mu) + "); typical silicone values are 100-1000");
   return K_over_mu * mu0;
 }
 
 Yeoh::Yeoh(double c10, double c20, double c30, double k) : C10(c10), C20(c20), C30(c30), K(k) {
   require(std::isfinite(C10) && std::isfinite(C20) && std::isfinite(C30) && std::isfinite(K), kName,
           "parameters must be finite numbers");
-  require(C10 > 0.0, kName, "C10 must be > 0 (initial shear modulus mu0 = 2 C10), got " + num(C10) + " Pa");
-  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa; set K0/mu0 (e.g. 100)");
+  require(C10 > 0.0, kName, "C10 must be > 0 (initial shear modulus mu0 = 2 C10), got " + short_num(C10) + " Pa");
+  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + short_num(K) + " Pa; set K0/mu0 (e.g. 100)");
 }
 
 double Yeoh::stability_limit_I1b_minus_3() const {
@@ -47,21 +42,21 @@ double Yeoh::stability_limit_I1b_minus_3() const {
 
 NeoHookean::NeoHookean(double c10, double k) : C10(c10), K(k) {
   require(std::isfinite(C10) && std::isfinite(K), kName, "parameters must be finite numbers");
-  require(C10 > 0.0, kName, "C10 must be > 0 (mu0 = 2 C10), got " + num(C10) + " Pa");
-  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa");
+  require(C10 > 0.0, kName, "C10 must be > 0 (mu0 = 2 C10), got " + short_num(C10) + " Pa");
+  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + short_num(K) + " Pa");
 }
 
 MooneyRivlin::MooneyRivlin(double c10, double c01, double k) : C10(c10), C01(c01), K(k) {
   require(std::isfinite(C10) && std::isfinite(C01) && std::isfinite(K), kName, "parameters must be finite numbers");
-  require(C10 + C01 > 0.0, kName, "C10 + C01 must be > 0 (mu0 = 2 (C10 + C01)), got " + num(C10 + C01) + " Pa");
+  require(C10 + C01 > 0.0, kName, "C10 + C01 must be > 0 (mu0 = 2 (C10 + C01)), got " + short_num(C10 + C01) + " Pa");
   require(C10 >= 0.0 || C01 >= 0.0, kName, "C10 and C01 cannot both be negative");
-  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + num(K) + " Pa");
+  require(K > 0.0, kName, "bulk modulus K must be > 0, got " + short_num(K) + " Pa");
 }
 
 SaintVenantKirchhoff::SaintVenantKirchhoff(double E, double nu) : E_(E), nu_(nu) {
   require(std::isfinite(E) && std::isfinite(nu), "linear_elastic", "E and nu must be finite numbers");
-  require(E > 0.0, "linear_elastic", "Young's modulus E must be > 0, got " + num(E) + " Pa");
-  require(nu > -1.0 && nu < 0.5, "linear_elastic", "Poisson ratio must lie in (-1, 0.5), got " + num(nu));
+  require(E > 0.0, "linear_elastic", "Young's modulus E must be > 0, got " + short_num(E) + " Pa");
+  require(nu > -1.0 && nu < 0.5, "linear_elastic", "Poisson ratio must lie in (-1, 0.5), got " + short_num(nu));
   lambda_ = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
   mu_ = E / (2.0 * (1.0 + nu));
 }

@@ -3,9 +3,9 @@
 #include <Eigen/SVD>
 #include <cassert>
 #include <cmath>
-#include <sstream>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 #include "materials/invariant_kernel.h"
 
 namespace pneufem {
@@ -14,12 +14,6 @@ namespace {
 
 void require(bool ok, const std::string& msg) {
   if (!ok) throw InputError(std::string(Ogden::kName) + ": " + msg);
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 // Divided difference (x^p - y^p) / (x - y) with x = y e^t, written as y^{p-1} expm1(p t) / expm1(t).
@@ -50,16 +44,16 @@ Ogden::Ogden(const std::vector<double>& mu, const std::vector<double>& alpha, do
     mu0_ += mu[i];
   }
   require(std::isfinite(K_), "bulk modulus K must be a finite number");
-  require(mu0_ > 0.0, "initial shear modulus mu0 = sum mu_i must be > 0, got " + num(mu0_) + " Pa");
+  require(mu0_ > 0.0, "initial shear modulus mu0 = sum mu_i must be > 0, got " + short_num(mu0_) + " Pa");
   for (int i = 0; i < n_; ++i) {
     const std::string id = std::to_string(i + 1);
     require(mu_[i] > 0.0,
-            "mu_" + id + " = " + num(mu_[i]) + " Pa (alpha_" + id + " = " + num(alpha_[i]) +
+            "mu_" + id + " = " + short_num(mu_[i]) + " Pa (alpha_" + id + " = " + short_num(alpha_[i]) +
                 ") violates Ogden's (1972) Drucker-type stability condition mu_p alpha_p > 0, which in the "
                 "Abaqus convention used here reads mu_i > 0. If your constants follow W = sum mu_p/alpha_p "
                 "(lambda_1^alpha_p + ... - 3), convert them with mu_i = mu_p alpha_p / 2 (Ogden::from_ogden1972)");
   }
-  require(K_ > 0.0, "bulk modulus K must be > 0, got " + num(K_) + " Pa; set K0/mu0 (e.g. 100)");
+  require(K_ > 0.0, "bulk modulus K must be > 0, got " + short_num(K_) + " Pa; set K0/mu0 (e.g. 100)");
 }
 
 Ogden Ogden::from_ogden1972(const std::vector<double>& mu_p, const std::vector<double>& alpha, double K) {

@@ -8,13 +8,13 @@
 #include <cstdint>
 #include <iterator>
 #include <limits>
-#include <sstream>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <openvdb/openvdb.h>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 
 // How the mesh is built
 // ---------------------
@@ -44,12 +44,6 @@ constexpr double kMaxCells = 5e6;  // refuse meshes larger than this (cells)
 // Refuse voxel solids whose box surfaces cross more voxels than this: the mask tree then holds
 // about 5e7 / 64 = 8e5 partially filled leaves (~100 MB).
 constexpr double kMaxSurfaceVoxels = 5e7;
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 // ---------------------------------------------------------------------------------------------
 // Feature planes and the rectilinear grid
@@ -130,7 +124,7 @@ std::array<AxisPlanes, 3> feature_planes(const PneuNetParams& p) {
     for (std::size_t m = 0; m + 1 < ax[d].at.size(); ++m)
       if (!(ax[d].at[m + 1] > ax[d].at[m]))
         throw InputError("geometry: two feature planes along " + std::string(1, "xyz"[d]) +
-                         " coincide (at " + num(ax[d].at[m]) +
+                         " coincide (at " + short_num(ax[d].at[m]) +
                          " m); a length is too small relative to the others to be represented");
   return ax;
 }
@@ -172,8 +166,8 @@ Plan make_plan(const PneuNetParams& p) {
     cells *= per_axis[d];
   }
   if (cells > kMaxCells)
-    throw InputError("mesh.h = " + num(p.h) + " m gives " + num(std::round(cells / 1e5) / 10) +
-                     " million grid cells (limit " + num(kMaxCells / 1e6) +
+    throw InputError("mesh.h = " + short_num(p.h) + " m gives " + short_num(std::round(cells / 1e5) / 10) +
+                     " million grid cells (limit " + short_num(kMaxCells / 1e6) +
                      " million); use a larger mesh.h (or fewer mesh.fabric_layers)");
 
   Plan plan;
@@ -212,10 +206,10 @@ Plan make_plan(const PneuNetParams& p) {
     for (const Box& b : *list) area += b.area();
   const double voxels = area / (v * v);
   if (voxels > kMaxSurfaceVoxels)
-    throw InputError("geometry: a cell centre lies only " + num(v) +
+    throw InputError("geometry: a cell centre lies only " + short_num(v) +
                      " m from a face of the solid, so the OpenVDB solid would need voxels of that size (about " +
-                     num(std::round(voxels / 1e5) / 10) + " million surface voxels, limit " +
-                     num(kMaxSurfaceVoxels / 1e6) +
+                     short_num(std::round(voxels / 1e5) / 10) + " million surface voxels, limit " +
+                     short_num(kMaxSurfaceVoxels / 1e6) +
                      " million); avoid very thin gaps between feature planes (e.g. fabric top just below "
                      "geometry.base_thickness, channel almost as wide as the chamber) or increase mesh.h");
   return plan;
@@ -223,7 +217,7 @@ Plan make_plan(const PneuNetParams& p) {
 
 void check_positive(double v, const std::string& key, const char* what) {
   if (!(std::isfinite(v) && v > 0.0))
-    throw InputError(key + " must be a positive length in metres (got " + num(v) + "); it is the " + what);
+    throw InputError(key + " must be a positive length in metres (got " + short_num(v) + "); it is the " + what);
 }
 
 void check_params(const PneuNetParams& p) {
@@ -243,27 +237,27 @@ void check_params(const PneuNetParams& p) {
     throw InputError("geometry.chambers must be >= 1 (got " + std::to_string(p.chambers) + ")");
   const double chamber_width = p.width - 2.0 * p.side_wall;
   if (!(chamber_width > 0.0))
-    throw InputError("geometry.side_wall: 2 * side_wall (" + num(2.0 * p.side_wall) +
-                     " m) must be less than geometry.width (" + num(p.width) +
+    throw InputError("geometry.side_wall: 2 * side_wall (" + short_num(2.0 * p.side_wall) +
+                     " m) must be less than geometry.width (" + short_num(p.width) +
                      " m) to leave room for the chambers; thin the side walls or widen the actuator");
   if (!(p.channel_width < chamber_width))
-    throw InputError("geometry.channel_width (" + num(p.channel_width) +
-                     " m) must be less than the chamber width width - 2 * side_wall (" + num(chamber_width) +
+    throw InputError("geometry.channel_width (" + short_num(p.channel_width) +
+                     " m) must be less than the chamber width width - 2 * side_wall (" + short_num(chamber_width) +
                      " m); narrow the channel or thin the side walls");
   if (!(p.roof < p.body_height))
-    throw InputError("geometry.roof (" + num(p.roof) + " m) must be less than geometry.body_height (" +
-                     num(p.body_height) + " m) to leave room for the chambers");
+    throw InputError("geometry.roof (" + short_num(p.roof) + " m) must be less than geometry.body_height (" +
+                     short_num(p.body_height) + " m) to leave room for the chambers");
   if (!(p.channel_height < p.body_height - p.roof))
-    throw InputError("geometry.channel_height (" + num(p.channel_height) +
+    throw InputError("geometry.channel_height (" + short_num(p.channel_height) +
                      " m) must be less than the chamber height body_height - roof (" +
-                     num(p.body_height - p.roof) + " m)");
+                     short_num(p.body_height - p.roof) + " m)");
   if (!(p.fabric_z0 + p.fabric_thickness < p.base_thickness))
     throw InputError("geometry.fabric_thickness: the fabric layer [fabric_z0, fabric_z0 + fabric_thickness] = [" +
-                     num(p.fabric_z0) + ", " + num(p.fabric_z0 + p.fabric_thickness) +
+                     short_num(p.fabric_z0) + ", " + short_num(p.fabric_z0 + p.fabric_thickness) +
                      "] m must lie strictly inside the base (below geometry.base_thickness = " +
-                     num(p.base_thickness) + " m); lower geometry.fabric_z0, thin the fabric or thicken the base");
+                     short_num(p.base_thickness) + " m); lower geometry.fabric_z0, thin the fabric or thicken the base");
   if (!(std::isfinite(p.h) && p.h > 0.0))
-    throw InputError("mesh.h must be a positive element size in metres (got " + num(p.h) + "), e.g. 2e-3");
+    throw InputError("mesh.h must be a positive element size in metres (got " + short_num(p.h) + "), e.g. 2e-3");
   if (p.fabric_layers < 1)
     throw InputError("mesh.fabric_layers must be >= 1 (got " + std::to_string(p.fabric_layers) + ")");
 }
