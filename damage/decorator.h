@@ -1,7 +1,7 @@
 #pragma once
 // Plumbing shared by the inelastic decorators of damage/ (Mullins, fatigue, viscoelasticity).
 //
-// A decorator wraps a base Material (STYLE.md practice 2) and owns a few doubles of history per
+// A decorator wraps a base Material and owns a few doubles of history per
 // quadrature point. The state block of one point is laid out as
 //     [ decorator's own state (own doubles) | base's state (base->state_size() doubles) ]
 // so decorators nest: viscoelastic(fatigue(mullins(yeoh))) holds

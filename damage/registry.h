@@ -1,8 +1,8 @@
 #pragma once
 // The one list of inelastic material effects pneufem knows: the built-ins (mullins, fatigue,
 // viscoelastic) and any effect a user adds in C++ (docs/adding_an_effect.md). An effect is a
-// decorator over a material (STYLE.md practice 2) with named numeric parameters; registering it
-// makes it available, by name, to
+// decorator over a material with named numeric parameters; registering it makes it available, by
+// name, to
 //   * scenes:    [materials.<m>.<name>] enabled = true, <param> = value   (scenes/scene_materials.cpp)
 //   * sweep:     --param materials.<m>.<name>.<param>=LO:HI:N
 //   * compare / diagnose / synth: as a candidate effect with the registered bounds (app/diagnose/effect_catalog.h).

@@ -1,4 +1,4 @@
-// The derivative battery (STYLE.md practice 5) for every decorated material, at a FIXED committed
+// The derivative battery for every decorated material, at a FIXED committed
 // history state and increment dt, plus the state layout of nested decorators and their neutral limits.
 //
 // "Consistent tangent" here means A = dP/dF of the map F -> P(F; committed state, dt) that evaluate()

@@ -151,7 +151,7 @@ TEST(Registry, RejectsBadRegistrations) {
   EXPECT_EQ(find_material_effect("test_effect_x"), nullptr);  // nothing half-registered
 }
 
-// ---- The derivative battery for the registered effect (STYLE.md practice 5) ----
+// ---- The derivative battery for the registered effect ----
 // Central differences with h = cbrt(eps) |F|/sqrt(3): truncation h^2/6 |P'''| plus round-off
 // eps |P| / h, both below 1e-7 of the tangent scale M = max(|A|, mu0) for Yeoh at these stretches
 // (the bound tests/materials derives for the base law; the effect multiplies by a constant).

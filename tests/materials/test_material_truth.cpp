@@ -1,4 +1,4 @@
-// Materials against truth (STYLE.md practice 6): closed-form incompressible uniaxial curves, Treloar's
+// Materials against truth: closed-form incompressible uniaxial curves, Treloar's
 // 1944 rubber data, the Yeoh stability limit, and Ogden special cases that reduce to invariant laws.
 #include <gtest/gtest.h>
 

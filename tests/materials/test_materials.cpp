@@ -1,4 +1,4 @@
-// The material test battery (STYLE.md practice 5): every material runs the same parameterised
+// The material test battery: every material runs the same parameterised
 // suite, and every family's parameter validation is checked with its message.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
