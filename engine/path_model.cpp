@@ -13,6 +13,7 @@
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/nonlocal.h"
+#include "engine/path_spline.h"
 #include "engine/tet_element.h"
 #include "materials/errors.h"
 
@@ -67,85 +68,6 @@ Groups group_points(const Model& model, const std::vector<int>& pt_element) {
   return g;
 }
 
-/// Cubic Hermite interpolation on one path segment at a = (theta - theta_k) / dth: the weights of
-/// the two end values and end slopes, for the value and for its theta-derivative, computed once per
-/// segment position and applied to every quantity there (each material point's F, V, S, p_el).
-/// Outside [0, 1], linear with the end slope (extrapolation: segment() clamps k, so a < 0 only on
-/// the first segment, a > 1 only on the last). Smooth across samples: see `PathSegment`.
-struct Hermite {
-  double a, dth;
-  double w00 = 0, w10 = 0, w01 = 0, w11 = 0;  ///< value weights of y0, m0, y1, m1
-  double s0 = 0, sm0 = 0, sm1 = 0;            ///< slope = s0 (y0 - y1) + sm0 m0 + sm1 m1
-  Hermite(double a_, double dth_) : a(a_), dth(dth_) {
-    const double a2 = a * a, a3 = a2 * a;
-    w00 = 2 * a3 - 3 * a2 + 1, w10 = (a3 - 2 * a2 + a) * dth, w01 = 3 * a2 - 2 * a3, w11 = (a3 - a2) * dth;
-    s0 = (6 * a2 - 6 * a) / dth, sm0 = 3 * a2 - 4 * a + 1, sm1 = 3 * a2 - 2 * a;
-  }
-  /// The interpolated value; `slope` gets its d/dtheta.
-  template <class T>
-  T operator()(const T& y0, const T& y1, const T& m0, const T& m1, T* slope) const {
-    if (a < 0.0) {
-      *slope = m0;
-      return y0 + (a * dth) * m0;
-    }
-    if (a > 1.0) {
-      *slope = m1;
-      return y1 + ((a - 1.0) * dth) * m1;
-    }
-    *slope = s0 * (y0 - y1) + sm0 * m0 + sm1 * m1;
-    return w00 * y0 + w10 * m0 + w01 * y1 + w11 * m1;
-  }
-};
-
-/// Slopes of samples y[k] at theta[k] such that the piecewise cubic Hermite through them is the
-/// cubic spline (C2: continuous second derivative) with not-a-knot ends, which reproduces any
-/// cubic exactly. Not natural ends (zero second derivative): the path's top ends at or near a
-/// limit point, where it curves most, and diagnose drives it there. C2 and not only C1:
-/// the residual's theta-derivative involves F'', and with F'' jumping at the samples (three-point
-/// slopes, C1) the equilibrium angle of a scaled model still had kinks of ~6 % of its slope in the
-/// constant (PathModel.AngleIsSmoothInTheConstants). The tridiagonal system (non-uniform knots)
-///   h_k m_{k-1} + 2 (h_{k-1} + h_k) m_k + h_{k-1} m_{k+1} = 3 (h_k d_{k-1} + h_{k-1} d_k)
-/// with h_k = theta_{k+1} - theta_k and chords d_k (and the two end rows), is solved by the Thomas
-/// algorithm without pivoting: the interior rows are diagonally dominant, and the pivots stay
-/// above 0.12 h for any spacing whose neighbours differ by less than 3x (checked on 20 000 random
-/// spacings; the path's samples, 1/40 of the peak pressure apart, differ by far less).
-template <class T>
-std::vector<T> sample_slopes(const std::vector<double>& theta, const std::function<T(std::size_t)>& y) {
-  const std::size_t n = theta.size();
-  std::vector<T> m(n);
-  if (n == 2) {
-    m[0] = m[1] = (y(1) - y(0)) / (theta[1] - theta[0]);
-    return m;
-  }
-  std::vector<double> h(n - 1), lower(n, 0.0), diag(n), upper(n, 0.0);
-  std::vector<T> d(n - 1), rhs(n);
-  for (std::size_t k = 0; k + 1 < n; ++k) {
-    h[k] = theta[k + 1] - theta[k];
-    d[k] = (y(k + 1) - y(k)) / h[k];
-  }
-  if (n >= 4) {  // not-a-knot ends: the third derivative continuous at the second and last-but-one sample
-    const double h0 = h[0], h1 = h[1], ha = h[n - 3], hb = h[n - 2];
-    diag[0] = h1, upper[0] = h0 + h1, rhs[0] = ((h0 + 2.0 * (h0 + h1)) * h1 * d[0] + h0 * h0 * d[1]) / (h0 + h1);
-    lower[n - 1] = ha + hb, diag[n - 1] = ha;
-    rhs[n - 1] = (hb * hb * d[n - 3] + (2.0 * (ha + hb) + hb) * ha * d[n - 2]) / (ha + hb);
-  } else {  // three samples: natural ends (zero second derivative)
-    diag[0] = 2.0, upper[0] = 1.0, rhs[0] = 3.0 * d[0];
-    lower[n - 1] = 1.0, diag[n - 1] = 2.0, rhs[n - 1] = 3.0 * d[n - 2];
-  }
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    lower[k] = h[k], diag[k] = 2.0 * (h[k - 1] + h[k]), upper[k] = h[k - 1];
-    rhs[k] = 3.0 * (h[k] * d[k - 1] + h[k - 1] * d[k]);
-  }
-  for (std::size_t k = 1; k < n; ++k) {  // forward elimination
-    const double w = lower[k] / diag[k - 1];
-    diag[k] -= w * upper[k - 1];
-    rhs[k] = rhs[k] - w * rhs[k - 1];
-  }
-  m[n - 1] = rhs[n - 1] / diag[n - 1];
-  for (std::size_t k = n - 1; k-- > 0;) m[k] = (rhs[k] - upper[k] * m[k + 1]) / diag[k];
-  return m;
-}
-
 /// One segment of the path for all material points: F at both samples and its theta-slopes.
 /// Why cubic and not linear in theta: with F linear on each segment, F'(theta) jumps at every
 /// sample, and so does G_model - G_ref of any model that is not the reference (a pressure jump of
@@ -153,7 +75,7 @@ std::vector<T> sample_slopes(const std::vector<double>& theta, const std::functi
 /// them as the constants change, which made the calibration objective piecewise constant at the
 /// 1 % level (0.4 deg at 45 kPa for a 0.05 % change of a Prony gamma on the default actuator,
 /// 2026-11-26) and trapped the optimiser in the gamma-tau valley far from its minimum. The cubic
-/// is the cubic spline through the samples (sample_slopes), so F, F' and F'' are continuous.
+/// is the cubic spline through the samples (spline_slopes, engine/path_spline.h), so F' and F'' are continuous.
 struct PathSegment {
   const Mat3 *F0, *F1, *M0, *M1;
   Hermite h;
@@ -338,32 +260,17 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
   // Slopes for the smooth path (PathSegment says why): of F per point, of V and of S.
   dF_.resize(F_.size());
   for (std::size_t i = 0; i < np; ++i) {
-    const std::vector<Mat3> m = sample_slopes<Mat3>(theta_, [&](std::size_t k) { return F_[k * np + i]; });
+    const std::vector<Mat3> m = spline_slopes<Mat3>(theta_, [&](std::size_t k) { return F_[k * np + i]; });
     for (std::size_t k = 0; k < theta_.size(); ++k) dF_[k * np + i] = m[k];
   }
-  dV_ = sample_slopes<double>(theta_, [&](std::size_t k) { return V_[k]; });
-  dS_ = sample_slopes<Eigen::Vector3d>(theta_, [&](std::size_t k) { return S_[k]; });
+  dV_ = spline_slopes<double>(theta_, [&](std::size_t k) { return V_[k]; });
+  dS_ = spline_slopes<Eigen::Vector3d>(theta_, [&](std::size_t k) { return S_[k]; });
 
   // The reference's equilibrium pressure between samples: a monotone cubic in theta (Fritsch-
   // Carlson slopes) rather than a chord. The chord made the elastic model's angle up to ~0.1°
   // (0.2 %) off its FEM curve between samples near the limit point, where p_el(theta) flattens;
   // diagnose compares at that level. Beyond the ends the residual stays linear (extrapolation).
-  dp_dtheta_.assign(theta_.size(), 0.0);
-  if (theta_.size() >= 2) {
-    const std::size_t ns = theta_.size();
-    std::vector<double> h(ns - 1), d(ns - 1);
-    for (std::size_t k = 0; k + 1 < ns; ++k) {
-      h[k] = theta_[k + 1] - theta_[k];
-      d[k] = (p_[k + 1] - p_[k]) / h[k];
-    }
-    dp_dtheta_.front() = d.front();
-    dp_dtheta_.back() = d.back();
-    for (std::size_t k = 1; k + 1 < ns; ++k)
-      if (d[k - 1] * d[k] > 0.0) {
-        const double w1 = 2 * h[k] + h[k - 1], w2 = h[k] + 2 * h[k - 1];
-        dp_dtheta_[k] = (w1 + w2) / (w1 / d[k - 1] + w2 / d[k]);
-      }
-  }
+  dp_dtheta_ = monotone_slopes(theta_, p_);
 
   // 3. The reference's generalised force on a fine grid of each segment: the difference form
   // needs G_ref at every residual evaluation, and it never changes.
@@ -377,11 +284,7 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
                                                        pt_weight_, pt_element_, TimeStep{}, nullptr, nullptr, Fbuf, dFbuf, rbuf);
 }
 
-int PathModel::segment(double theta) const {
-  const auto it = std::upper_bound(theta_.begin(), theta_.end(), theta);
-  const int k = static_cast<int>(it - theta_.begin()) - 1;
-  return std::clamp(k, 0, static_cast<int>(theta_.size()) - 2);
-}
+int PathModel::segment(double theta) const { return path_segment_index(theta_, theta); }
 
 std::vector<double> PathModel::run(const Model& model, const PathLoad& load, PathRunStats* stats) const {
   if (model.mesh.num_elements() != ref_.mesh.num_elements() || model.mesh.num_nodes() != ref_.mesh.num_nodes())

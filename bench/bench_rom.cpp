@@ -1,0 +1,286 @@
+// Reduced-order model benchmark (not run in CI; results in BENCHMARKS.md): the reduced model of
+// engine/rom.h against the full quasi-static FEM on a scene's protocol.
+//   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
+//             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
+// Prints the offline cost (elastic trace, basis), the online cost (states, Newton iterations,
+// wall), and with --fem the FEM's record and the differences: every report angle, and the paper's
+// NRMSE per trial against the ideal elastic model, for both. --work DIR keeps the elastic trace
+// and the FEM record between invocations (keyed by the scene text), so basis options can be varied
+// without re-running the FEM.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+
+#include "analysis/paper_metrics.h"
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/path_model.h"
+#include "engine/quasi_static.h"
+#include "engine/rom.h"
+#include "engine/linear_solver.h"
+#include "engine/static_solver.h"
+#include "engine/tet_element.h"
+#include "scenes/build_model.h"
+
+using namespace pneufem;
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+namespace {
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::uint64_t fnv(const std::string& s) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : s) h = (h ^ c) * 0x100000001b3ULL;
+  return h;
+}
+
+Scene elastic_reference(const Scene& scene) {
+  std::vector<std::string> sets;
+  for (const std::string& m : scene.table_keys("materials"))
+    for (const std::string& sub : scene.table_keys("materials." + m))
+      if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
+  sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
+  sets.push_back("gravity.rig_angle_deg=-1.0");
+  sets.push_back("load.pressure_lag_s=0.0");
+  return scene.with(sets);
+}
+
+void write_doubles(const fs::path& p, const std::vector<double>& v) {
+  std::ofstream f(p, std::ios::binary);
+  const std::uint64_t n = v.size();
+  f.write(reinterpret_cast<const char*>(&n), sizeof n);
+  f.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(double)));
+}
+bool read_doubles(const fs::path& p, std::vector<double>& v) {
+  std::ifstream f(p, std::ios::binary);
+  if (!f) return false;
+  std::uint64_t n = 0;
+  f.read(reinterpret_cast<char*>(&n), sizeof n);
+  v.resize(n);
+  f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(double)));
+  return static_cast<bool>(f);
+}
+
+struct Record {
+  std::vector<int> trial;
+  std::vector<double> t, p, angle;
+};
+
+/// Per trial: the paper's NRMSE of `a` against the ideal angles `ideal` (trial 1 of the ideal).
+std::vector<double> nrmse_per_trial(const LoadHistory& load, const Record& a, const Record& ideal) {
+  std::vector<double> out;
+  auto steps = [&](const Record& r, int trial) {
+    StepAngles s;
+    s.trial = trial;
+    const TrialLoad& tl = load.trials[static_cast<std::size_t>(trial - 1)];
+    auto at = [&](double t) {
+      for (std::size_t i = 0; i < r.t.size(); ++i)
+        if (r.trial[i] == trial && std::abs(r.t[i] - t) < 1e-9) return r.angle[i];
+      return std::nan("");
+    };
+    for (std::size_t k = 0; k < tl.step_start_s.size(); ++k) {
+      s.level_kPa.push_back(tl.step_level_Pa[k] * 1e-3);
+      s.at_mark_deg.push_back(at(tl.step_start_s[k] + tl.mark_s));
+      s.at_end_deg.push_back(at(tl.step_end_s[k]));
+    }
+    return s;
+  };
+  const StepAngles ref = steps(ideal, 1);
+  for (std::size_t k = 0; k < load.trials.size(); ++k) out.push_back(paper_metrics(steps(a, static_cast<int>(k) + 1), ref).nrmse);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path, work = "rom_work";
+  std::vector<std::string> sets, model_sets;
+  bool fem = false;
+  int threads = 0;
+  RomBasisOptions ro;
+  ro.verbose = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&] { return std::string(i + 1 < argc ? argv[++i] : ""); };
+    if (a == "--set") sets.push_back(next());
+    else if (a == "--model-set") model_sets.push_back(next());  // the run's model only, not the reference
+    else if (a == "--work") work = next();
+    else if (a == "--fem") fem = true;
+    else if (a == "--threads") threads = std::stoi(next());
+    else if (a == "--modes") ro.max_modes = std::stoi(next());
+    else if (a == "--clusters") ro.clusters = std::stoi(next());
+    else if (a == "--mode-samples") ro.mode_samples = std::stoi(next());
+    else if (a == "--ecsw-tol") ro.ecsw_tolerance = std::stod(next());
+    else if (a == "--pod-tol") ro.pod_tolerance = std::stod(next());
+    else if (a == "--no-hyper") ro.hyper_reduce = false;
+    else if (a[0] != '-') scene_path = a;
+    else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  std::unique_ptr<tbb::global_control> gc;
+  if (threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  fs::create_directories(work);
+  const Scene base = Scene::load(scene_path, sets);
+  const Scene scene = base.with(model_sets);
+  const Scene ref_scene = elastic_reference(base).with({"load.trials=1"});
+  auto bm = build_model(scene);
+  auto ref = build_model(ref_scene);
+  std::printf("model: %d nodes, %d elements, %d dof\n", bm->model.mesh.num_nodes(), bm->model.mesh.num_elements(),
+              bm->model.num_dofs());
+  double p_max = 0.0;
+  for (const TrialLoad& tl : bm->load.trials)
+    for (double p : tl.pressure_Pa) p_max = std::max(p_max, p);
+  const std::string key = std::to_string(fnv(ref_scene.model_toml()));
+
+  // 1. Elastic path (cached).
+  PathModelOptions po;
+  po.p_top_Pa = 1.8 * p_max;
+  po.dp_Pa = p_max / 40.0;
+  po.newton = ref->solver.quasi_static.newton;
+  ElasticPathTrace trace;
+  {
+    const fs::path f = fs::path(work) / ("trace_" + key + ".bin");
+    std::vector<double> d;
+    const auto t0 = Clock::now();
+    if (read_doubles(f, d)) {
+      const std::size_t ns = static_cast<std::size_t>(d[0]), nd = static_cast<std::size_t>(ref->model.num_dofs());
+      trace.p_Pa.assign(d.begin() + 1, d.begin() + 1 + static_cast<std::ptrdiff_t>(ns));
+      for (std::size_t k = 0; k < ns; ++k)
+        trace.u.push_back(Eigen::Map<const Eigen::VectorXd>(d.data() + 1 + ns + k * nd, static_cast<Eigen::Index>(nd)));
+      std::printf("elastic path: %zu samples from %s\n", ns, f.c_str());
+    } else {
+      trace = trace_elastic_path(ref->model, po);
+      d = {static_cast<double>(trace.p_Pa.size())};
+      d.insert(d.end(), trace.p_Pa.begin(), trace.p_Pa.end());
+      for (const auto& u : trace.u) d.insert(d.end(), u.data(), u.data() + u.size());
+      write_doubles(f, d);
+      std::printf("elastic path: %zu samples to %.2f kPa, traced in %.1f s\n", trace.p_Pa.size(), trace.p_Pa.back() * 1e-3,
+                  since(t0));
+    }
+  }
+  const auto tb = Clock::now();
+  const ReducedBasis basis = build_reduced_basis(ref->model, trace, ro);
+  std::printf("basis: %d modes, %zu sampled elements of %d soft (%d clusters), POD energy left %.2e, ECSW worst %.2e, %.1f s; path to %.2f deg\n",
+              basis.num_modes(), basis.elements.size(), basis.info.soft_elements, basis.info.clusters, basis.info.pod_energy_left,
+              basis.info.ecsw_worst_residual, since(tb), basis.theta.back());
+  {  // the ECSW weights per region against the region's volume
+    const ElementGeometry geom = compute_geometry(ref->model.mesh);
+    std::map<int, double> vol, wvol;
+    std::map<int, int> count;
+    for (int e = 0; e < ref->model.mesh.num_elements(); ++e) vol[ref->model.mesh.region[e]] += geom.volume[e];
+    for (std::size_t i = 0; i < basis.elements.size(); ++i) {
+      const int e = basis.elements[i];
+      wvol[ref->model.mesh.region[e]] += basis.weights[i] * geom.volume[e];
+      ++count[ref->model.mesh.region[e]];
+    }
+    for (auto [r, v] : vol)
+      std::printf("  region %-14s volume %.3e m3, weighted kept %.3e m3, %d elements\n", ref->model.mesh.region_names[r].c_str(), v,
+                  wvol[r], count[r]);
+  }
+  // 3. Reduced runs: the ideal (reference) and the model.
+  Record ideal, red;
+  {
+    const ReducedOrderModel rom(ref->model, basis, ref->model);
+    ReducedRun run(rom, ref->solver.quasi_static);
+    run.run(ref->load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) {
+      ideal.trial.push_back(r.trial);
+      ideal.t.push_back(r.time_s);
+      ideal.p.push_back(r.pressure_Pa);
+      ideal.angle.push_back(r.angle_deg);
+    });
+  }
+  const auto t_on = Clock::now();
+  const ReducedOrderModel rom(ref->model, basis, bm->model);
+  ReducedRun run(rom, bm->solver.quasi_static);
+  try {
+    run.run(bm->load, [&](const StateRecord& r, const ReducedCoordinates& z, const Eigen::VectorXd&) {
+      red.trial.push_back(r.trial);
+      red.t.push_back(r.time_s);
+      red.p.push_back(r.pressure_Pa);
+      red.angle.push_back(r.angle_deg);
+      (void)z;
+    });
+  } catch (const std::exception& e) {
+    std::printf("reduced run failed: %s\n", e.what());
+  }
+  double qmax = 0.0;
+  for (const ReducedStep& s : run.trajectory()) qmax = std::max(qmax, s.z.q.norm());
+  std::printf("largest correction: RMS %.3g mm; path top RMS %.3g mm\n", qmax * 1e3,
+              1e3 * basis.U.col(basis.num_samples() - 1).norm() / std::sqrt(basis.dofs() / 3.0));
+  const ReducedRunStats& st = run.stats();
+  std::printf("reduced run: %.2f s wall, %ld states (%ld rejected), %ld Newton its, %ld tangents, %ld residuals, %d points%s\n",
+              since(t_on), st.states, st.rejected_steps, st.newton_iterations, st.tangents, st.residuals, rom.num_points(),
+              st.beyond_path ? ", BEYOND THE PATH" : "");
+  // 4. FEM (cached).
+  Record full;
+  if (fem) {
+    const fs::path f = fs::path(work) / ("fem_" + std::to_string(fnv(scene.to_toml())) + ".csv");
+    if (fs::exists(f)) {
+      std::ifstream in(f);
+      Record r;
+      int tr;
+      double t, p, a;
+      while (in >> tr >> t >> p >> a) {
+        r.trial.push_back(tr), r.t.push_back(t), r.p.push_back(p), r.angle.push_back(a);
+      }
+      full = r;
+      std::printf("FEM record from %s\n", f.c_str());
+    } else {
+      const auto t0 = Clock::now();
+      Assembler A(bm->model);
+      QuasiStaticRun q(A, bm->solver.quasi_static);
+      std::ofstream out(f.string() + ".part");
+      out.precision(17);
+      try {
+        q.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
+          full.trial.push_back(r.trial), full.t.push_back(r.time_s), full.p.push_back(r.pressure_Pa), full.angle.push_back(r.angle_deg);
+          out << r.trial << " " << r.time_s << " " << r.pressure_Pa << " " << r.angle_deg << "\n";
+          out.flush();
+        });
+        out.close();
+        fs::rename(f.string() + ".part", f);
+      } catch (const std::exception& e) {
+        std::printf("FEM failed: %s\n", e.what());
+      }
+      std::printf("FEM: %.1f s wall, %ld states\n", since(t0), q.stats().states);
+    }
+  }
+  // 5. Comparison.
+  const std::size_t n = std::min(red.angle.size(), full.angle.size());
+  if (fem && n > 0) {
+    std::map<int, double> worst;
+    for (std::size_t i = 0; i < n; ++i) worst[full.trial[i]] = std::max(worst[full.trial[i]], std::abs(red.angle[i] - full.angle[i]));
+    const bool complete = red.angle.size() == full.angle.size();
+    std::vector<double> nr = complete ? nrmse_per_trial(bm->load, red, ideal) : std::vector<double>();
+    std::vector<double> nf = complete ? nrmse_per_trial(bm->load, full, ideal) : std::vector<double>();
+    std::printf("trial  max|rom-fem| deg   NRMSE fem %%   NRMSE rom %%   diff points\n");
+    for (auto [tr, w] : worst) {
+      if (complete)
+        std::printf("%5d  %14.3f  %12.2f  %12.2f  %+10.2f\n", tr, w, 100 * nf[tr - 1], 100 * nr[tr - 1], 100 * (nr[tr - 1] - nf[tr - 1]));
+      else
+        std::printf("%5d  %14.3f\n", tr, w);
+    }
+    std::printf("reports (trial, t, p kPa, fem, rom, diff):\n");
+    for (std::size_t i = 0; i < n; ++i)
+      std::printf("  %d %7.2f %6.2f %9.3f %9.3f %+7.3f\n", full.trial[i], full.t[i], full.p[i] * 1e-3, full.angle[i], red.angle[i],
+                  red.angle[i] - full.angle[i]);
+  } else {
+    for (std::size_t i = 0; i < red.angle.size(); ++i)
+      std::printf("  %d %7.2f %6.2f %9.3f (ideal %9.3f)\n", red.trial[i], red.t[i], red.p[i] * 1e-3, red.angle[i],
+                  i < ideal.angle.size() ? ideal.angle[i] : std::nan(""));
+  }
+  return 0;
+}

@@ -1,0 +1,708 @@
+#include "engine/rom.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <Eigen/LU>
+
+#include "engine/angle.h"
+#include "engine/path_spline.h"
+#include "engine/rom_points.h"
+#include "engine/tet_element.h"
+#include "core/errors.h"
+
+namespace pneufem {
+
+// ================================================================ kept points (rom_points.h)
+namespace rom_detail {
+
+KeptPoints::KeptPoints(const Model& model, const ReducedBasis& basis) : basis_(basis) {
+  r_ = basis.num_modes();
+  ns_ = basis.num_samples();
+  const Mesh& mesh = model.mesh;
+  const ElementGeometry geom = compute_geometry(mesh);
+  const int nqp = geom.nqp, npe = geom.npe;
+  // Points grouped by material (one batched evaluate per chunk of a group), elements in order.
+  std::vector<std::pair<int, int>> order;  // (part, position in basis.elements)
+  for (std::size_t i = 0; i < basis.elements.size(); ++i)
+    order.emplace_back(model.element_part[basis.elements[i]], static_cast<int>(i));
+  std::stable_sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first < b.first; });
+  for (auto [part, pos] : order) {
+    const int e = basis.elements[pos];
+    const Material* m = &model.material_of(e);
+    if (groups_.empty() || groups_.back().material != m) {
+      const int begin = size();
+      groups_.push_back({m, begin, begin, history_size_, m->state_size()});
+    }
+    for (int q = 0; q < nqp; ++q) {
+      element_.push_back(e);
+      weight_.push_back(basis.weights[pos] * geom.w(e, q));
+    }
+    groups_.back().end = size();
+    history_size_ += static_cast<std::size_t>(nqp) * m->state_size();
+  }
+  const int np = size();
+  F_.resize(static_cast<std::size_t>(ns_) * np);
+  dF_.resize(F_.size());
+  T_.resize(F_.size());
+  B_.assign(static_cast<std::size_t>(np) * 9 * r_, 0.0);
+  for (int i = 0; i < np; ++i) {
+    const int e = element_[i], q = i % nqp;  // points of an element are consecutive, nqp each
+    const int* n = mesh.element(e);
+    const double* g = geom.grad(e, q);
+    for (int k = 0; k < ns_; ++k) {
+      Mat3 F = Mat3::Identity(), dF = Mat3::Zero(), T = Mat3::Zero();
+      for (int a = 0; a < npe; ++a) {
+        const Eigen::Map<const Eigen::RowVector3d> ga(g + 3 * a);
+        F += basis.U.col(k).segment<3>(3 * n[a]) * ga;
+        dF += basis.dU.col(k).segment<3>(3 * n[a]) * ga;
+        T += basis.W.col(k).segment<3>(3 * n[a]) * ga;
+      }
+      F_[static_cast<std::size_t>(k) * np + i] = F;
+      dF_[static_cast<std::size_t>(k) * np + i] = dF;
+      T_[static_cast<std::size_t>(k) * np + i] = T;
+    }
+    {
+      const std::vector<Mat3> m = spline_slopes<Mat3>(basis.theta, [&](std::size_t k) { return T_[k * np + i]; });
+      if (dT_.empty()) dT_.resize(T_.size());
+      for (int k = 0; k < ns_; ++k) dT_[static_cast<std::size_t>(k) * np + i] = m[static_cast<std::size_t>(k)];
+    }
+    double* B = B_.data() + static_cast<std::size_t>(i) * 9 * r_;
+    for (int j = 0; j < r_; ++j) {
+      Mat3 Bj = Mat3::Zero();
+      for (int a = 0; a < npe; ++a)
+        Bj += basis.Phi.col(j).segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+      for (int c = 0; c < 9; ++c) B[c * r_ + j] = Bj(c);
+    }
+  }
+}
+
+std::vector<double> KeptPoints::initial_history() const {
+  std::vector<double> h(history_size_, 0.0);
+  for (const Group& gr : groups_)
+    for (int i = gr.begin; i < gr.end; ++i)
+      gr.material->init_state(std::span<double>(h).subspan(gr.state_offset + static_cast<std::size_t>(i - gr.begin) * gr.state_size,
+                                                            gr.state_size));
+  return h;
+}
+
+std::vector<double> KeptPoints::history_scalars(const std::vector<double>& history) const {
+  std::vector<double> out(2 * static_cast<std::size_t>(size()), 0.0);
+  for (const Group& gr : groups_) {
+    if (gr.state_size == 0) continue;
+    for (int i = gr.begin; i < gr.end; ++i) {
+      const PointFields f = gr.material->fields(std::span<const double>(history).subspan(
+          gr.state_offset + static_cast<std::size_t>(i - gr.begin) * gr.state_size, gr.state_size));
+      out[2 * i] = f.fatigue_damage;
+      out[2 * i + 1] = f.viscous_strain;
+    }
+  }
+  return out;
+}
+
+void KeptPoints::force(double theta, const Eigen::VectorXd& q, const TimeStep& ts, std::span<const double> old,
+                       std::span<double> trial, Eigen::VectorXd& g, Eigen::MatrixXd* jac) const {
+  const int n1 = r_ + 1, np = size();
+  const int k = path_segment_index(basis_.theta, theta);
+  const Hermite h((theta - basis_.theta[k]) / (basis_.theta[k + 1] - basis_.theta[k]), basis_.theta[k + 1] - basis_.theta[k]);
+  const Mat3* F0 = F_.data() + static_cast<std::size_t>(k) * np;
+  const Mat3* F1 = F0 + np;
+  const Mat3* M0 = dF_.data() + static_cast<std::size_t>(k) * np;
+  const Mat3* M1 = M0 + np;
+  const Mat3* T0 = T_.data() + static_cast<std::size_t>(k) * np;
+  const Mat3* T1 = T0 + np;
+  const Mat3* S0 = dT_.data() + static_cast<std::size_t>(k) * np;
+  const Mat3* S1 = S0 + np;
+  // Chunks of up to kChunk points of one group: one batched evaluate each, partial sums per chunk,
+  // added in chunk order (the result does not depend on the thread count).
+  constexpr int kChunk = 32;
+  struct Chunk {
+    int group, begin, end;
+  };
+  std::vector<Chunk> chunks;
+  for (int gi = 0; gi < static_cast<int>(groups_.size()); ++gi)
+    for (int b = groups_[gi].begin; b < groups_[gi].end; b += kChunk)
+      chunks.push_back({gi, b, std::min(b + kChunk, groups_[gi].end)});
+  const bool tangent = jac != nullptr;
+  const std::size_t jsz = tangent ? static_cast<std::size_t>(n1) * n1 : 0;
+  std::vector<double> part(chunks.size() * (n1 + jsz), 0.0);
+  std::atomic<int> bad{INT_MAX};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::array<Mat3, kChunk> F, Ft, Tw, Twt;
+    std::array<PointResponse, kChunk> resp;
+    Eigen::Matrix<double, 9, Eigen::Dynamic> D(9, n1), Dt(9, n1);
+    for (std::size_t c = range.begin(); c < range.end(); ++c) {
+      const Chunk& ch = chunks[c];
+      const Group& gr = groups_[ch.group];
+      const int m = ch.end - ch.begin;
+      bool ok = true;
+      for (int j = 0; j < m; ++j) {
+        const int i = ch.begin + j;
+        F[j] = h(F0[i], F1[i], M0[i], M1[i], &Ft[j]);
+        Tw[j] = tangent ? h(T0[i], T1[i], S0[i], S1[i], &Twt[j]) : h.value(T0[i], T1[i], S0[i], S1[i]);
+        const double* B = B_.data() + static_cast<std::size_t>(i) * 9 * r_;
+        for (int cc = 0; cc < 9; ++cc) {
+          double s = 0.0;
+          for (int jj = 0; jj < r_; ++jj) s += B[cc * r_ + jj] * q[jj];
+          F[j](cc) += s;
+        }
+        const double J = F[j].determinant();
+        if (!(J > 0.0) || !std::isfinite(J)) ok = false;
+      }
+      if (!ok) {
+        for (int j = 0; j < m; ++j) {
+          const double J = F[j].determinant();
+          if (!(J > 0.0) || !std::isfinite(J)) {
+            int cur = bad.load(), e = element_[ch.begin + j];
+            while (e < cur && !bad.compare_exchange_weak(cur, e)) {
+            }
+          }
+        }
+        continue;
+      }
+      const std::size_t so = gr.state_offset + static_cast<std::size_t>(ch.begin - gr.begin) * gr.state_size;
+      const std::size_t sl = static_cast<std::size_t>(m) * gr.state_size;
+      std::span<const double> s_old = gr.state_size > 0 && !old.empty() ? old.subspan(so, sl) : std::span<const double>();
+      std::span<double> s_new = gr.state_size > 0 && !trial.empty() ? trial.subspan(so, sl) : std::span<double>();
+      gr.material->evaluate(std::span<const Mat3>(F.data(), m), ts, s_old, s_new, std::span<PointResponse>(resp.data(), m), tangent);
+      double* gp = part.data() + c * (n1 + jsz);
+      Eigen::Map<Eigen::MatrixXd> Jp(gp + n1, tangent ? n1 : 0, tangent ? n1 : 0);
+      for (int j = 0; j < m; ++j) {
+        const int i = ch.begin + j;
+        const Mat3 P = resp[j].P();
+        if (!P.allFinite()) {
+          int cur = bad.load(), e = element_[i];
+          while (e < cur && !bad.compare_exchange_weak(cur, e)) {
+          }
+          break;
+        }
+        const double W = weight_[i];
+        const double* B = B_.data() + static_cast<std::size_t>(i) * 9 * r_;
+        gp[0] += W * P.cwiseProduct(Tw[j]).sum();
+        for (int cc = 0; cc < 9; ++cc) {
+          const double Pc = W * P(cc);
+          for (int jj = 0; jj < r_; ++jj) gp[1 + jj] += Pc * B[cc * r_ + jj];
+        }
+        if (!tangent) continue;
+        for (int cc = 0; cc < 9; ++cc) {
+          D(cc, 0) = Ft[j](cc);
+          Dt(cc, 0) = Tw[j](cc);
+          for (int jj = 0; jj < r_; ++jj) Dt(cc, 1 + jj) = D(cc, 1 + jj) = B[cc * r_ + jj];
+        }
+        const Mat9 A = resp[j].A();
+        Jp.noalias() += W * (Dt.transpose() * (A * D));
+        Jp(0, 0) += W * P.cwiseProduct(Twt[j]).sum();
+      }
+    }
+  });
+  if (bad.load() != INT_MAX) {
+    std::ostringstream s;
+    s << "reduced model: element " << bad.load() + 1
+      << " inverted or gave a non-finite stress at t = " << ts.time_s
+      << " s (the reduced state left the range its basis describes, or the actuator is past its limit point)";
+    throw PhysicsError(s.str(), bad.load(), ts.time_s);
+  }
+  g = Eigen::VectorXd::Zero(n1);
+  if (tangent) *jac = Eigen::MatrixXd::Zero(n1, n1);
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    const double* gp = part.data() + c * (n1 + jsz);
+    g += Eigen::Map<const Eigen::VectorXd>(gp, n1);
+    if (tangent) *jac += Eigen::Map<const Eigen::MatrixXd>(gp + n1, n1, n1);
+  }
+}
+
+}  // namespace rom_detail
+
+// ================================================================ ReducedOrderModel
+namespace {
+
+/// Values of per-sample vectors y (rows x ns) at segment k with Hermite h, and their theta-slope
+/// (slopes dy given per sample, same layout).
+struct Splined {
+  Eigen::VectorXd v, d;
+};
+Splined spline_at(const Eigen::MatrixXd& y, const Eigen::MatrixXd& dy, int k, const Hermite& h) {
+  Splined s;
+  const Eigen::VectorXd y0 = y.col(k), y1 = y.col(k + 1), m0 = dy.col(k), m1 = dy.col(k + 1);
+  s.v = h.value(y0, y1, m0, m1);
+  s.d = h.slope(y0, y1, m0, m1);
+  return s;
+}
+
+Eigen::MatrixXd slopes_of(const std::vector<double>& theta, const Eigen::MatrixXd& y) {
+  const std::vector<Eigen::VectorXd> m =
+      spline_slopes<Eigen::VectorXd>(theta, [&](std::size_t k) { return Eigen::VectorXd(y.col(static_cast<Eigen::Index>(k))); });
+  Eigen::MatrixXd out(y.rows(), y.cols());
+  for (std::size_t k = 0; k < m.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = m[k];
+  return out;
+}
+
+std::vector<Eigen::MatrixXd> slopes_of(const std::vector<double>& theta, const std::vector<Eigen::MatrixXd>& y) {
+  return spline_slopes<Eigen::MatrixXd>(theta, [&](std::size_t k) { return y[k]; });
+}
+
+}  // namespace
+
+struct ReducedOrderModel::Impl {
+  std::unique_ptr<rom_detail::KeptPoints> points;
+  // Spline slopes (theta) of the per-sample operators.
+  std::vector<double> dp;                   ///< monotone slopes of p_el
+  std::vector<double> dwg;                  ///< slopes of w^T g (spline)
+  Eigen::MatrixXd db, dc, dh, dgt, dgauge;  ///< slopes of b (exact), c, h, gt, gauge
+  std::vector<Eigen::MatrixXd> dK, dH, dKref;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  std::vector<int> tip_nodes;               ///< nodes whose displacement the angle needs
+};
+
+ReducedOrderModel::ReducedOrderModel(const Model& reference, const ReducedBasis& basis, const Model& model)
+    : reference_(reference), basis_(basis), model_(model), impl_(std::make_unique<Impl>()) {
+  if (basis.dofs() != reference.num_dofs() || model.num_dofs() != reference.num_dofs() ||
+      model.mesh.num_elements() != reference.mesh.num_elements())
+    throw InputError("reduced model: the basis, the reference and the run's model must share one mesh (basis " +
+                     std::to_string(basis.dofs()) + " dof, reference " + std::to_string(reference.num_dofs()) +
+                     ", model " + std::to_string(model.num_dofs()) + "); rebuild the basis for this mesh");
+  if (basis.stiff_part.size() != reference.parts.size())
+    throw InputError("reduced model: the reference has other parts than the basis was built for; rebuild the basis");
+  // Elements of the stiff parts (the fabric) must keep the reference's material; the soft parts may
+  // differ in anything, per element (region scales split a part into several).
+  std::vector<char> checked(model.parts.size(), 0);
+  for (int e = 0; e < model.mesh.num_elements(); ++e) {
+    const int mp = model.element_part[e];
+    const int rp = reference.element_part[e];
+    if (checked[mp]) continue;
+    checked[mp] = 1;
+    const Material& a = *model.parts[mp].material;
+    if (!basis.stiff_part[rp]) {
+      if (a.nonlocal().radius_m > 0.0)
+        throw InputError("reduced model: part '" + model.parts[mp].name + "' has a non-local driver (nonlocal_radius_mm > 0), " +
+                         "which needs every material point; run the full FEM (solver.model = \"full\")");
+      continue;
+    }
+    const Material& b = *reference.parts[rp].material;
+    if (a.name() != b.name() || a.initial_shear_modulus() != b.initial_shear_modulus() ||
+        a.initial_bulk_modulus() != b.initial_bulk_modulus() || a.state_size() != 0)
+      throw InputError("reduced model: part '" + model.parts[mp].name + "' is stiff (the fabric) and the reduced model keeps it " +
+                       "linear about the reference path, so its material must equal the reference's (" + b.name() +
+                       "); run the full FEM (solver.model = \"full\") to change it");
+  }
+  impl_->points = std::make_unique<rom_detail::KeptPoints>(model, basis);
+  const std::vector<double>& th = basis.theta;
+  impl_->dp = monotone_slopes(th, basis.p);
+  impl_->dwg = spline_slopes<double>(th, [&](std::size_t k) { return basis.wg[k]; });
+  impl_->db = basis.db;  // b' = Phi^T H_V u_el' exactly
+  impl_->dc = slopes_of(th, basis.c);
+  impl_->dh = slopes_of(th, basis.h);
+  impl_->dgt = slopes_of(th, basis.gt);
+  impl_->dgauge = slopes_of(th, basis.gauge);
+  impl_->dK = slopes_of(th, basis.K);
+  impl_->dH = slopes_of(th, basis.H);
+  impl_->dKref = slopes_of(th, basis.Kref);
+  impl_->gravity = model.gravity_m_s2;
+}
+
+ReducedOrderModel::~ReducedOrderModel() = default;
+
+int ReducedOrderModel::num_points() const { return impl_->points->size(); }
+std::size_t ReducedOrderModel::history_size() const { return impl_->points->history_size(); }
+std::vector<double> ReducedOrderModel::initial_history() const { return impl_->points->initial_history(); }
+std::vector<double> ReducedOrderModel::history_scalars(const std::vector<double>& history) const {
+  return impl_->points->history_scalars(history);
+}
+int ReducedOrderModel::element_of_point(int i) const { return impl_->points->element(i); }
+
+Eigen::VectorXd ReducedOrderModel::displacement(const ReducedCoordinates& z) const {
+  const int k = path_segment_index(basis_.theta, z.theta);
+  const Hermite h((z.theta - basis_.theta[k]) / (basis_.theta[k + 1] - basis_.theta[k]), basis_.theta[k + 1] - basis_.theta[k]);
+  Eigen::VectorXd u = h.value<Eigen::VectorXd>(basis_.U.col(k), basis_.U.col(k + 1), basis_.dU.col(k), basis_.dU.col(k + 1));
+  if (z.q.size() > 0) u.noalias() += basis_.Phi * z.q;
+  return u;
+}
+
+double ReducedOrderModel::angle_deg(const ReducedCoordinates& z, double previous_deg, double* plane_rms_m) const {
+  const AngleResult a = bending_angle(model_, displacement(z));
+  if (plane_rms_m) *plane_rms_m = a.plane_rms_m;
+  return unwrap_deg(a.angle_deg, previous_deg);
+}
+
+double ReducedOrderModel::cavity_volume(const ReducedCoordinates& z) const {
+  const std::vector<double>& th = basis_.theta;
+  const int k = path_segment_index(th, z.theta);
+  const Hermite h((z.theta - th[k]) / (th[k + 1] - th[k]), th[k + 1] - th[k]);
+  double V = h.value(basis_.V[k], basis_.V[k + 1], basis_.dV[k], basis_.dV[k + 1]);
+  if (z.q.size() > 0) V += spline_at(basis_.b, impl_->db, k, h).v.dot(z.q);
+  return V;
+}
+
+Eigen::VectorXd ReducedOrderModel::residual(const ReducedCoordinates& z, double p_Pa, const TimeStep& ts,
+                                            const std::vector<double>& history_old, std::vector<double>& history_new,
+                                            Eigen::MatrixXd* jacobian) const {
+  const ReducedBasis& B = basis_;
+  const int r = B.num_modes(), n1 = r + 1;
+  const std::vector<double>& th = B.theta;
+  const int k = path_segment_index(th, z.theta);
+  const double dth = th[k + 1] - th[k];
+  const Hermite h((z.theta - th[k]) / dth, dth);
+  const Eigen::VectorXd& q = z.q;
+
+  // The exact reference, linearised in q about the path.
+  double dpel = 0.0;
+  const double pel = h(B.p[k], B.p[k + 1], impl_->dp[k], impl_->dp[k + 1], &dpel);
+  const double Vp = h.value(B.wg[k], B.wg[k + 1], impl_->dwg[k], impl_->dwg[k + 1]);
+  const double Vpp = h.slope(B.wg[k], B.wg[k + 1], impl_->dwg[k], impl_->dwg[k + 1]);
+  const Splined b = spline_at(B.b, impl_->db, k, h), c = spline_at(B.c, impl_->dc, k, h), hh = spline_at(B.h, impl_->dh, k, h);
+  const Splined gt = spline_at(B.gt, impl_->dgt, k, h), gauge = spline_at(B.gauge, impl_->dgauge, k, h);
+  const Eigen::MatrixXd Kq = h.value(B.K[k], B.K[k + 1], impl_->dK[k], impl_->dK[k + 1]);
+  const Eigen::MatrixXd Hq = h.value(B.H[k], B.H[k + 1], impl_->dH[k], impl_->dH[k + 1]);
+  const double dp = pel - p_Pa;
+  Eigen::VectorXd R = Eigen::VectorXd::Zero(n1 + 1);
+  R[0] = dp * Vp + (c.v + dp * hh.v).dot(q);
+  R.segment(1, r) = dp * b.v + (Kq + dp * Hq) * q;
+
+  // Gravity: -J^T f_g (f_g linear in the acceleration).
+  const Eigen::Vector3d& gvec = impl_->gravity;
+  if (!gvec.isZero()) {
+    R[0] -= gt.v.dot(gvec);
+    R.segment(1, r) -= B.gq * gvec;
+  }
+
+  // The hyper-reduced departure from the reference: G_hat(z) - G_hat_ref(theta) - K_hat_ref(theta) q.
+  Eigen::VectorXd G;
+  Eigen::MatrixXd JG;
+  impl_->points->force(z.theta, q, ts, history_old, history_new, G, jacobian ? &JG : nullptr);
+  // G_hat_ref on the fine grid (linear between its points); outside the path, its end values.
+  const int nsub = ReducedBasis::kRefSub;
+  double x = std::clamp(h.a, 0.0, 1.0) * nsub;
+  const int j = std::min(static_cast<int>(x), nsub - 1);
+  const Eigen::Index col = static_cast<Eigen::Index>(k) * (nsub + 1) + j;
+  const Eigen::VectorXd Gref = B.Gref.col(col) + (x - j) * (B.Gref.col(col + 1) - B.Gref.col(col));
+  const Eigen::VectorXd dGref = h.inside() ? Eigen::VectorXd((B.Gref.col(col + 1) - B.Gref.col(col)) * (nsub / dth))
+                                           : Eigen::VectorXd::Zero(n1);
+  const Eigen::MatrixXd Kref = h.value(B.Kref[k], B.Kref[k + 1], impl_->dKref[k], impl_->dKref[k + 1]);
+  R.head(n1) += G - Gref - Kref.rightCols(r) * q;
+
+  // Gauge: q is mass-orthogonal to u_el'(theta); multiplier lambda.
+  R[0] += z.lambda * gauge.d.dot(q);
+  R.segment(1, r) += z.lambda * gauge.v;
+  R[n1] = gauge.v.dot(q);
+
+  if (jacobian) {
+    Eigen::MatrixXd& Jm = *jacobian;
+    Jm = Eigen::MatrixXd::Zero(n1 + 1, n1 + 1);
+    // d/dtheta of the linearised reference.
+    const Eigen::MatrixXd dKq = h.slope(B.K[k], B.K[k + 1], impl_->dK[k], impl_->dK[k + 1]);
+    const Eigen::MatrixXd dHq = h.slope(B.H[k], B.H[k + 1], impl_->dH[k], impl_->dH[k + 1]);
+    Jm(0, 0) = dpel * Vp + dp * Vpp + (c.d + dpel * hh.v + dp * hh.d).dot(q);
+    Jm.block(1, 0, r, 1) = dpel * b.v + dp * b.d + (dKq + dpel * Hq + dp * dHq) * q;
+    Jm.block(0, 1, 1, r) = (c.v + dp * hh.v).transpose();
+    Jm.block(1, 1, r, r) = Kq + dp * Hq;
+    if (!gvec.isZero()) {
+      Jm(0, 0) -= gt.d.dot(gvec);
+    }
+    // Hyper-reduced part.
+    const Eigen::MatrixXd dKref = h.slope(B.Kref[k], B.Kref[k + 1], impl_->dKref[k], impl_->dKref[k + 1]);
+    Jm.topLeftCorner(n1, n1) += JG;
+    Jm.block(0, 0, n1, 1) -= dGref + dKref.rightCols(r) * q;
+    Jm.block(0, 1, n1, r) -= Kref.rightCols(r);
+    // Gauge.
+    const Eigen::VectorXd ddgauge = h.curvature<Eigen::VectorXd>(B.gauge.col(k), B.gauge.col(k + 1), impl_->dgauge.col(k),
+                                                                 impl_->dgauge.col(k + 1));
+    Jm(0, 0) += z.lambda * ddgauge.dot(q);
+    Jm.block(0, 1, 1, r) += z.lambda * gauge.d.transpose();
+    Jm.block(1, 0, r, 1) += z.lambda * gauge.d;
+    Jm.block(0, n1, 1, 1)(0, 0) = gauge.d.dot(q);
+    Jm.block(1, n1, r, 1) = gauge.v;
+    Jm(n1, 0) = gauge.d.dot(q);
+    Jm.block(n1, 1, 1, r) = gauge.v.transpose();
+  }
+  return R;
+}
+
+// ================================================================ ReducedRun
+struct ReducedRun::Segment {
+  int trial;
+  double t0, t1, g0, g1, p0, p1;
+  bool report;
+};
+
+namespace {
+
+struct HistoryStep {
+  double change = 0.0, error = 0.0;
+  int change_point = -1, error_point = -1;
+};
+
+// As engine/quasi_static.cpp: the largest change of (fatigue damage, viscous strain) over the kept
+// points, and with the previous step the largest local-error estimate (Milne's device).
+HistoryStep history_step(const std::vector<double>& prev, const std::vector<double>& cur, const std::vector<double>& next,
+                         double r) {
+  HistoryStep out;
+  for (std::size_t i = 0; i < next.size(); i += 2) {
+    const int point = static_cast<int>(i / 2);
+    const double c = std::abs(next[i] - cur[i]) + std::abs(next[i + 1] - cur[i + 1]);
+    if (c > out.change) out.change = c, out.change_point = point;
+    if (prev.empty()) continue;
+    double e = 0.0;
+    for (std::size_t k = i; k < i + 2; ++k) e += std::abs((next[k] - cur[k]) - r * (cur[k] - prev[k]));
+    e *= r / (1.0 + r);
+    if (e > out.error) out.error = e, out.error_point = point;
+  }
+  return out;
+}
+
+}  // namespace
+
+ReducedRun::ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options) : rom_(rom), opt_(options) {
+  z_.q = Eigen::VectorXd::Zero(rom.num_modes());
+  z_prev_ = z_;
+  hist_ = rom.initial_history();
+  trial_ = hist_;
+  rate_dependent_ = !hist_.empty();
+}
+
+void ReducedRun::equilibrium(double p, double t, double dt) {
+  const TimeStep ts{t, dt};
+  const int n = rom_.num_modes() + 2;
+  // Predictor: along the last step's direction when the pressure keeps moving the same way.
+  ReducedCoordinates z = z_;
+  Eigen::VectorXd dz = Eigen::VectorXd::Zero(n);
+  const ReducedBasis& B = rom_.basis();
+  // Convergence on the Newton step: theta to 1e-7 deg, q to 1e-9 of the path's largest RMS displacement.
+  const double q_scale = std::sqrt(B.U.col(B.num_samples() - 1).squaredNorm() / std::max<double>(1.0, B.dofs())) + 1e-12;
+  Eigen::MatrixXd Jm;
+  Eigen::VectorXd R;
+  auto apply = [&](ReducedCoordinates& y, const Eigen::VectorXd& d, double s) {
+    y.theta += s * d[0];
+    y.q += s * d.segment(1, n - 2);
+    y.lambda += s * d[n - 1];
+  };
+  bool converged = false;
+  int it = 0;
+  for (; it < 30; ++it) {
+    R = rom_.residual(z, p, ts, hist_, trial_, &Jm);
+    ++stats_.residuals;
+    ++stats_.tangents;
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu(Jm);
+    dz = -lu.solve(R);
+    if (!dz.allFinite()) break;
+    if (std::abs(dz[0]) <= 1e-7 * (1.0 + std::abs(z.theta)) && dz.segment(1, n - 2).lpNorm<Eigen::Infinity>() <= 1e-9 * q_scale) {
+      apply(z, dz, 1.0);  // converged: the last (tiny) step, and the trial history of its state
+      rom_.residual(z, p, ts, hist_, trial_, nullptr);
+      ++stats_.residuals;
+      converged = true;
+      break;
+    }
+    // Damped step: the scaled residual must fall (rows scaled by the Jacobian's row norms).
+    Eigen::VectorXd scale = Jm.rowwise().norm().cwiseMax(1e-300).cwiseInverse();
+    const double f0 = R.cwiseProduct(scale).norm();
+    double s = 1.0;
+    // Keep theta steps moderate: a tenth of the path's span at most.
+    const double span = B.theta.back() - B.theta.front();
+    if (std::abs(dz[0]) > 0.1 * span) s = 0.1 * span / std::abs(dz[0]);
+    ReducedCoordinates y = z;
+    apply(y, dz, s);
+    bool accepted = false;
+    for (int ls = 0; ls < 8; ++ls) {
+      try {
+        const Eigen::VectorXd R1 = rom_.residual(y, p, ts, hist_, trial_, nullptr);
+        ++stats_.residuals;
+        if (R1.cwiseProduct(scale).norm() < (1.0 - 1e-4 * s) * f0 || ls == 7) {
+          accepted = true;
+          break;
+        }
+      } catch (const PhysicsError&) {
+      }
+      s *= 0.5;
+      y = z;
+      apply(y, dz, s);
+    }
+    if (!accepted) break;
+    z = y;
+    ++stats_.newton_iterations;
+  }
+  if (!converged) {
+    std::ostringstream m;
+    m << "reduced model: no equilibrium at p = " << p * 1e-3 << " kPa, t = " << t << " s after " << it
+      << " Newton iterations (theta " << z.theta << " deg); the model may be past its limit point";
+    throw PhysicsError(m.str(), -1, t);
+  }
+  z_ = z;
+  if (z.theta > B.theta.back() || z.theta < B.theta.front()) stats_.beyond_path = true;
+}
+
+void ReducedRun::solve_segment(const Segment& s) {
+  const double span = s.g1 - s.g0;
+  auto commit = [&](double t, double dt, double p, bool report) {
+    hist_.swap(trial_);
+    trial_ = hist_;
+    ++stats_.states;
+    steps_.push_back({t, dt, p, z_, report ? 0 : -1});
+  };
+  if (!rate_dependent_ || span <= 0.0) {
+    if (span > 0.0 || s.p0 != s.p1) {
+      // Elastic or instantaneous: pressure continuation in zero time (history frozen) when a direct
+      // solve fails; the end state does not depend on the way (rate-independent laws only load up).
+      const ReducedCoordinates z0 = z_;
+      const double t = s.g1, dt = span;
+      int pieces = 1;
+      for (;;) {
+        try {
+          z_ = z0;
+          for (int i = 1; i <= pieces; ++i) {
+            const double p = s.p0 + (s.p1 - s.p0) * i / pieces;
+            equilibrium(p, t, i == pieces ? dt : 0.0);
+            if (i < pieces) {
+              hist_.swap(trial_);  // a rate-independent law's loading in zero time is committed as it goes
+              trial_ = hist_;
+            }
+          }
+          break;
+        } catch (const PhysicsError&) {
+          if (pieces >= 64) throw;
+          pieces *= 4;
+          ++stats_.rejected_steps;
+        }
+      }
+      commit(t, dt, s.p1, s.report);
+    }
+    hist_prev_.clear();
+    hist_cur_.clear();
+    return;
+  }
+  auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
+  if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
+  const bool error_control = opt_.time_control == TimeControl::Error;
+  const double rate = (s.p1 - s.p0) / span;
+  const bool kink = std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_));
+  if (kink) hist_prev_.clear();
+  double t = s.g0;
+  long steps = 0;
+  while (t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1))) {
+    if (++steps > opt_.max_segment_steps) {
+      std::ostringstream m;
+      m << "reduced model: physical time stepping stalled: " << opt_.max_segment_steps << " steps in the load segment "
+        << s.g0 << " -> " << s.g1 << " s reached only t = " << t << " s";
+      throw PhysicsError(m.str(), -1, t);
+    }
+    const bool minimal = dt_suggest_ <= opt_.min_dt_s * (1.0 + 1e-9);
+    double hstep = std::min(dt_suggest_, s.g1 - t);
+    if (s.g1 - (t + hstep) < 0.25 * hstep) hstep = s.g1 - t;
+    const ReducedCoordinates z_saved = z_;
+    try {
+      equilibrium(p_at(t + hstep), t + hstep, hstep);
+    } catch (const PhysicsError&) {
+      if (minimal || hstep <= opt_.min_dt_s * (1.0 + 1e-9)) throw;
+      z_ = z_saved;
+      dt_suggest_ = std::max(opt_.min_dt_s, 0.25 * hstep);
+      ++stats_.rejected_steps;
+      continue;
+    }
+    std::vector<double> hist_new = rom_.history_scalars(trial_);
+    if (hist_cur_.empty()) hist_cur_ = rom_.history_scalars(hist_);
+    const bool estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
+    static const std::vector<double> kNoPrevious;
+    const HistoryStep hs = history_step(estimate ? hist_prev_ : kNoPrevious, hist_cur_, hist_new, estimate ? hstep / h_prev_ : 0.0);
+    const double measure = estimate ? hs.error : hs.change, order = estimate ? 2.0 : 1.0;
+    const bool reject = measure > 2.0 * opt_.time_tol && !minimal && hstep > opt_.min_dt_s * (1.0 + 1e-9);
+    if (reject) {
+      z_ = z_saved;
+      dt_suggest_ = std::max(opt_.min_dt_s, hstep * std::max(0.2, std::pow(0.9 * opt_.time_tol / measure, 1.0 / order)));
+      ++stats_.rejected_steps;
+      continue;
+    }
+    const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
+    dt_suggest_ = std::clamp(hstep * grow, opt_.min_dt_s, opt_.max_dt_s);
+    if (error_control) {
+      hist_prev_ = std::move(hist_cur_);
+      h_prev_ = hstep;
+    }
+    hist_cur_ = std::move(hist_new);
+    rate_prev_ = rate;
+    t += hstep;
+    const bool last = !(t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1)));
+    commit(t, hstep, p_at(t), last && s.report);
+  }
+}
+
+void ReducedRun::run(const LoadHistory& load, const Observer& observer) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  // The segments of QuasiStaticRun: each trial's breakpoints and reports, the release to zero and
+  // the rest before every trial but the first.
+  std::vector<Segment> segs;
+  double g = 0.0;
+  for (std::size_t k = 0; k < load.trials.size(); ++k) {
+    const TrialLoad& tl = load.trials[k];
+    const int tr = static_cast<int>(k);
+    if (k > 0) {
+      segs.push_back({tr, 0, 0, g, g, load.trials[k - 1].pressure_Pa.back(), 0.0, false});
+      if (load.rest_between_trials_s > 0) {
+        segs.push_back({tr, 0, 0, g, g + load.rest_between_trials_s, 0.0, 0.0, false});
+        g += load.rest_between_trials_s;
+      }
+      segs.push_back({tr, 0, 0, g, g, 0.0, tl.pressure(0.0), false});
+    }
+    std::vector<double> times = tl.time_s;
+    times.insert(times.end(), tl.output_s.begin(), tl.output_s.end());
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end(), [](double a, double b) { return std::abs(a - b) < 1e-12; }), times.end());
+    auto is_output = [&](double t) {
+      return std::any_of(tl.output_s.begin(), tl.output_s.end(), [&](double o) { return std::abs(o - t) < 1e-12; });
+    };
+    if (is_output(times.front())) {
+      const double t = times.front();
+      segs.push_back({tr, t, t, g + t, g + t, tl.pressure(t), tl.pressure(t), true});
+    }
+    for (std::size_t i = 1; i < times.size(); ++i)
+      segs.push_back({tr, times[i - 1], times[i], g + times[i - 1], g + times[i], tl.pressure(times[i - 1]),
+                      tl.pressure(times[i]), is_output(times[i])});
+    g += tl.duration();
+  }
+  if (!segs.empty() && (segs.front().p0 != 0.0 || !rom_.model().gravity_m_s2.isZero())) {
+    const Segment& s0 = segs.front();
+    Segment first{s0.trial, s0.t0, s0.t0, s0.g0, s0.g0, 0.0, s0.p0, false};
+    const bool rd = rate_dependent_;
+    rate_dependent_ = false;
+    if (s0.p0 == 0.0) {
+      equilibrium(0.0, s0.g0, 0.0);
+      hist_.swap(trial_);
+      trial_ = hist_;
+      steps_.push_back({s0.g0, 0.0, 0.0, z_, -1});
+    } else {
+      solve_segment(first);
+    }
+    rate_dependent_ = rd;
+  }
+  int reports = 0;
+  for (const Segment& s : segs) {
+    if (s.g1 == s.g0 && s.p0 == s.p1) {
+      // A report at a breakpoint without a step: the current state.
+    } else {
+      solve_segment(s);
+    }
+    if (!s.report) continue;
+    if (!steps_.empty() && steps_.back().time_s == s.g1) steps_.back().report = reports;
+    else steps_.push_back({s.g1, 0.0, s.p1, z_, reports});
+    StateRecord rec;
+    rec.trial = s.trial + 1;
+    rec.time_s = s.t1;
+    rec.global_time_s = s.g1;
+    rec.pressure_Pa = s.p1;
+    const Eigen::VectorXd u = rom_.displacement(z_);
+    const AngleResult a = bending_angle(rom_.model(), u);
+    rec.angle_deg = unwrap_deg(a.angle_deg, last_angle_);
+    last_angle_ = rec.angle_deg;
+    rec.plane_rms_m = a.plane_rms_m;
+    rec.cavity_volume_m3 = rom_.cavity_volume(z_);
+    ++reports;
+    if (observer) observer(rec, z_, u);
+  }
+  stats_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+}
+
+}  // namespace pneufem

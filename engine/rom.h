@@ -1,0 +1,249 @@
+#pragma once
+// A reduced-order model (ROM) of the quasi-static run (engine/quasi_static.h) that follows the full
+// FEM through damage, creep and any other history effect at a cost that does not grow with the mesh.
+//
+// Kinematics. The displacement is kept on a manifold around the elastic loading path:
+//
+//     u(theta, q) = u_el(theta) + Phi q,
+//
+// u_el(theta) the elastic FEM solution traced in load control and parametrised by its bending angle
+// theta (deg; a C2 cubic spline through the samples, engine/path_spline.h), which carries the large
+// rotation of the actuator, and Phi (dofs x r) correction modes: how the deformation departs from the
+// elastic shape when parts of the body soften or stiffen. They come from the linear responses of the
+// elastic path to softening each of a few dozen spatial clusters of the soft elements,
+//     du_c = K_T(theta_k)^-1 f_iso,c(theta_k)     (K_T the tangent of the path's equilibrium, with the
+//                                                  follower load's stiffness; f_iso,c the isochoric
+//                                                  internal force of cluster c's elements),
+// at several samples theta_k, made mass-orthogonal to the path's tangent and compressed by POD.
+// Every history effect of damage/ acts on the isochoric stress, locally (Mullins, fatigue, Prony
+// terms, region scales), so a local softening is the generic first-order deformation change; no
+// effect's constants enter the basis (the same basis serves any constants and any registered effect).
+// More modes can be added from snapshots (an FEM state, an indicator's correction).
+//
+// Equations: a Petrov-Galerkin projection of the equilibrium R(u) = f_int(u) - p dV/du - f_g = 0. The
+// q rows are Galerkin (tested with Phi). The theta row is tested with the bending angle's influence
+// vector at the path sample, w = K_T^-1 grad(angle) / (g^T K_T^-1 grad(angle)), instead of the path
+// tangent u_el': to first order, w^T dR is the change of angle that ANY force perturbation dR causes
+// (the adjoint of the output), so the theta balance gets the angle right even when the departure of the
+// state from the path lies outside the span of Phi. Damage is such a case: the FEM's damaged state
+// departs from the path by a local, within-element redistribution that no compact basis holds, and a
+// Galerkin theta row (test u_el') then overestimated every softening about twofold, as the 1-dof path
+// model does. The residual is written in a difference ("control variate") form that keeps the elastic
+// reference exact and the stiff fabric unlocked:
+//
+//     r(theta, q) = E(theta, q; p) + [G_hat(theta, q) - G_hat_ref(theta) - K_hat_ref(theta) q] - T^T f_g
+//
+//   E:  the exact FEM reference residual linearised in q about the path,
+//         E_theta = (p_el(theta) - p) w^T g + [c(theta) + (p_el - p) h(theta)] . q
+//         E_q     = (p_el(theta) - p) b(theta) + [K(theta) + (p_el - p) H(theta)] q
+//       with p_el(theta) the path's pressure, g = dV/du, b = Phi^T g, c = Phi^T K_T w,
+//       K = Phi^T K_T Phi, h = Phi^T H_V w, H = Phi^T H_V Phi (H_V = dg/du, the load stiffness per
+//       unit pressure), all computed once per path sample from the assembled FEM tangent and splined
+//       in theta. On the path (q = 0) E is the exact projected residual of the reference, so the elastic
+//       model is reproduced exactly whatever the rest; the fabric (10^5 times stiffer than the silicone)
+//       enters only here, linearly in q: a linearised rotation of a correction mode does not stretch it
+//       to second order, which locked every linear reduced basis tried before (BENCHMARKS.md §7).
+//   G_hat: the hyper-reduced projected internal force of the soft parts with the RUN'S materials and
+//       history, sum over sampled elements e of xi_e T_e^T f_e(u_e(theta, q)) (T = [w, Phi], the test vectors); G_hat_ref, K_hat_ref the
+//       same quadrature with the reference materials at q = 0 and its q-derivative (precomputed). The
+//       bracket is the model's departure from the reference (its damage, overstress, softening) plus
+//       the soft parts' nonlinearity in q, both integrated by the sampled elements only.
+//   Hyper-reduction: energy-conserving sampling and weighting (ECSW; Farhat, Avery, Chapman & Cortial
+//       2014, IJNME 98, 625-662; Farhat, Chapman & Avery 2015, IJNME 102, 1077-1110): element weights
+//       xi_e >= 0 from non-negative least squares (engine/nnls.h) on training snapshots, per spatial
+//       cluster, so that each cluster's reduced force is reproduced within ecsw_tolerance: a softening
+//       confined to any cluster is then integrated as the FEM would. The weighted sum is a sum of
+//       element energies: the reduced model keeps a potential structure, and its cost is set by the
+//       number of sampled elements, not by the mesh.
+//   The gauge: theta and the part of Phi q along u_el'(theta) would describe the same motion, so q is
+//       kept mass-orthogonal to u_el'(theta) (one Lagrange multiplier).
+//
+// Material history lives at the sampled elements' quadrature points only, evaluated by the run's own
+// Material objects (any law and decorator; committed/trial as in the FEM). Fields of the whole mesh
+// (damage, stress) are reconstructed by replaying every element's history along the reduced
+// trajectory (engine/rom_verify.h), which also gives the a-posteriori indicator: the full residual of
+// the reconstructed state.
+//
+// Units: SI; theta in degrees; q in metres (Phi is mass-orthonormal, scaled by the total mass).
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/load_history.h"
+#include "engine/model.h"
+#include "engine/path_model.h"
+#include "engine/quasi_static.h"
+#include "engine/static_solver.h"
+
+namespace pneufem {
+
+struct RomBasisOptions {
+  int clusters = 48;              ///< spatial clusters of the soft elements (softening patterns, ECSW blocks)
+  int mode_samples = 6;           ///< path samples at which the softening responses are computed
+  int max_modes = 16;             ///< correction modes kept
+  double pod_tolerance = 1e-4;    ///< relative energy of the responses the kept modes may leave out
+  double ecsw_tolerance = 1e-2;   ///< relative residual of each cluster's hyper-reduced training force
+  int training_fields = 3;        ///< random cluster-wise softening fields per mode sample (ECSW training)
+  double training_softening = 0.3;  ///< largest softening of a cluster in a training field
+  double training_amplitude = 0.05;  ///< cap of a field's response, relative to the path's top RMS displacement
+  double stiff_modulus_ratio = 100.0;  ///< parts this much stiffer than the softest are "stiff" (fabric)
+  bool hyper_reduce = true;       ///< false: every soft element, weight 1 (for tests and verification)
+  bool verbose = false;
+};
+
+/// The offline part of a reduced model: everything computed from the elastic reference model and its
+/// path. Plain data; to_doubles / from_doubles store it with its exact bits (app/result_cache.h).
+struct ReducedBasis {
+  // The path: samples theta_k (deg), p_k (Pa), displacements U (dofs x ns) and their spline slopes dU.
+  std::vector<double> theta, p;
+  Eigen::MatrixXd U, dU;
+  Eigen::MatrixXd Phi;            ///< correction modes (dofs x r)
+  // Reference operators per path sample (see the header comment).
+  Eigen::MatrixXd W;              ///< dofs x ns: the theta row's test vector w (below), per sample
+  std::vector<double> V, dV;      ///< cavity volume (m^3) and V' = u_el'^T g
+  std::vector<double> wg;         ///< w^T g (1 where w is the angle's influence vector)
+  Eigen::MatrixXd b, db, c, h;    ///< r x ns: b = Phi^T g, db = Phi^T H_V u_el' (= b'), c = Phi^T K_T w, h = Phi^T H_V w
+  std::vector<Eigen::MatrixXd> K, H;  ///< r x r per sample
+  Eigen::MatrixXd gt;             ///< 3 x ns: w^T f_g per unit acceleration along x, y, z
+  Eigen::MatrixXd gq;             ///< r x 3: Phi^T f_g per unit acceleration
+  Eigen::MatrixXd gauge;          ///< r x ns: Phi^T M u_el' (q is kept orthogonal to it)
+  // Hyper-reduction: sampled elements and their ECSW weights; the reference's hyper-reduced force at
+  // q = 0 on a fine grid of every segment (kRefSub + 1 points each) and its q-Jacobian per sample.
+  std::vector<int> elements;
+  std::vector<double> weights;
+  static constexpr int kRefSub = 64;
+  Eigen::MatrixXd Gref;           ///< (r + 1) x (segments * (kRefSub + 1))
+  std::vector<Eigen::MatrixXd> Kref;  ///< (r + 1) x (r + 1) per sample: d G_hat_ref / d(theta, q) at q = 0
+  std::vector<char> stiff_part;   ///< per part of the reference: 1 = stiff (linear reference only)
+  // What the construction saw (reported in summaries).
+  struct Info {
+    int clusters = 0, responses = 0, soft_elements = 0;
+    double pod_energy_left = 0.0;     ///< relative energy of the responses outside the kept modes
+    double ecsw_worst_residual = 0.0; ///< largest relative residual of a cluster's training fit
+    double build_s = 0.0;
+  } info;
+
+  int num_modes() const { return static_cast<int>(Phi.cols()); }
+  int num_samples() const { return static_cast<int>(theta.size()); }
+  long dofs() const { return static_cast<long>(U.rows()); }
+
+  std::vector<double> to_doubles() const;
+  /// Throws InputError when the data are not a basis (damaged, or of another format version).
+  static ReducedBasis from_doubles(const std::vector<double>& d);
+};
+
+/// Builds the basis of `reference` (elastic: materials without history, no gravity) from its traced
+/// path (engine/path_model.h). Throws InputError for a reference with history or a trace that does
+/// not fit it, PhysicsError when no sample's tangent could be factorised.
+/// `snapshots` (optional): displacements of states the basis should contain (e.g. FEM states of a run
+/// with history effects); their departures from the path at equal angle join the softening responses.
+ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& options,
+                                 const std::vector<Eigen::VectorXd>& snapshots = {});
+
+/// A reduced state: path coordinate, correction amplitudes, gauge multiplier.
+struct ReducedCoordinates {
+  double theta = 0.0;
+  Eigen::VectorXd q;
+  double lambda = 0.0;
+};
+
+/// One accepted physical step of a reduced run: enough to replay every element's history along it.
+struct ReducedStep {
+  double time_s = 0.0, dt_s = 0.0;  ///< global time at the end of the step and its length (0: a jump)
+  double pressure_Pa = 0.0;
+  ReducedCoordinates z;
+  int report = -1;                  ///< index of the report made at this state, or -1
+};
+
+struct ReducedRunStats {
+  long states = 0, rejected_steps = 0, newton_iterations = 0, tangents = 0, residuals = 0;
+  double wall_s = 0.0;
+  bool beyond_path = false;  ///< theta left the traced path (extrapolated): trust it less
+};
+
+/// The online part: a basis bound to the reference model (same mesh) and to a run's model (any
+/// materials on the soft parts, gravity). Evaluates the reduced residual and its Jacobian.
+class ReducedOrderModel {
+ public:
+  /// Throws InputError when the basis does not belong to the reference's mesh, or when a stiff part
+  /// of `model` (the fabric) has a material that differs in name or initial moduli from the
+  /// reference's (the reduced model keeps stiff parts linear about the reference path).
+  ReducedOrderModel(const Model& reference, const ReducedBasis& basis, const Model& model);
+  ~ReducedOrderModel();
+  ReducedOrderModel(const ReducedOrderModel&) = delete;
+  ReducedOrderModel& operator=(const ReducedOrderModel&) = delete;
+
+  const ReducedBasis& basis() const { return basis_; }
+  const Model& model() const { return model_; }
+  int num_modes() const { return basis_.num_modes(); }
+  int num_points() const;                      ///< material points kept (sampled elements x points)
+  std::size_t history_size() const;            ///< doubles of history at the kept points
+  std::vector<double> initial_history() const;
+
+  /// Full displacement (all dofs) of reduced coordinates z.
+  Eigen::VectorXd displacement(const ReducedCoordinates& z) const;
+  /// Bending angle (deg, unwrapped near `previous_deg`) and tip-plane residual of z.
+  double angle_deg(const ReducedCoordinates& z, double previous_deg, double* plane_rms_m = nullptr) const;
+  /// Cavity volume (m^3), linearised in q about the path (as the equations are).
+  double cavity_volume(const ReducedCoordinates& z) const;
+
+  /// Reduced residual (r + 2: theta row, q rows, gauge row) at z, pressure p, physical step ts; reads
+  /// the committed history, writes the trial history of z. With `jacobian`, also d residual / dz
+  /// (theta column by a forward difference, the rest analytic). Throws PhysicsError naming the
+  /// element of a kept point whose F inverted or whose stress is not finite.
+  Eigen::VectorXd residual(const ReducedCoordinates& z, double p_Pa, const TimeStep& ts,
+                           const std::vector<double>& history_old, std::vector<double>& history_new,
+                           Eigen::MatrixXd* jacobian) const;
+
+  /// Per kept point (2 values: fatigue damage, viscous strain), as Assembler::history_scalars.
+  std::vector<double> history_scalars(const std::vector<double>& history) const;
+  int element_of_point(int i) const;           ///< mesh element of kept point i
+
+ private:
+  struct Impl;
+  const Model& reference_;
+  const ReducedBasis& basis_;
+  const Model& model_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Quasi-static march through a load history in the reduced model: the same segments, physical step
+/// control (QuasiStaticOptions: time_control, time_tol, min/max_dt_s) and reports as QuasiStaticRun,
+/// with Newton in the reduced coordinates.
+class ReducedRun {
+ public:
+  /// Called at every report with its record, the reduced coordinates and the full displacement.
+  using Observer = std::function<void(const StateRecord&, const ReducedCoordinates&, const Eigen::VectorXd& u)>;
+  ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options);
+
+  void run(const LoadHistory& load, const Observer& observer);
+
+  const std::vector<ReducedStep>& trajectory() const { return steps_; }
+  const ReducedRunStats& stats() const { return stats_; }
+  const ReducedCoordinates& coordinates() const { return z_; }
+  const std::vector<double>& history() const { return hist_; }
+
+ private:
+  struct Segment;
+  void solve_segment(const Segment& s);
+  /// Equilibrium at (p, t) after a step dt from the committed state; on success commits and
+  /// records the step. Throws PhysicsError when Newton fails.
+  void equilibrium(double p_Pa, double t_s, double dt_s);
+
+  const ReducedOrderModel& rom_;
+  QuasiStaticOptions opt_;
+  ReducedCoordinates z_, z_prev_;
+  double p_prev_ = 0.0;
+  std::vector<double> hist_, trial_;
+  std::vector<ReducedStep> steps_;
+  ReducedRunStats stats_;
+  double dt_suggest_ = 0.0, last_angle_ = 0.0;
+  std::vector<double> hist_prev_, hist_cur_;
+  double h_prev_ = 0.0, rate_prev_ = 0.0;
+  bool rate_dependent_ = false;
+};
+
+}  // namespace pneufem

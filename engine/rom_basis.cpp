@@ -1,0 +1,695 @@
+// Offline part of the reduced-order model (engine/rom.h): path, correction modes, reference
+// operators and the ECSW sampling, all from the elastic reference model and its traced path.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+#include <Eigen/Eigenvalues>
+
+#include "engine/angle.h"
+#include "engine/assembly.h"
+#include "engine/linear_solver.h"
+#include "engine/nnls.h"
+#include "engine/path_spline.h"
+#include "engine/rom.h"
+#include "engine/rom_points.h"
+#include "engine/static_solver.h"
+#include "engine/tet_element.h"
+#include "core/errors.h"
+
+namespace pneufem {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// Parts at least `ratio` times stiffer (initial shear modulus) than the softest part: the fabric.
+std::vector<char> stiff_parts(const Model& model, double ratio) {
+  double soft = std::numeric_limits<double>::infinity();
+  for (const Part& p : model.parts) soft = std::min(soft, p.material->initial_shear_modulus());
+  std::vector<char> stiff(model.parts.size(), 0);
+  for (std::size_t i = 0; i < model.parts.size(); ++i)
+    stiff[i] = model.parts[i].material->initial_shear_modulus() >= ratio * soft ? 1 : 0;
+  return stiff;
+}
+
+Eigen::Vector3d centroid(const Mesh& mesh, int e) {
+  const int* n = mesh.element(e);
+  return 0.25 * (mesh.X[n[0]] + mesh.X[n[1]] + mesh.X[n[2]] + mesh.X[n[3]]);
+}
+
+/// k-means clusters (Lloyd) of the element centroids of `elements`, `k` of them, seeded by farthest
+/// points from the element nearest the centroid (deterministic; ties to the lowest index).
+std::vector<std::vector<int>> kmeans(const Mesh& mesh, const std::vector<int>& elements, int k) {
+  const std::size_t n = elements.size();
+  k = std::max(1, std::min<int>(k, static_cast<int>(n)));
+  std::vector<Eigen::Vector3d> x(n);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) mean += (x[i] = centroid(mesh, elements[i]));
+  mean /= static_cast<double>(n);
+  std::vector<Eigen::Vector3d> c;
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if ((x[i] - mean).squaredNorm() < (x[first] - mean).squaredNorm()) first = i;
+  c.push_back(x[first]);
+  std::vector<double> dmin(n, std::numeric_limits<double>::infinity());
+  while (static_cast<int>(c.size()) < k) {
+    std::size_t far = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      dmin[i] = std::min(dmin[i], (x[i] - c.back()).squaredNorm());
+      if (dmin[i] > dmin[far]) far = i;
+    }
+    c.push_back(x[far]);
+  }
+  std::vector<int> assign(n, 0);
+  for (int it = 0; it < 25; ++it) {
+    bool moved = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      int best = 0;
+      for (int j = 1; j < k; ++j)
+        if ((x[i] - c[j]).squaredNorm() < (x[i] - c[best]).squaredNorm()) best = j;
+      if (best != assign[i]) moved = true;
+      assign[i] = best;
+    }
+    std::vector<Eigen::Vector3d> sum(k, Eigen::Vector3d::Zero());
+    std::vector<int> cnt(k, 0);
+    for (std::size_t i = 0; i < n; ++i) sum[assign[i]] += x[i], ++cnt[assign[i]];
+    for (int j = 0; j < k; ++j)
+      if (cnt[j] > 0) c[j] = sum[j] / cnt[j];
+    if (!moved && it > 0) break;
+  }
+  std::vector<std::vector<int>> out(k);
+  for (std::size_t i = 0; i < n; ++i) out[assign[i]].push_back(elements[i]);
+  out.erase(std::remove_if(out.begin(), out.end(), [](const auto& v) { return v.empty(); }), out.end());
+  return out;
+}
+
+/// Clusters of the soft elements: k-means within each region, about `total` in all, in proportion
+/// to the regions' element counts (a softening confined to one region is then a sum of clusters).
+std::vector<std::vector<int>> soft_clusters(const Model& model, const std::vector<char>& stiff, int total) {
+  const Mesh& mesh = model.mesh;
+  std::map<int, std::vector<int>> by_region;
+  int soft = 0;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    if (stiff[model.element_part[e]]) continue;
+    by_region[mesh.region.empty() ? 0 : mesh.region[e]].push_back(e);
+    ++soft;
+  }
+  std::vector<std::vector<int>> out;
+  for (auto& [region, elems] : by_region) {
+    const int k = std::max(1, static_cast<int>(std::lround(static_cast<double>(total) * elems.size() / std::max(1, soft))));
+    for (auto& c : kmeans(mesh, elems, k)) out.push_back(std::move(c));
+  }
+  return out;
+}
+
+/// Internal force of element e (3 npe) at u with its (elastic) material, the whole stress and its
+/// isochoric part.
+void element_force(const Model& model, const ElementGeometry& geom, int e, const Eigen::VectorXd& u, Eigen::VectorXd& f,
+                   Eigen::VectorXd& f_iso) {
+  const int npe = geom.npe, nqp = geom.nqp;
+  const int* n = model.mesh.element(e);
+  std::array<Mat3, 4> F;
+  std::array<PointResponse, 4> resp;
+  for (int q = 0; q < nqp; ++q) {
+    const double* g = geom.grad(e, q);
+    F[q] = Mat3::Identity();
+    for (int a = 0; a < npe; ++a) F[q] += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+  }
+  model.material_of(e).evaluate(std::span<const Mat3>(F.data(), nqp), TimeStep{}, {}, {},
+                                std::span<PointResponse>(resp.data(), nqp), false);
+  f = Eigen::VectorXd::Zero(3 * npe);
+  f_iso = Eigen::VectorXd::Zero(3 * npe);
+  for (int q = 0; q < nqp; ++q) {
+    const double* g = geom.grad(e, q);
+    const double w = geom.w(e, q);
+    const Mat3 P = resp[q].P(), Pi = resp[q].P_iso;
+    for (int a = 0; a < npe; ++a) {
+      const Eigen::Map<const Eigen::Vector3d> ga(g + 3 * a);
+      f.segment<3>(3 * a) += w * P * ga;
+      f_iso.segment<3>(3 * a) += w * Pi * ga;
+    }
+  }
+}
+
+/// d(bending angle)/du at u (deg/m), by central differences over the tip nodes' dofs (the only
+/// ones the angle reads). Step: 1e-7 of the model's size, far above round-off of the SVD fit and far
+/// below the displacement over which the angle is nonlinear.
+Eigen::VectorXd angle_gradient(const Model& model, const Eigen::VectorXd& u) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(u.size());
+  Eigen::Vector3d lo = model.mesh.X[0], hi = lo;
+  for (const auto& x : model.mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  const double step = 1e-7 * (hi - lo).norm();
+  Eigen::VectorXd v = u;
+  const double a0 = bending_angle(model, u).angle_deg;
+  for (int n : model.angle.tip_nodes)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::Index i = 3 * n + d;
+      v[i] = u[i] + step;
+      const double ap = unwrap_deg(bending_angle(model, v).angle_deg, a0);
+      v[i] = u[i] - step;
+      const double am = unwrap_deg(bending_angle(model, v).angle_deg, a0);
+      v[i] = u[i];
+      g[i] = (ap - am) / (2.0 * step);
+    }
+  return g;
+}
+
+/// K_T = K_int - p H_V at u (the follower load's stiffness included), unconstrained.
+SparseMatrix tangent(const Assembler& A, const Eigen::VectorXd& u, double p) {
+  SparseMatrix K = A.tangent_pattern();
+  std::vector<double> none;
+  A.internal(u, TimeStep{}, none, none, nullptr, &K, nullptr);
+  Eigen::VectorXd dummy = Eigen::VectorXd::Zero(A.num_dofs());
+  A.add_pressure(u, p, dummy, &K);
+  return K;
+}
+
+/// H_V = d(dV/du)/du at u (symmetrised), and g = dV/du.
+SparseMatrix volume_hessian(const Assembler& A, const Eigen::VectorXd& u, Eigen::VectorXd& g) {
+  SparseMatrix K = A.tangent_pattern();
+  g = Eigen::VectorXd::Zero(A.num_dofs());
+  A.add_pressure(u, 1.0, g, &K);  // subtracts H_V from the zero matrix
+  return -K;
+}
+
+double mass_dot(const Eigen::VectorXd& m, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  double s = 0.0;
+  for (Eigen::Index i = 0; i < m.size(); ++i) s += m[i] * a.segment<3>(3 * i).dot(b.segment<3>(3 * i));
+  return s;
+}
+
+}  // namespace
+
+ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& opt,
+                                 const std::vector<Eigen::VectorXd>& snapshots) {
+  const auto t_start = Clock::now();
+  if (opt.clusters < 1 || opt.mode_samples < 1 || opt.max_modes < 1 || !(opt.pod_tolerance > 0.0 && opt.pod_tolerance < 1.0) ||
+      !(opt.ecsw_tolerance > 0.0 && opt.ecsw_tolerance < 1.0) || opt.training_fields < 0 ||
+      !(opt.training_softening > 0.0 && opt.training_softening <= 1.0))
+    throw InputError("reduced model: basis options out of range (clusters, mode_samples, max_modes >= 1; pod_tolerance and "
+                     "ecsw_tolerance in (0, 1); training_softening in (0, 1])");
+  const Assembler A(reference);
+  if (A.state_size() != 0 || !reference.gravity_m_s2.isZero())
+    throw InputError("reduced model: the reference model must be elastic and without gravity");
+  const int ndof = reference.num_dofs();
+  const std::size_t ns = trace.u.size();
+  if (ns < 3 || trace.p_Pa.size() != ns) throw InputError("reduced model: the elastic path trace needs at least three samples");
+  ReducedBasis B;
+  B.p = trace.p_Pa;
+  B.U.resize(ndof, static_cast<Eigen::Index>(ns));
+  for (std::size_t k = 0; k < ns; ++k) {
+    if (trace.u[k].size() != ndof)
+      throw InputError("reduced model: the elastic path trace has " + std::to_string(trace.u[k].size()) + " dof, the model " +
+                       std::to_string(ndof));
+    B.U.col(static_cast<Eigen::Index>(k)) = trace.u[k];
+    const double th = k == 0 ? 0.0 : unwrap_deg(bending_angle(reference, trace.u[k]).angle_deg, B.theta.back());
+    if (k > 0 && !(th > B.theta.back()))
+      throw InputError("reduced model: the elastic path trace is not increasing in angle at sample " + std::to_string(k));
+    B.theta.push_back(th);
+  }
+  B.dU.resize(ndof, static_cast<Eigen::Index>(ns));
+  {
+    const std::vector<Eigen::VectorXd> m = spline_slopes<Eigen::VectorXd>(
+        B.theta, [&](std::size_t k) { return Eigen::VectorXd(B.U.col(static_cast<Eigen::Index>(k))); });
+    for (std::size_t k = 0; k < ns; ++k) B.dU.col(static_cast<Eigen::Index>(k)) = m[k];
+  }
+  B.stiff_part = stiff_parts(reference, opt.stiff_modulus_ratio);
+  const Eigen::VectorXd& mass = A.lumped_mass();
+  const double m_tot = mass.sum();
+  const ElementGeometry& geom = A.geometry();
+
+  // 1. Softening responses at the mode samples and their POD.
+  const std::vector<std::vector<int>> clusters = soft_clusters(reference, B.stiff_part, opt.clusters);
+  B.info.clusters = static_cast<int>(clusters.size());
+  for (const auto& c : clusters) B.info.soft_elements += static_cast<int>(c.size());
+  // Mode samples spread evenly along the path in pressure and in angle alike (the mean of the two
+  // normalised coordinates): the response shapes change with the load level (a wall's bulge at
+  // 5 kPa is not its bulge at 40 kPa, turned), and near a limit point the angle runs ahead of the
+  // pressure. Samples chosen by angle alone left the low levels without shapes of their own: a
+  // softening of the walls then moved the angle at 5 kPa 14 % too far on a 3-chamber actuator.
+  std::vector<int> mode_k;
+  {
+    std::vector<double> s(ns);
+    for (std::size_t k = 0; k < ns; ++k) s[k] = 0.5 * (B.p[k] / B.p.back() + B.theta[k] / B.theta.back());
+    for (int j = 1; j <= opt.mode_samples; ++j) {
+      const double target = (j - 0.25) / opt.mode_samples;
+      std::size_t best = 1;
+      for (std::size_t k = 1; k < ns; ++k)
+        if (std::abs(s[k] - target) < std::abs(s[best] - target)) best = k;
+      if (std::find(mode_k.begin(), mode_k.end(), static_cast<int>(best)) == mode_k.end()) mode_k.push_back(static_cast<int>(best));
+    }
+  }
+  std::vector<Eigen::VectorXd> responses;
+  std::vector<int> response_sample, response_cluster;
+  for (int k : mode_k) {
+    const Eigen::VectorXd uk = B.U.col(k);
+    SparseMatrix K = tangent(A, uk, B.p[k]);
+    A.apply_constraints(K, 1.0);
+    LinearSolver solver;
+    if (!solver.factorize(K)) {
+      if (opt.verbose) std::fprintf(stderr, "reduced basis: tangent at %.3g kPa not positive definite, sample skipped\n", B.p[k] * 1e-3);
+      continue;
+    }
+    const Eigen::VectorXd t = B.dU.col(k);
+    const double tt = mass_dot(mass, t, t);
+    const std::size_t nc = clusters.size();
+    // Per soft element: its isochoric force at the sample.
+    std::vector<Eigen::VectorXd> fel(static_cast<std::size_t>(reference.mesh.num_elements()));
+    tbb::parallel_for(std::size_t(0), nc, [&](std::size_t c) {
+      Eigen::VectorXd fe;
+      for (int e : clusters[c]) element_force(reference, geom, e, uk, fe, fel[static_cast<std::size_t>(e)]);
+    });
+    auto add = [&](Eigen::VectorXd& f, int e, double s) {
+      const int* n = reference.mesh.element(e);
+      for (int a = 0; a < geom.npe; ++a) f.segment<3>(3 * n[a]) += s * fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
+    };
+    std::vector<Eigen::VectorXd> f(nc, Eigen::VectorXd::Zero(ndof));
+    for (std::size_t c = 0; c < nc; ++c)
+      for (int e : clusters[c]) add(f[c], e, 1.0);
+    for (std::size_t c = 0; c < f.size(); ++c) {
+      A.zero_fixed(f[c]);
+      Eigen::VectorXd du = solver.solve(f[c]);
+      A.zero_fixed(du);
+      du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
+      responses.push_back(std::move(du));
+      response_sample.push_back(k);
+      response_cluster.push_back(static_cast<int>(c % nc));
+    }
+  }
+  // Snapshots: their departure from the path point of equal angle (bisection on the path's angle).
+  for (const Eigen::VectorXd& u : snapshots) {
+    if (u.size() != ndof) throw InputError("reduced model: a snapshot has " + std::to_string(u.size()) + " dof, the model " + std::to_string(ndof));
+    const double target = bending_angle(reference, u).angle_deg;
+    double lo = B.theta.front(), hi = B.theta.back();
+    auto path_at = [&](double th, Eigen::VectorXd* slope) {
+      const int k = path_segment_index(B.theta, th);
+      const Hermite h((th - B.theta[k]) / (B.theta[k + 1] - B.theta[k]), B.theta[k + 1] - B.theta[k]);
+      const Eigen::VectorXd y0 = B.U.col(k), y1 = B.U.col(k + 1), m0 = B.dU.col(k), m1 = B.dU.col(k + 1);
+      if (slope) *slope = h.slope(y0, y1, m0, m1);
+      return Eigen::VectorXd(h.value(y0, y1, m0, m1));
+    };
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      const double a = unwrap_deg(bending_angle(reference, path_at(mid, nullptr)).angle_deg, mid);
+      (a < target ? lo : hi) = mid;
+    }
+    Eigen::VectorXd t;
+    Eigen::VectorXd du = u - path_at(0.5 * (lo + hi), &t);
+    du -= (mass_dot(mass, t, du) / mass_dot(mass, t, t)) * t;
+    if (mass_dot(mass, du, du) <= 0.0) continue;
+    responses.push_back(std::move(du));
+    response_sample.push_back(-1);
+    response_cluster.push_back(-1);
+  }
+  if (responses.empty())
+    throw PhysicsError("reduced model: no tangent along the elastic path could be factorised (the path may start at a limit "
+                       "point); check the model with pneufem simulate");
+  B.info.responses = static_cast<int>(responses.size());
+  // POD of the responses' shapes: each normalised to unit mass norm, so that every cluster at every
+  // sample counts alike. Their raw sizes differ by orders of magnitude (a tangent near the limit point
+  // amplifies every response), and a softening of the walls matters at every level, not only near it.
+  const Eigen::Index nr = static_cast<Eigen::Index>(responses.size());
+  std::vector<double> rnorm(responses.size());
+  for (std::size_t i = 0; i < responses.size(); ++i) rnorm[i] = std::sqrt(mass_dot(mass, responses[i], responses[i]) / m_tot) + 1e-300;
+  Eigen::MatrixXd C(nr, nr);
+  tbb::parallel_for(Eigen::Index(0), nr, [&](Eigen::Index i) {
+    for (Eigen::Index j = 0; j <= i; ++j)
+      C(i, j) = C(j, i) = mass_dot(mass, responses[i], responses[j]) / (m_tot * rnorm[i] * rnorm[j]);
+  });
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(C);
+  const Eigen::VectorXd lam = eig.eigenvalues().reverse();
+  const Eigen::MatrixXd vec = eig.eigenvectors().rowwise().reverse();
+  const double total = std::max(lam.sum(), 1e-300);
+  int r = 0;
+  double left = total;
+  while (r < opt.max_modes && r < nr && lam[r] > 1e-14 * lam[0] && left > opt.pod_tolerance * total) left -= lam[r++];
+  B.info.pod_energy_left = std::max(0.0, left / total);
+  B.Phi = Eigen::MatrixXd::Zero(ndof, r);
+  for (int j = 0; j < r; ++j) {
+    for (Eigen::Index i = 0; i < nr; ++i) B.Phi.col(j) += (vec(i, j) / rnorm[i]) * responses[i];
+    B.Phi.col(j) /= std::sqrt(mass_dot(mass, B.Phi.col(j), B.Phi.col(j)) / m_tot);
+  }
+  if (opt.verbose)
+    std::fprintf(stderr, "reduced basis: %d clusters, %lld responses at %zu samples, %d modes (energy left %.2e), %.1f s\n",
+                 B.info.clusters, static_cast<long long>(nr), mode_k.size(), r, B.info.pod_energy_left, seconds_since(t_start));
+
+  // 2. Reference operators per path sample (from the assembled FEM tangent).
+  Eigen::VectorXd unit_load;  // consistent gravity load per unit acceleration (same along x, y, z)
+  {
+    Model g1 = reference;
+    g1.gravity_m_s2 = Eigen::Vector3d::Ones();
+    const Assembler Ag(g1);
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(ndof);
+    Ag.add_gravity(f);
+    unit_load = f;
+  }
+  std::array<Eigen::VectorXd, 3> f_axis;
+  for (int d = 0; d < 3; ++d) {
+    f_axis[d] = Eigen::VectorXd::Zero(ndof);
+    for (int a = 0; a < reference.mesh.num_nodes(); ++a) f_axis[d][3 * a + d] = unit_load[3 * a + d];
+  }
+  B.V.resize(ns);
+  B.dV.resize(ns);
+  B.b.resize(r, static_cast<Eigen::Index>(ns));
+  B.db.resize(r, static_cast<Eigen::Index>(ns));
+  B.c.resize(r, static_cast<Eigen::Index>(ns));
+  B.W.resize(ndof, static_cast<Eigen::Index>(ns));
+  B.wg.resize(ns);
+  B.h.resize(r, static_cast<Eigen::Index>(ns));
+  B.gt.resize(3, static_cast<Eigen::Index>(ns));
+  B.gauge.resize(r, static_cast<Eigen::Index>(ns));
+  B.K.resize(ns);
+  B.H.resize(ns);
+  B.gq.resize(r, 3);
+  for (int d = 0; d < 3; ++d) B.gq.col(d) = B.Phi.transpose() * f_axis[d];
+  Eigen::MatrixXd MPhi = B.Phi;
+  for (Eigen::Index i = 0; i < ndof; ++i) MPhi.row(i) *= mass[i / 3];
+  for (std::size_t k = 0; k < ns; ++k) {
+    const Eigen::Index kk = static_cast<Eigen::Index>(k);
+    const Eigen::VectorXd uk = B.U.col(kk), tk = B.dU.col(kk);
+    const SparseMatrix KT = tangent(A, uk, B.p[k]);
+    Eigen::VectorXd g;
+    const SparseMatrix HV = volume_hessian(A, uk, g);
+    B.V[k] = A.cavity_volume(uk);
+    B.dV[k] = tk.dot(g);
+    // The theta row's test vector: the influence vector of the bending angle, w = K_T^-1 grad(angle),
+    // normalised so that w^T g = 1 (see the header). Where the tangent cannot be factorised (at the
+    // unloaded sample with nothing to bend, or at a limit point) the path tangent u_el' / V'.
+    Eigen::VectorXd w = tk / B.dV[k];
+    Eigen::VectorXd ga = angle_gradient(reference, uk);
+    A.zero_fixed(ga);
+    if (k > 0) {
+      SparseMatrix Kc = KT;
+      A.apply_constraints(Kc, 1.0);
+      LinearSolver ls;
+      if (ls.factorize(Kc)) {
+        Eigen::VectorXd a = ls.solve(ga);
+        A.zero_fixed(a);
+        const double ag = a.dot(g);
+        if (ag > 0.0 && a.allFinite()) w = a / ag;
+      }
+    }
+    B.W.col(kk) = w;
+    B.wg[k] = w.dot(g);
+    B.b.col(kk) = B.Phi.transpose() * g;
+    const Eigen::MatrixXd KPhi = KT * B.Phi, HPhi = HV * B.Phi;
+    B.db.col(kk) = HPhi.transpose() * tk;
+    B.c.col(kk) = KPhi.transpose() * w;
+    B.h.col(kk) = HPhi.transpose() * w;
+    B.K[k] = B.Phi.transpose() * KPhi;
+    B.H[k] = B.Phi.transpose() * HPhi;
+    B.K[k] = 0.5 * (B.K[k] + B.K[k].transpose());
+    B.H[k] = 0.5 * (B.H[k] + B.H[k].transpose());
+    for (int d = 0; d < 3; ++d) B.gt(d, kk) = w.dot(f_axis[d]);
+    B.gauge.col(kk) = MPhi.transpose() * tk;
+  }
+  if (opt.verbose) std::fprintf(stderr, "reduced basis: operators at %zu samples, %.1f s\n", ns, seconds_since(t_start));
+
+  // 3. ECSW: per cluster, non-negative element weights reproducing the cluster's reduced force on
+  // training states (path samples, and path samples plus the response to a random softening field).
+  struct TrainingState {
+    Eigen::VectorXd u, t;  // displacement, the theta row's test vector
+    double t_scale;        // its RMS size: the theta row in force per metre, as the modes' rows
+  };
+  std::vector<TrainingState> train;
+  {
+    const std::size_t stride = std::max<std::size_t>(1, (ns + 15) / 16);
+    for (std::size_t k = ns - 1;; k -= stride) {  // the top sample and every stride-th below it
+      train.push_back({B.U.col(static_cast<Eigen::Index>(k)), B.W.col(static_cast<Eigen::Index>(k)), 0.0});
+      if (k <= stride) break;
+    }
+    std::mt19937_64 rng(20261126);
+    std::uniform_real_distribution<double> unif(0.0, opt.training_softening);
+    // A field's linear response is capped at training_amplitude of the path's largest RMS
+    // displacement: near the limit point the linear response to a 30 % softening would invert
+    // elements, a state no run visits.
+    const Eigen::VectorXd u_top = B.U.col(static_cast<Eigen::Index>(ns - 1));
+    const double cap = opt.training_amplitude * std::sqrt(mass_dot(mass, u_top, u_top) / m_tot);
+    for (int k : mode_k) {
+      std::vector<std::size_t> idx;
+      for (std::size_t i = 0; i < responses.size(); ++i)
+        if (response_sample[i] == k) idx.push_back(i);
+      if (idx.empty()) continue;
+      for (int f = 0; f < opt.training_fields; ++f) {
+        Eigen::VectorXd du = Eigen::VectorXd::Zero(ndof);
+        for (std::size_t i : idx) du += unif(rng) * responses[i];
+        Eigen::VectorXd q = MPhi.transpose() * du / m_tot;
+        if (q.norm() > cap) q *= cap / q.norm();
+        train.push_back({B.U.col(k) + B.Phi * q, B.W.col(k), 0.0});
+      }
+    }
+    for (TrainingState& s : train) s.t_scale = std::sqrt(mass_dot(mass, s.t, s.t) / m_tot) + 1e-300;
+  }
+  responses.clear();
+  responses.shrink_to_fit();
+  const int n1 = r + 1;
+  const std::size_t nt = train.size();
+  std::vector<std::vector<std::pair<int, double>>> picked(clusters.size());
+  std::vector<double> cluster_residual(clusters.size(), 0.0);
+  if (!opt.hyper_reduce) {
+    for (std::size_t c = 0; c < clusters.size(); ++c)
+      for (int e : clusters[c]) picked[c].push_back({e, 1.0});
+  } else {
+    tbb::parallel_for(std::size_t(0), clusters.size(), [&](std::size_t c) {
+      const std::vector<int>& el = clusters[c];
+      const Eigen::Index rows = static_cast<Eigen::Index>(nt * 2 * n1);
+      Eigen::MatrixXd G(rows, static_cast<Eigen::Index>(el.size()));
+      Eigen::VectorXd fe, fi;
+      for (std::size_t j = 0; j < el.size(); ++j) {
+        const int e = el[j];
+        const int* n = reference.mesh.element(e);
+        for (std::size_t s = 0; s < nt; ++s) {
+          element_force(reference, geom, e, train[s].u, fe, fi);
+          for (int blk = 0; blk < 2; ++blk) {
+            const Eigen::VectorXd& f = blk == 0 ? fe : fi;
+            const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1);
+            double gth = 0.0;
+            Eigen::VectorXd gq = Eigen::VectorXd::Zero(r);
+            for (int a = 0; a < geom.npe; ++a) {
+              gth += train[s].t.segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
+              for (int m = 0; m < r; ++m) gq[m] += B.Phi.col(m).segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
+            }
+            G(row, static_cast<Eigen::Index>(j)) = gth / train[s].t_scale;
+            G.block(row + 1, static_cast<Eigen::Index>(j), r, 1) = gq;
+          }
+        }
+      }
+      // A training state that inverts an element of this cluster says nothing about it: dropped.
+      for (Eigen::Index row = 0; row < rows; ++row)
+        if (!G.row(row).allFinite()) G.row(row).setZero();
+      Eigen::VectorXd target = G.rowwise().sum();
+      // Every generalised coordinate (theta and each mode, of the whole and of the isochoric force)
+      // counts alike, relative to its own size over the training states: the theta row, which sets
+      // the angle, is then fitted as well as any mode's, not drowned by the sixteen of them.
+      for (int comp = 0; comp < 2 * n1; ++comp) {
+        const int blk = comp / n1, i = comp % n1;
+        double ss = 0.0;
+        for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>((s * 2 + blk) * n1 + i)], 2);
+        const double scale = std::sqrt(ss / static_cast<double>(nt));
+        if (!(scale > 0.0)) continue;
+        for (std::size_t s = 0; s < nt; ++s) {
+          const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1 + i);
+          G.row(row) /= scale;
+          target[row] /= scale;
+        }
+      }
+      const NnlsResult res = nnls(G, target, opt.ecsw_tolerance);
+      cluster_residual[c] = res.residual / std::max(target.norm(), 1e-300);
+      for (std::size_t j = 0; j < el.size(); ++j)
+        if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked[c].push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
+    });
+  }
+  std::vector<std::pair<int, double>> all;
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    all.insert(all.end(), picked[c].begin(), picked[c].end());
+    B.info.ecsw_worst_residual = std::max(B.info.ecsw_worst_residual, cluster_residual[c]);
+  }
+  std::sort(all.begin(), all.end());
+  for (auto [e, w] : all) {
+    B.elements.push_back(e);
+    B.weights.push_back(w);
+  }
+  if (opt.verbose)
+    std::fprintf(stderr, "reduced basis: ECSW kept %zu of %d soft elements (%zu training states, worst cluster residual %.2e), %.1f s\n",
+                 B.elements.size(), B.info.soft_elements, nt, B.info.ecsw_worst_residual, seconds_since(t_start));
+
+  // 4. The reference's hyper-reduced force at q = 0 on the fine grid, and its Jacobian per sample.
+  {
+    const rom_detail::KeptPoints pts(reference, B);
+    const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(r);
+    const int nsub = ReducedBasis::kRefSub;
+    B.Gref.resize(n1, static_cast<Eigen::Index>((ns - 1) * (nsub + 1)));
+    Eigen::VectorXd g;
+    for (std::size_t k = 0; k + 1 < ns; ++k)
+      for (int j = 0; j <= nsub; ++j) {
+        const double th = B.theta[k] + (B.theta[k + 1] - B.theta[k]) * j / nsub;
+        // At j = nsub, theta_{k+1} itself would select segment k + 1: evaluate on segment k's end.
+        const double th_eval = j == nsub ? std::nextafter(B.theta[k + 1], B.theta[k]) : th;
+        pts.force(th_eval, q0, TimeStep{}, {}, {}, g, nullptr);
+        B.Gref.col(static_cast<Eigen::Index>(k * (nsub + 1) + j)) = g;
+      }
+    B.Kref.resize(ns);
+    for (std::size_t k = 0; k < ns; ++k) {
+      Eigen::MatrixXd J;
+      pts.force(B.theta[k], q0, TimeStep{}, {}, {}, g, &J);
+      B.Kref[k] = J;
+    }
+  }
+  B.info.build_s = seconds_since(t_start);
+  if (opt.verbose) std::fprintf(stderr, "reduced basis: done in %.1f s\n", B.info.build_s);
+  return B;
+}
+
+// ------------------------------------------------------------------ serialisation
+namespace {
+constexpr double kMagic = 7.261126e6;  // format tag of ReducedBasis::to_doubles
+constexpr double kVersion = 2.0;
+
+struct Writer {
+  std::vector<double> d;
+  void num(double x) { d.push_back(x); }
+  void vec(const std::vector<double>& v) {
+    num(static_cast<double>(v.size()));
+    d.insert(d.end(), v.begin(), v.end());
+  }
+  void mat(const Eigen::MatrixXd& m) {
+    num(static_cast<double>(m.rows()));
+    num(static_cast<double>(m.cols()));
+    d.insert(d.end(), m.data(), m.data() + m.size());
+  }
+};
+
+struct Reader {
+  const std::vector<double>& d;
+  std::size_t i = 0;
+  double num() {
+    if (i >= d.size()) throw InputError("reduced model: stored basis is truncated");
+    return d[i++];
+  }
+  std::size_t count() {
+    const double x = num();
+    if (!(x >= 0.0) || x > 1e10 || x != std::floor(x)) throw InputError("reduced model: stored basis is damaged");
+    return static_cast<std::size_t>(x);
+  }
+  std::vector<double> vec() {
+    const std::size_t n = count();
+    if (i + n > d.size()) throw InputError("reduced model: stored basis is truncated");
+    std::vector<double> v(d.begin() + static_cast<std::ptrdiff_t>(i), d.begin() + static_cast<std::ptrdiff_t>(i + n));
+    i += n;
+    return v;
+  }
+  Eigen::MatrixXd mat() {
+    const std::size_t r = count(), c = count();
+    if (i + r * c > d.size()) throw InputError("reduced model: stored basis is truncated");
+    Eigen::MatrixXd m = Eigen::Map<const Eigen::MatrixXd>(d.data() + i, static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
+    i += r * c;
+    return m;
+  }
+};
+}  // namespace
+
+std::vector<double> ReducedBasis::to_doubles() const {
+  Writer w;
+  w.num(kMagic);
+  w.num(kVersion);
+  w.vec(theta);
+  w.vec(p);
+  w.mat(U);
+  w.mat(dU);
+  w.mat(Phi);
+  w.mat(W);
+  w.vec(V);
+  w.vec(dV);
+  w.vec(wg);
+  w.mat(b);
+  w.mat(db);
+  w.mat(c);
+  w.mat(h);
+  w.num(static_cast<double>(K.size()));
+  for (std::size_t k = 0; k < K.size(); ++k) {
+    w.mat(K[k]);
+    w.mat(H[k]);
+    w.mat(Kref[k]);
+  }
+  w.mat(gt);
+  w.mat(gq);
+  w.mat(gauge);
+  w.vec(std::vector<double>(elements.begin(), elements.end()));
+  w.vec(weights);
+  w.mat(Gref);
+  w.vec(std::vector<double>(stiff_part.begin(), stiff_part.end()));
+  w.num(info.clusters);
+  w.num(info.responses);
+  w.num(info.soft_elements);
+  w.num(info.pod_energy_left);
+  w.num(info.ecsw_worst_residual);
+  w.num(info.build_s);
+  return std::move(w.d);
+}
+
+ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
+  Reader rd{d};
+  if (rd.num() != kMagic || rd.num() != kVersion)
+    throw InputError("reduced model: stored data are not a reduced basis of this pneufem version");
+  ReducedBasis B;
+  B.theta = rd.vec();
+  B.p = rd.vec();
+  B.U = rd.mat();
+  B.dU = rd.mat();
+  B.Phi = rd.mat();
+  B.W = rd.mat();
+  B.V = rd.vec();
+  B.dV = rd.vec();
+  B.wg = rd.vec();
+  B.b = rd.mat();
+  B.db = rd.mat();
+  B.c = rd.mat();
+  B.h = rd.mat();
+  const std::size_t ns = rd.count();
+  for (std::size_t k = 0; k < ns; ++k) {
+    B.K.push_back(rd.mat());
+    B.H.push_back(rd.mat());
+    B.Kref.push_back(rd.mat());
+  }
+  B.gt = rd.mat();
+  B.gq = rd.mat();
+  B.gauge = rd.mat();
+  for (double e : rd.vec()) B.elements.push_back(static_cast<int>(e));
+  B.weights = rd.vec();
+  B.Gref = rd.mat();
+  for (double s : rd.vec()) B.stiff_part.push_back(static_cast<char>(s));
+  B.info.clusters = static_cast<int>(rd.num());
+  B.info.responses = static_cast<int>(rd.num());
+  B.info.soft_elements = static_cast<int>(rd.num());
+  B.info.pod_energy_left = rd.num();
+  B.info.ecsw_worst_residual = rd.num();
+  B.info.build_s = rd.num();
+  const Eigen::Index r = B.Phi.cols(), n = static_cast<Eigen::Index>(B.theta.size());
+  const bool ok = rd.i == d.size() && n >= 3 && B.p.size() == B.theta.size() && B.U.cols() == n && B.dU.cols() == n && B.W.cols() == n && B.wg.size() == B.theta.size() && B.db.cols() == n &&
+                  B.U.rows() == B.Phi.rows() && B.V.size() == B.theta.size() && B.dV.size() == B.theta.size() &&
+                  B.b.rows() == r && B.b.cols() == n && B.c.cols() == n && B.h.cols() == n && ns == B.theta.size() &&
+                  B.gt.rows() == 3 && B.gt.cols() == n && B.gq.rows() == r && B.gauge.cols() == n &&
+                  B.elements.size() == B.weights.size() && B.Gref.rows() == r + 1 &&
+                  B.Gref.cols() == (n - 1) * (kRefSub + 1);
+  if (!ok) throw InputError("reduced model: stored basis is damaged (inconsistent sizes)");
+  for (std::size_t k = 0; k < ns; ++k)
+    if (B.K[k].rows() != r || B.H[k].rows() != r || B.Kref[k].rows() != r + 1)
+      throw InputError("reduced model: stored basis is damaged (inconsistent sizes)");
+  for (int e : B.elements)
+    if (e < 0) throw InputError("reduced model: stored basis is damaged (element index)");
+  return B;
+}
+
+}  // namespace pneufem
