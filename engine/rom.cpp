@@ -264,7 +264,8 @@ struct ReducedOrderModel::Impl {
 ReducedOrderModel::ReducedOrderModel(const Model& reference, const ReducedBasis& basis, const Model& model)
     : reference_(reference), basis_(basis), model_(model), impl_(std::make_unique<Impl>()) {
   if (basis.dofs() != reference.num_dofs() || model.num_dofs() != reference.num_dofs() ||
-      model.mesh.num_elements() != reference.mesh.num_elements())
+      model.mesh.num_elements() != reference.mesh.num_elements() || basis.mesh_fingerprint != mesh_fingerprint(reference.mesh) ||
+      (&model.mesh != &reference.mesh && mesh_fingerprint(model.mesh) != basis.mesh_fingerprint))
     throw InputError("reduced model: the basis, the reference and the run's model must share one mesh (basis " +
                      std::to_string(basis.dofs()) + " dof, reference " + std::to_string(reference.num_dofs()) +
                      ", model " + std::to_string(model.num_dofs()) + "); rebuild the basis for this mesh");

@@ -118,6 +118,7 @@ struct ReducedBasis {
   Eigen::MatrixXd Gref;           ///< (r + 1) x (segments * (kRefSub + 1))
   std::vector<Eigen::MatrixXd> Kref;  ///< (r + 1) x (r + 1) per sample: d G_hat_ref / d(theta, q) at q = 0
   std::vector<char> stiff_part;   ///< per part of the reference: 1 = stiff (linear reference only)
+  double mesh_fingerprint = 0.0;  ///< mesh_fingerprint() of the reference's mesh
   // What the construction saw (reported in summaries).
   struct Info {
     int clusters = 0, responses = 0, soft_elements = 0;
@@ -134,6 +135,10 @@ struct ReducedBasis {
   /// Throws InputError when the data are not a basis (damaged, or of another format version).
   static ReducedBasis from_doubles(const std::vector<double>& d);
 };
+
+/// A 52-bit hash of a mesh's node coordinates and connectivity (exact in a double): a basis is
+/// only used with the mesh it was built on.
+double mesh_fingerprint(const Mesh& mesh);
 
 /// Builds the basis of `reference` (elastic: materials without history, no gravity) from its traced
 /// path (engine/path_model.h). Throws InputError for a reference with history or a trace that does

@@ -192,6 +192,17 @@ double mass_dot(const Eigen::VectorXd& m, const Eigen::VectorXd& a, const Eigen:
 
 }  // namespace
 
+double mesh_fingerprint(const Mesh& mesh) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a over the bytes
+  auto mix = [&](const void* p, std::size_t n) {
+    const unsigned char* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 0x100000001b3ULL;
+  };
+  for (const auto& x : mesh.X) mix(x.data(), 3 * sizeof(double));
+  for (int e = 0; e < mesh.num_elements(); ++e) mix(mesh.element(e), static_cast<std::size_t>(mesh.npe()) * sizeof(int));
+  return static_cast<double>(h >> 12);
+}
+
 ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& opt,
                                  const std::vector<Eigen::VectorXd>& snapshots) {
   const auto t_start = Clock::now();
@@ -226,6 +237,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     for (std::size_t k = 0; k < ns; ++k) B.dU.col(static_cast<Eigen::Index>(k)) = m[k];
   }
   B.stiff_part = stiff_parts(reference, opt.stiff_modulus_ratio);
+  B.mesh_fingerprint = mesh_fingerprint(reference.mesh);
   const Eigen::VectorXd& mass = A.lumped_mass();
   const double m_tot = mass.sum();
   const ElementGeometry& geom = A.geometry();
@@ -390,7 +402,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     Eigen::VectorXd w = tk / B.dV[k];
     Eigen::VectorXd ga = angle_gradient(reference, uk);
     A.zero_fixed(ga);
-    if (k > 0) {
+    {
       SparseMatrix Kc = KT;
       A.apply_constraints(Kc, 1.0);
       LinearSolver ls;
@@ -555,7 +567,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
 // ------------------------------------------------------------------ serialisation
 namespace {
 constexpr double kMagic = 7.261126e6;  // format tag of ReducedBasis::to_doubles
-constexpr double kVersion = 2.0;
+constexpr double kVersion = 3.0;
 
 struct Writer {
   std::vector<double> d;
@@ -630,6 +642,7 @@ std::vector<double> ReducedBasis::to_doubles() const {
   w.vec(weights);
   w.mat(Gref);
   w.vec(std::vector<double>(stiff_part.begin(), stiff_part.end()));
+  w.num(mesh_fingerprint);
   w.num(info.clusters);
   w.num(info.responses);
   w.num(info.soft_elements);
@@ -670,6 +683,7 @@ ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
   B.weights = rd.vec();
   B.Gref = rd.mat();
   for (double s : rd.vec()) B.stiff_part.push_back(static_cast<char>(s));
+  B.mesh_fingerprint = rd.num();
   B.info.clusters = static_cast<int>(rd.num());
   B.info.responses = static_cast<int>(rd.num());
   B.info.soft_elements = static_cast<int>(rd.num());
