@@ -483,12 +483,15 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
     y.q += s * d.segment(1, n - 2);
     y.lambda += s * d[n - 1];
   };
-  bool converged = false;
+  bool converged = false, have_tangent = false;
   int it = 0;
   for (; it < 30; ++it) {
-    R = rom_.residual(z, p, ts, hist_, trial_, &Jm);
-    ++stats_.residuals;
-    ++stats_.tangents;
+    if (!have_tangent) {
+      R = rom_.residual(z, p, ts, hist_, trial_, &Jm);
+      ++stats_.residuals;
+      ++stats_.tangents;
+    }
+    have_tangent = false;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(Jm);
     dz = -lu.solve(R);
     if (!dz.allFinite()) break;
@@ -509,12 +512,17 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
     ReducedCoordinates y = z;
     apply(y, dz, s);
     bool accepted = false;
+    Eigen::MatrixXd J1;
     for (int ls = 0; ls < 8; ++ls) {
       try {
-        const Eigen::VectorXd R1 = rom_.residual(y, p, ts, hist_, trial_, nullptr);
+        // The full step's residual comes with its Jacobian: accepted (the usual case), it starts
+        // the next iteration without evaluating the same state again.
+        const Eigen::VectorXd R1 = rom_.residual(y, p, ts, hist_, trial_, ls == 0 ? &J1 : nullptr);
         ++stats_.residuals;
+        if (ls == 0) ++stats_.tangents;
         if (R1.cwiseProduct(scale).norm() < (1.0 - 1e-4 * s) * f0 || ls == 7) {
           accepted = true;
+          if (ls == 0) R = R1, Jm.swap(J1), have_tangent = true;
           break;
         }
       } catch (const PhysicsError&) {

@@ -143,29 +143,6 @@ void element_force(const Model& model, const ElementGeometry& geom, int e, const
   }
 }
 
-/// d(bending angle)/du at u (deg/m), by central differences over the tip nodes' dofs (the only
-/// ones the angle reads). Step: 1e-7 of the model's size, far above round-off of the SVD fit and far
-/// below the displacement over which the angle is nonlinear.
-Eigen::VectorXd angle_gradient(const Model& model, const Eigen::VectorXd& u) {
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(u.size());
-  Eigen::Vector3d lo = model.mesh.X[0], hi = lo;
-  for (const auto& x : model.mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  const double step = 1e-7 * (hi - lo).norm();
-  Eigen::VectorXd v = u;
-  const double a0 = bending_angle(model, u).angle_deg;
-  for (int n : model.angle.tip_nodes)
-    for (int d = 0; d < 3; ++d) {
-      const Eigen::Index i = 3 * n + d;
-      v[i] = u[i] + step;
-      const double ap = unwrap_deg(bending_angle(model, v).angle_deg, a0);
-      v[i] = u[i] - step;
-      const double am = unwrap_deg(bending_angle(model, v).angle_deg, a0);
-      v[i] = u[i];
-      g[i] = (ap - am) / (2.0 * step);
-    }
-  return g;
-}
-
 /// K_T = K_int - p H_V at u (the follower load's stiffness included), unconstrained.
 SparseMatrix tangent(const Assembler& A, const Eigen::VectorXd& u, double p) {
   SparseMatrix K = A.tangent_pattern();
@@ -191,6 +168,29 @@ double mass_dot(const Eigen::VectorXd& m, const Eigen::VectorXd& a, const Eigen:
 }
 
 }  // namespace
+
+/// d(bending angle)/du at u (deg/m), by central differences over the tip nodes' dofs (the only
+/// ones the angle reads). Step: 1e-7 of the model's size, far above round-off of the SVD fit and far
+/// below the displacement over which the angle is nonlinear.
+Eigen::VectorXd rom_detail::angle_gradient(const Model& model, const Eigen::VectorXd& u) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(u.size());
+  Eigen::Vector3d lo = model.mesh.X[0], hi = lo;
+  for (const auto& x : model.mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  const double step = 1e-7 * (hi - lo).norm();
+  Eigen::VectorXd v = u;
+  const double a0 = bending_angle(model, u).angle_deg;
+  for (int n : model.angle.tip_nodes)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::Index i = 3 * n + d;
+      v[i] = u[i] + step;
+      const double ap = unwrap_deg(bending_angle(model, v).angle_deg, a0);
+      v[i] = u[i] - step;
+      const double am = unwrap_deg(bending_angle(model, v).angle_deg, a0);
+      v[i] = u[i];
+      g[i] = (ap - am) / (2.0 * step);
+    }
+  return g;
+}
 
 double mesh_fingerprint(const Mesh& mesh) {
   std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a over the bytes
@@ -379,6 +379,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
   B.c.resize(r, static_cast<Eigen::Index>(ns));
   B.W.resize(ndof, static_cast<Eigen::Index>(ns));
   B.wg.resize(ns);
+  B.wa.assign(ns, 0.0);
   B.h.resize(r, static_cast<Eigen::Index>(ns));
   B.gt.resize(3, static_cast<Eigen::Index>(ns));
   B.gauge.resize(r, static_cast<Eigen::Index>(ns));
@@ -400,7 +401,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     // normalised so that w^T g = 1 (see the header). Where the tangent cannot be factorised (at the
     // unloaded sample with nothing to bend, or at a limit point) the path tangent u_el' / V'.
     Eigen::VectorXd w = tk / B.dV[k];
-    Eigen::VectorXd ga = angle_gradient(reference, uk);
+    Eigen::VectorXd ga = rom_detail::angle_gradient(reference, uk);
     A.zero_fixed(ga);
     {
       SparseMatrix Kc = KT;
@@ -410,7 +411,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
         Eigen::VectorXd a = ls.solve(ga);
         A.zero_fixed(a);
         const double ag = a.dot(g);
-        if (ag > 0.0 && a.allFinite()) w = a / ag;
+        if (ag > 0.0 && a.allFinite()) w = a / ag, B.wa[k] = ag;
       }
     }
     B.W.col(kk) = w;
@@ -567,7 +568,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
 // ------------------------------------------------------------------ serialisation
 namespace {
 constexpr double kMagic = 7.261126e6;  // format tag of ReducedBasis::to_doubles
-constexpr double kVersion = 3.0;
+constexpr double kVersion = 4.0;
 
 struct Writer {
   std::vector<double> d;
@@ -625,6 +626,7 @@ std::vector<double> ReducedBasis::to_doubles() const {
   w.vec(V);
   w.vec(dV);
   w.vec(wg);
+  w.vec(wa);
   w.mat(b);
   w.mat(db);
   w.mat(c);
@@ -666,6 +668,7 @@ ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
   B.V = rd.vec();
   B.dV = rd.vec();
   B.wg = rd.vec();
+  B.wa = rd.vec();
   B.b = rd.mat();
   B.db = rd.mat();
   B.c = rd.mat();
@@ -691,7 +694,7 @@ ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
   B.info.ecsw_worst_residual = rd.num();
   B.info.build_s = rd.num();
   const Eigen::Index r = B.Phi.cols(), n = static_cast<Eigen::Index>(B.theta.size());
-  const bool ok = rd.i == d.size() && n >= 3 && B.p.size() == B.theta.size() && B.U.cols() == n && B.dU.cols() == n && B.W.cols() == n && B.wg.size() == B.theta.size() && B.db.cols() == n &&
+  const bool ok = rd.i == d.size() && n >= 3 && B.p.size() == B.theta.size() && B.U.cols() == n && B.dU.cols() == n && B.W.cols() == n && B.wg.size() == B.theta.size() && B.wa.size() == B.theta.size() && B.db.cols() == n &&
                   B.U.rows() == B.Phi.rows() && B.V.size() == B.theta.size() && B.dV.size() == B.theta.size() &&
                   B.b.rows() == r && B.b.cols() == n && B.c.cols() == n && B.h.cols() == n && ns == B.theta.size() &&
                   B.gt.rows() == 3 && B.gt.cols() == n && B.gq.rows() == r && B.gauge.cols() == n &&

@@ -23,6 +23,9 @@
 
 namespace pneufem::rom_detail {
 
+/// d(bending angle)/du at u (deg/m) by central differences over the tip nodes (engine/rom_basis.cpp).
+Eigen::VectorXd angle_gradient(const Model& model, const Eigen::VectorXd& u);
+
 class KeptPoints {
  public:
   /// Points of basis.elements with the materials of `model` (same mesh as the basis).

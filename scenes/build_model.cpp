@@ -361,10 +361,30 @@ SolverSettings solver_settings(const Scene& s) {
   if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
   sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
   sv.time_scale = positive(s, "solver.time_scale");
+  sv.model = choice<SolverSettings::Model>(s, "solver.model", {{"full", SolverSettings::Model::Full},
+                                                             {"reduced", SolverSettings::Model::Reduced}});
+  sv.reduced.max_modes = s.integer("solver.reduced_modes");
+  if (sv.reduced.max_modes < 1) s.fail("solver.reduced_modes", "must be >= 1");
+  sv.reduced.ecsw_tolerance = positive(s, "solver.reduced_ecsw_tol");
+  if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
+  sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
+  if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)
+    s.fail("solver.model", "\"reduced\" needs solver.mode = \"quasi_static\"");
   return sv;
 }
 
 }  // namespace
+
+Scene elastic_reference_scene(const Scene& scene) {
+  std::vector<std::string> sets;
+  for (const std::string& m : scene.table_keys("materials"))
+    for (const std::string& sub : scene.table_keys("materials." + m))
+      if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
+  sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
+  sets.push_back("gravity.rig_angle_deg=-1.0");
+  if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
+  return scene.with(sets);
+}
 
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   const std::string source = s.string("mesh.source");

@@ -10,6 +10,7 @@
 #include "engine/load_history.h"
 #include "engine/model.h"
 #include "engine/quasi_static.h"
+#include "engine/rom.h"
 #include "scenes/scene.h"
 
 namespace pneufem {
@@ -17,6 +18,10 @@ namespace pneufem {
 struct SolverSettings {
   enum class Mode { QuasiStatic, Explicit };
   Mode mode = Mode::QuasiStatic;
+  enum class Model { Full, Reduced };  ///< quasi-static: the full FEM or the reduced model (engine/rom.h)
+  Model model = Model::Full;
+  RomBasisOptions reduced;             ///< solver.reduced_modes, solver.reduced_ecsw_tol
+  double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
   QuasiStaticOptions quasi_static;
   ExplicitOptions explicit_dynamics;
   double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time
@@ -41,6 +46,11 @@ struct BuiltModel {
 MaterialPtr make_material(const Scene& scene, const std::string& name);
 /// The same with the stiffness additionally multiplied by `region_scale` (regions.<tag>.stiffness_scale).
 MaterialPtr make_material(const Scene& scene, const std::string& name, double region_scale);
+
+/// The elastic reference of a scene: every effect table (materials.<m>.<effect>.enabled) switched
+/// off, no gravity, no pressure lag. Stiffness scales are elastic and stay. The reference of the
+/// 1-dof path model and of the reduced-order model (engine/path_model.h, engine/rom.h).
+Scene elastic_reference_scene(const Scene& scene);
 
 /// Builds only the mesh described by the scene (mesh.* and geometry.*), with its sets.
 Mesh build_mesh(const Scene& scene, std::vector<std::string>* warnings = nullptr);

@@ -323,9 +323,12 @@ void drop_disabled_tables(toml::table& t) {
 }
 }  // namespace
 
-std::string Scene::model_toml() const {
+std::string Scene::model_toml() const { return model_toml_without({}); }
+
+std::string Scene::model_toml_without(const std::vector<std::string>& tables) const {
   toml::table t = impl_->table;
   drop_disabled_tables(t);
+  for (const std::string& name : tables) t.erase(name);
   std::ostringstream s;
   s << t;
   return s.str();

@@ -54,6 +54,9 @@ class Scene {
   /// other keys do not change the model: equal strings for scenes that build the same model, the
   /// key of caches (the ideal model of app/simulate/ideal_cache.h, diagnose's elastic curves).
   std::string model_toml() const;
+  /// model_toml() without the named top-level tables (e.g. "load", "output"): the key of results
+  /// that do not depend on them (the reduced model's basis, app/simulate/reduced.h).
+  std::string model_toml_without(const std::vector<std::string>& tables) const;
 
   /// A copy with more overrides applied (used by sweeps and diagnosis).
   Scene with(const std::vector<std::string>& overrides) const;

@@ -22,19 +22,6 @@ namespace pneufem::diagnose_detail {
 
 namespace {
 
-/// The elastic reference of a scene: every inelastic effect table switched off, no gravity, no
-/// pressure lag (the path model adds gravity and lag itself; stiffness scales are elastic and stay).
-Scene elastic_reference(const Scene& scene) {
-  std::vector<std::string> sets;
-  for (const std::string& m : scene.table_keys("materials"))
-    for (const std::string& sub : scene.table_keys("materials." + m))
-      if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
-  sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
-  sets.push_back("gravity.rig_angle_deg=-1.0");
-  if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
-  return scene.with(sets);
-}
-
 /// Cache key of a scene's elastic FEM curve: its TOML without the lag (curves are lag-free) and
 /// without the tables of disabled effects, whose constants do not change the model (otherwise
 /// every calibration run of a history effect on top of gravity missed the cache of its elastic
@@ -52,7 +39,7 @@ bool has_history(const Model& m) {
 RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
                            int rom_points, const Scene* mesh_scene, const std::string& cache_dir)
     : cache_dir_(cache_dir), rec_(rec), frames_(frames) {
-  ref_ = build_model(elastic_reference(base));
+  ref_ = build_model(elastic_reference_scene(base));
   double p_max = 0.0;
   for (const TrialRecording& t : rec.trials)
     for (double p : t.pressure_kPa.value) p_max = std::max(p_max, p);
@@ -78,7 +65,7 @@ RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::v
     Fnv1a h;
     h.str(executable_fingerprint());
     h.str("elastic path");
-    hash_model(h, elastic_reference(base), ref_->model);
+    hash_model(h, elastic_reference_scene(base), ref_->model);
     h.num(po.p_top_Pa);
     h.num(po.dp_Pa);
     const Eigen::Index nd = ref_->model.num_dofs();
@@ -110,7 +97,7 @@ RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::v
   tbb::parallel_invoke(make_path,
                        [&] {
                          try {
-                           const Scene fine_scene = elastic_reference(*mesh_scene);
+                           const Scene fine_scene = elastic_reference_scene(*mesh_scene);
                            const std::unique_ptr<BuiltModel> fine = build_model(fine_scene);
                            fine_dofs_ = fine->model.num_dofs();
                            fine_curve_ = stored_curve(fine_scene, *fine, inlet_max_Pa_, kMeshCurvePoints, &fine_source_);
@@ -238,7 +225,7 @@ std::vector<std::vector<double>> RomEvaluator::simulate(const Scene& variant, bo
     // otherwise costs a static FEM sweep per evaluation (measured: 24 runs, 56 s of a 84 s
     // diagnosis on the 5-chamber test actuator); five sweeps serve every angle, within ~1e-4 deg
     // of the direct sweep (RigAngleInterpolation.MatchesDirectFemSweepsBetweenNodes).
-    const Scene el = elastic_reference(variant);
+    const Scene el = elastic_reference_scene(variant);
     const double hi = chamber(inlet_max_Pa_);  // pl holds mapped pressures
     const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
     std::vector<double> off(c0.size(), 0.0);

@@ -39,6 +39,10 @@ std::unique_ptr<SimulateCommand> add_simulate_command(CLI::App& app) {
                   "Share the ideal elastic model of metrics.json between runs through this directory (keyed by "
                   "pneufem version, mesh and every scene key but the inelastic ones): the first run computes it, "
                   "later runs of the same actuator read it (pneufem sweep gives its points one)");
+  sim->add_option("--cache", c->cache_dir,
+                  "Store the reduced model's offline part (elastic path and basis; solver.model = \"reduced\") in this "
+                  "directory and reuse it: the first run of an actuator builds it, later runs with any effect constants "
+                  "read it");
   return c;
 }
 
@@ -59,6 +63,7 @@ int run_simulate_command(SimulateCommand& c, const std::string& command_line) {
   opt.abort_after_checkpoints = c.abort_after_checkpoints;
   opt.threads = c.threads;
   opt.ideal_cache_dir = c.ideal_cache_dir;
+  opt.cache_dir = c.cache_dir;
   opt.progress = isatty(fileno(stderr));
   opt.command_line = command_line;
   const Scene scene = opt.resume ? Scene::load("") : Scene::load(c.scene_path, c.sets);

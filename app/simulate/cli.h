@@ -21,6 +21,7 @@ struct SimulateCommand {
   double checkpoint_every_s = 30.0;
   int abort_after_checkpoints = -1;
   std::string ideal_cache_dir;
+  std::string cache_dir;
 };
 
 /// Adds `simulate [SCENE.toml] --out DIR [--set k=v ...] [--threads N] [--resume DIR]

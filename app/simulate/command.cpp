@@ -12,6 +12,7 @@
 
 #include "analysis/paper_metrics.h"
 #include "app/simulate/ideal_cache.h"
+#include "app/simulate/reduced.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/json_writer.h"
@@ -163,6 +164,51 @@ std::vector<StateRecord> records_of(const Scene& scene) {
   return recs;
 }
 
+/// Per report of a reduced run: its indicator (reduced_check.csv).
+std::string reduced_check_csv(const std::vector<ReducedReport>& reports) {
+  std::string s = "trial,time_s,pressure_kPa,angle_deg,estimated_angle_error_deg,newton_step_angle_error_deg,residual_rel\n";
+  char line[256];
+  for (const ReducedReport& r : reports) {
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g\n", r.record.trial, r.record.time_s, r.record.pressure_Pa * 1e-3,
+                  r.record.angle_deg, r.check.angle_error_deg, r.check.newton_angle_error_deg, r.check.residual_rel);
+    s += line;
+  }
+  return s;
+}
+
+/// What summary.json says about a reduced run: the offline part, the online cost, the check and
+/// whether the run fell back to the full FEM, where and why.
+std::string reduced_summary(const ReducedSetup& setup, const ReducedRunResult& res, double tol_deg, const std::string& fallback) {
+  const ReducedBasis& B = setup.basis;
+  json::Object offline;
+  offline.add_str("path", setup.path_source)
+      .add_str("basis", setup.basis_source)
+      .add("offline_s", setup.offline_s)
+      .add("path_samples", static_cast<double>(B.num_samples()))
+      .add("modes", static_cast<double>(B.num_modes()))
+      .add("sampled_elements", static_cast<double>(B.elements.size()))
+      .add("soft_elements", static_cast<double>(B.info.soft_elements))
+      .add("pod_energy_left", B.info.pod_energy_left)
+      .add("ecsw_worst_residual", B.info.ecsw_worst_residual);
+  json::Object online;
+  online.add("states", static_cast<double>(res.stats.states))
+      .add("rejected_time_steps", static_cast<double>(res.stats.rejected_steps))
+      .add("newton_iterations", static_cast<double>(res.stats.newton_iterations))
+      .add("solve_s", res.stats.wall_s)
+      .add("replay_s", res.replay_s)
+      .add("beyond_traced_path", res.stats.beyond_path ? 1.0 : 0.0);
+  json::Object check;
+  check.add("tolerance_deg", tol_deg).add("worst_estimated_error_deg", res.worst_check_deg);
+  if (res.worst_report >= 0) {
+    const StateRecord& w = res.reports[static_cast<std::size_t>(res.worst_report)].record;
+    check.add("worst_trial", static_cast<double>(w.trial)).add("worst_time_s", w.time_s).add("worst_pressure_kPa", w.pressure_Pa * 1e-3);
+  }
+  check.add_str("per_report", "reduced_check.csv");
+  json::Object o;
+  o.add("offline", offline.str(4)).add("online", online.str(4)).add("check", check.str(4)).add_str("fallback", fallback);
+  return o.str(2);
+}
+
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
@@ -181,6 +227,14 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const Assembler asmb(bm->model);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
   if (!opt.resume) write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
+
+  const bool reduced = bm->solver.mode == SolverSettings::Mode::QuasiStatic && bm->solver.model == SolverSettings::Model::Reduced;
+  if (reduced && opt.resume) throw InputError("--resume: reduced-model runs have no checkpoints; start the run again");
+  std::unique_ptr<ReducedSetup> rsetup;
+  if (reduced) {
+    if (opt.progress) std::fprintf(stderr, "  reduced model: elastic path and basis ...\n");
+    rsetup = reduced_setup(scene, peak_pressure(bm->load), bm->solver.reduced, opt.cache_dir);
+  }
 
   RunResult result;
   ProgressLine progress(opt.progress);
@@ -204,10 +258,17 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       const Scene ideal_scene = scene.with(sets);
       auto compute = [&] {
         if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
-        return records_of(ideal_scene);
+        if (!reduced) return records_of(ideal_scene);
+        std::vector<StateRecord> recs;
+        for (const ReducedReport& r : run_reduced(*rsetup, *build_model(ideal_scene), nullptr, false).reports) recs.push_back(r.record);
+        return recs;
       };
       if (opt.ideal_cache_dir.empty()) {
         ideal = compute();
+        if (reduced) ideal_source = "computed by the reduced model";
+      } else if (reduced) {
+        ideal = compute();  // seconds; the ideal cache holds full-FEM results only
+        ideal_source = "computed by the reduced model";
       } else {
         IdealResult r = cached_ideal(opt.ideal_cache_dir, ideal_cache_key(ideal_scene, bm->model, version_string()),
                                      ideal_scene, bm->load.trials[0].output_s, compute, bm->warnings);
@@ -265,8 +326,39 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   };
 
   const auto t_solve = std::chrono::steady_clock::now();
+  std::string reduced_json = "null";
   try {
-    if (bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
+    bool full = bm->solver.mode == SolverSettings::Mode::QuasiStatic;
+    if (reduced) {
+      const ReducedRunResult rr = run_reduced(*rsetup, *bm, observe);
+      const double tol = bm->solver.reduced_check_deg;
+      std::string fallback = "none";
+      if (rr.worst_check_deg > tol) {
+        const StateRecord& w = rr.reports[static_cast<std::size_t>(rr.worst_report)].record;
+        char why[320];
+        std::snprintf(why, sizeof why,
+                      "full FEM: the reduced model's estimated angle error %.3g deg at trial %d, t = %.2f s (%.1f kPa) exceeds "
+                      "solver.reduced_check_deg = %.3g",
+                      rr.worst_check_deg, w.trial, w.time_s, w.pressure_Pa * 1e-3, tol);
+        fallback = why;
+        bm->warnings.push_back(fallback);
+        progress.done();
+        if (opt.progress) std::fprintf(stderr, "  %s\n", why);
+        records.clear();  // the FEM's reports and VTU files replace the reduced ones
+        app.vtu.clear();
+        pvd = PvdSeries((dir / "results.pvd").string());
+      } else {
+        full = false;
+        solver_stats.add_str("mode", "quasi_static")
+            .add_str("model", "reduced")
+            .add("states", static_cast<double>(rr.stats.states))
+            .add("rejected_time_steps", static_cast<double>(rr.stats.rejected_steps))
+            .add("newton_iterations", static_cast<double>(rr.stats.newton_iterations));
+      }
+      write_file_atomic((dir / "reduced_check.csv").string(), reduced_check_csv(rr.reports));
+      reduced_json = reduced_summary(*rsetup, rr, tol, fallback);
+    }
+    if (full) {
       QuasiStaticRun run(asmb, bm->solver.quasi_static);
       try {
         run.run(bm->load, observe, sink, resume_from.get());
@@ -276,6 +368,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       }
       const StaticStats& st = run.static_solver().stats();
       solver_stats.add_str("mode", "quasi_static")
+          .add_str("model", "full")
           .add_str("method", bm->solver.quasi_static.method == EquilibriumMethod::Newton ? "newton" : "relaxation")
           .add("states", static_cast<double>(run.stats().states))
           .add("rejected_time_steps", static_cast<double>(run.stats().rejected_steps))
@@ -296,7 +389,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
           .add("assembly_s", st.assembly_s)
           .add("factor_solve_s", st.factor_s)
           .add("resumed", opt.resume ? 1.0 : 0.0);
-    } else {
+    } else if (bm->solver.mode == SolverSettings::Mode::Explicit) {
       if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
       // Explicit dynamics through the concatenated trials; time_scale > 1 compresses the
       // protocol (quasi-static by time scaling) and the reported times are protocol times.
@@ -369,6 +462,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       .add_str("load", bm->load.description)
       .add("mesh", mesh_stats_json(bm->stats))
       .add("solver", solver_stats.str(2))
+      .add("reduced_model", reduced_json)
       .add("timings", timings.str(2))
       .add("warnings", warnings)
       .add("metrics", metrics_note)

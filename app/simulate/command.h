@@ -9,7 +9,9 @@
 //   summary.json      version, status, resolved scene, mesh and solver statistics, timings
 //   scene.toml        the fully resolved scene (re-runnable as is; --resume reads it)
 //   results.pvd + vtu/state_NNNN.vtu   fields for ParaView
-//   checkpoint.bin    the full state at the last checkpoint (quasi-static runs)
+//   checkpoint.bin    the full state at the last checkpoint (quasi-static runs of the full FEM)
+//   reduced_check.csv solver.model = "reduced": each report's estimated angle error (the full
+//                     residual of the reconstructed state, weighted by the angle's adjoint)
 // Every file is written atomically (temporary file + rename).
 #include <functional>
 #include <string>
@@ -31,6 +33,9 @@ struct RunOptions {
   bool compare_ideal = true;           ///< also run the ideal elastic model and write metrics.json
   /// Share the ideal model between runs through this directory (app/simulate/ideal_cache.h); "" = compute.
   std::string ideal_cache_dir;
+  /// The reduced model's offline part (solver.model = "reduced"; app/simulate/reduced.h) is stored
+  /// and reused here; "" = computed every run.
+  std::string cache_dir;
 };
 
 struct RunResult {

@@ -94,6 +94,10 @@ const std::string& executable_fingerprint() {
 
 void hash_model(Fnv1a& h, const Scene& scene, const Model& model) {
   h.str(scene.model_toml());
+  hash_mesh(h, model);
+}
+
+void hash_mesh(Fnv1a& h, const Model& model) {
   std::vector<double> X;
   X.reserve(3 * model.mesh.X.size());
   for (const auto& x : model.mesh.X) X.insert(X.end(), {x.x(), x.y(), x.z()});

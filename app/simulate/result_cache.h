@@ -72,6 +72,9 @@ const std::string& executable_fingerprint();
 /// Hash of the model `scene` builds as `model`: the resolved scene (Scene::model_toml), and the
 /// mesh, boundary conditions, cavity faces, membranes and tip nodes of the built model.
 void hash_model(Fnv1a& h, const Scene& scene, const Model& model);
+/// The part of hash_model that is not the scene: mesh, boundary conditions, cavity faces,
+/// membranes and tip nodes.
+void hash_mesh(Fnv1a& h, const Model& model);
 
 /// The doubles of `compute()`, read from DIR/<kind>_<key>.bin when a valid entry exists, computed
 /// and stored otherwise. `source` (optional) gets "computed", "cache <file>" or "recomputed (<file>

@@ -1,0 +1,128 @@
+#include "app/simulate/reduced.h"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "app/simulate/result_cache.h"
+#include "core/errors.h"
+#include "engine/path_model.h"
+
+namespace pneufem {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// A trace stored flat: the sample count, the pressures, then each sample's displacement.
+std::vector<double> flatten_trace(const ElasticPathTrace& t) {
+  std::vector<double> f = {static_cast<double>(t.p_Pa.size())};
+  f.insert(f.end(), t.p_Pa.begin(), t.p_Pa.end());
+  for (const Eigen::VectorXd& u : t.u) f.insert(f.end(), u.data(), u.data() + u.size());
+  return f;
+}
+
+ElasticPathTrace unflatten_trace(const std::vector<double>& f, Eigen::Index dofs, const std::string& source) {
+  const std::size_t ns = f.empty() ? 0 : static_cast<std::size_t>(f[0]);
+  if (f.empty() || f.size() != 1 + ns + ns * static_cast<std::size_t>(dofs))
+    throw InputError("reduced model: the stored elastic path (" + source + ") does not fit the model; delete it");
+  ElasticPathTrace t;
+  t.p_Pa.assign(f.begin() + 1, f.begin() + 1 + static_cast<std::ptrdiff_t>(ns));
+  for (std::size_t k = 0; k < ns; ++k)
+    t.u.push_back(Eigen::Map<const Eigen::VectorXd>(f.data() + 1 + ns + k * static_cast<std::size_t>(dofs), dofs));
+  return t;
+}
+
+}  // namespace
+
+double peak_pressure(const LoadHistory& load) {
+  double p = 0.0;
+  for (const TrialLoad& tl : load.trials)
+    for (double x : tl.pressure_Pa) p = std::max(p, x);
+  return p;
+}
+
+std::unique_ptr<ReducedSetup> reduced_setup(const Scene& scene, double p_max_Pa, const RomBasisOptions& options,
+                                            const std::string& cache_dir) {
+  const auto t0 = Clock::now();
+  auto out = std::make_unique<ReducedSetup>();
+  const Scene ref_scene = elastic_reference_scene(scene).with({"load.trials=1"});
+  out->reference = build_model(ref_scene);
+  const Model& ref = out->reference->model;
+  PathModelOptions po;
+  po.p_top_Pa = 1.8 * std::max(p_max_Pa, 1e3);
+  po.dp_Pa = std::max(p_max_Pa, 1e3) / 40.0;
+  po.newton = out->reference->solver.quasi_static.newton;
+  Fnv1a h;
+  h.str(executable_fingerprint());
+  h.str(ref_scene.model_toml_without({"load", "output", "solver"}));
+  hash_mesh(h, ref);
+  h.num(po.newton.rel_tol);
+  h.num(po.p_top_Pa);
+  h.num(po.dp_Pa);
+  const std::string path_key = h.hex();
+  auto trace = [&] { return flatten_trace(trace_elastic_path(ref, po)); };
+  const ElasticPathTrace path = unflatten_trace(cache_dir.empty() ? (out->path_source = "computed", trace())
+                                                                  : cached_doubles(cache_dir, "rom_path", path_key, trace, &out->path_source),
+                                                ref.num_dofs(), out->path_source);
+  h.str("basis");
+  h.num(options.clusters);
+  h.num(options.mode_samples);
+  h.num(options.max_modes);
+  h.num(options.pod_tolerance);
+  h.num(options.ecsw_tolerance);
+  h.num(options.training_fields);
+  h.num(options.training_softening);
+  h.num(options.training_amplitude);
+  h.num(options.stiff_modulus_ratio);
+  h.num(options.hyper_reduce ? 1.0 : 0.0);
+  auto build = [&] { return build_reduced_basis(ref, path, options).to_doubles(); };
+  out->basis = ReducedBasis::from_doubles(cache_dir.empty() ? (out->basis_source = "computed", build())
+                                                            : cached_doubles(cache_dir, "rom_basis", h.hex(), build, &out->basis_source));
+  out->offline_s = seconds_since(t0);
+  return out;
+}
+
+ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
+                             const std::function<void(const StateRecord&, const Eigen::VectorXd&, const std::vector<double>&)>& at_report,
+                             bool check) {
+  ReducedRunResult res;
+  const ReducedOrderModel rom(setup.reference->model, setup.basis, bm.model);
+  ReducedRun run(rom, bm.solver.quasi_static);
+  std::vector<StateRecord> records;
+  run.run(bm.load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) { records.push_back(r); });
+  res.stats = run.stats();
+  if (!check) {
+    for (const StateRecord& r : records) res.reports.push_back({r, ReducedCheck{}});
+    return res;
+  }
+  const auto t0 = Clock::now();
+  // The Newton-step check at each trial's report of largest angle (the top step, where the
+  // actuator is most sensitive and the history effects have acted longest).
+  std::map<int, std::size_t> top;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    auto [it, added] = top.emplace(records[k].trial, k);
+    if (!added && records[k].angle_deg > records[it->second].angle_deg) it->second = k;
+  }
+  std::set<std::size_t> newton_reports;
+  for (auto [trial, k] : top) newton_reports.insert(k);
+  std::size_t asked = 0, i = 0;
+  auto newton_at = [&](const ReducedStep&) { return newton_reports.count(asked++) > 0; };
+  replay_reduced_run(rom, run.trajectory(), [&](const ReducedStep&, const Eigen::VectorXd& u, const std::vector<double>& state,
+                                                const ReducedCheck& check) {
+    if (i >= records.size()) throw PhysicsError("reduced model: the replay found more reports than the run made (internal error)");
+    res.reports.push_back({records[i], check});
+    double e = std::isnan(check.angle_error_deg) ? 0.0 : std::abs(check.angle_error_deg);
+    if (!std::isnan(check.newton_angle_error_deg)) e = std::max(e, std::abs(check.newton_angle_error_deg));
+    if (e > res.worst_check_deg || res.worst_report < 0) res.worst_check_deg = e, res.worst_report = static_cast<int>(i);
+    if (at_report) at_report(records[i], u, state);
+    ++i;
+  }, newton_at);
+  if (i != records.size()) throw PhysicsError("reduced model: the replay found fewer reports than the run made (internal error)");
+  res.replay_s = seconds_since(t0);
+  return res;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,68 @@
+#pragma once
+// The reduced-order model of a scene (engine/rom.h) as the commands use it: the offline part
+// (elastic reference, its traced path, the basis) built once per actuator and stored in a cache
+// directory, and reduced runs whose reports are checked against the full model.
+//
+// Offline part. The reference is the scene's elastic reference (scenes/build_model.h
+// elastic_reference_scene: effects off, no gravity, no lag). Its path is traced to 1.8 x the
+// largest pressure of the load (softened models reach angles the elastic one reaches only above
+// it), in 40 samples up to that pressure. Cache key (app/simulate/result_cache.h): the executable,
+// the reference's scene without its [load], [output] and [solver] tables, the mesh and its sets,
+// the Newton tolerance, the traced range and the basis options: any effect, constant, gravity or
+// protocol reuses the basis of the same actuator; a change of mesh, material or build does not.
+//
+// Online part. run_reduced marches the load (ReducedRun), then replays the whole mesh's history
+// along the reduced trajectory (replay_reduced_run): VTU fields at the reports and the indicator,
+// the adjoint-weighted full residual, at every report; and at each trial's report of largest
+// angle the angle after one full Newton step (one factorisation per trial). The caller decides what a report above
+// solver.reduced_check_deg means (simulate falls back to the full FEM).
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/rom.h"
+#include "scenes/build_model.h"
+
+namespace pneufem {
+
+struct ReducedSetup {
+  std::unique_ptr<BuiltModel> reference;  ///< the elastic reference model
+  ReducedBasis basis;
+  std::string path_source, basis_source;  ///< "computed", "cache <file>", "recomputed (...)"
+  double offline_s = 0.0;                 ///< wall time of this setup (trace + basis, or reading them)
+};
+
+/// The reduced model's offline part for `scene` with loads up to `p_max_Pa`, cached in `cache_dir`
+/// ("" = always computed). Throws InputError for a scene the reduced model cannot run (non-local
+/// damage, a mesh without a stiff layer is fine), PhysicsError when the path cannot be traced.
+std::unique_ptr<ReducedSetup> reduced_setup(const Scene& scene, double p_max_Pa, const RomBasisOptions& options,
+                                            const std::string& cache_dir);
+
+/// One report of a reduced run with its check.
+struct ReducedReport {
+  StateRecord record;
+  ReducedCheck check;
+};
+
+struct ReducedRunResult {
+  std::vector<ReducedReport> reports;
+  ReducedRunStats stats;
+  double replay_s = 0.0;       ///< wall time of the full-mesh replay
+  double worst_check_deg = 0.0;  ///< largest |estimated angle error| over the reports (either estimate)
+  int worst_report = -1;       ///< its index in `reports`
+};
+
+/// Runs `bm` (the scene's model, same mesh as the setup's reference) through its load with the
+/// reduced model, replays the history and checks every report. `at_report` (optional) sees each
+/// report's record, full displacement and whole-mesh history, in order, after the replay.
+/// `check` = false: no replay (no at_report calls, no indicator): the reports of the run alone.
+ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
+                             const std::function<void(const StateRecord&, const Eigen::VectorXd&, const std::vector<double>&)>&
+                                 at_report = nullptr,
+                             bool check = true);
+
+/// The largest pressure of a load history (Pa).
+double peak_pressure(const LoadHistory& load);
+
+}  // namespace pneufem

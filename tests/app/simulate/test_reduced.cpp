@@ -1,0 +1,125 @@
+// `simulate` with solver.model = "reduced" (app/simulate/reduced.h): the run directory says what
+// the reduced model did, its offline part is reused from the cache bit for bit, a basis broken on
+// purpose is caught by the indicator and the run falls back to the full FEM, and bad keys are errors.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app/simulate/command.h"
+#include "core/errors.h"
+#include "scenes/build_model.h"
+
+namespace pneufem {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kStory = std::string(PNEUFEM_TEST_DATA_DIR) + "/../../scenes/examples/paper_story.toml";
+// 3 chambers, h = 6 mm, one trial of the staircase with 4 s holds: ~5 s per reduced run.
+const std::vector<std::string> kSmall = {"geometry.chambers=3", "mesh.h_mm=6.0", "output.vtu=\"none\"", "load.trials=1",
+                                         "load.hold_s=4.0", "load.mark_s=2.0", "materials.silicone.fatigue.tau_s=80.0"};
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("pneufem_test_reduced_" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+nlohmann::json summary(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+RunResult run(const fs::path& dir, std::vector<std::string> extra, const std::string& cache = "") {
+  std::vector<std::string> sets = kSmall;
+  sets.insert(sets.end(), extra.begin(), extra.end());
+  RunOptions opt;
+  opt.out_dir = dir.string();
+  opt.cache_dir = cache;
+  return run_simulation(Scene::load(kStory, sets), opt);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(SimulateReduced, ReportsTheReducedRunAndReusesItsCacheBitForBit) {
+  const fs::path cache = temp_dir("cache");
+  const fs::path a = temp_dir("a"), b = temp_dir("b"), full = temp_dir("full");
+  const RunResult ra = run(a, {"solver.model=\"reduced\""}, cache.string());
+  const RunResult rb = run(b, {"solver.model=\"reduced\""}, cache.string());
+  const RunResult rf = run(full, {});
+  const nlohmann::json sa = summary(a), sb = summary(b);
+  EXPECT_EQ(sa["solver"]["model"], "reduced");
+  EXPECT_EQ(sa["reduced_model"]["fallback"], "none");
+  EXPECT_EQ(sa["reduced_model"]["offline"]["basis"], "computed");
+  EXPECT_EQ(sb["reduced_model"]["offline"]["basis"].get<std::string>().rfind("cache ", 0), 0u);
+  EXPECT_EQ(sb["reduced_model"]["offline"]["path"].get<std::string>().rfind("cache ", 0), 0u);
+  EXPECT_TRUE(fs::exists(a / "reduced_check.csv"));
+  EXPECT_EQ(summary(full)["reduced_model"], nullptr);
+  ASSERT_EQ(ra.records.size(), rb.records.size());
+  ASSERT_EQ(ra.records.size(), rf.records.size());
+  for (std::size_t i = 0; i < ra.records.size(); ++i) {
+    EXPECT_EQ(ra.records[i].angle_deg, rb.records[i].angle_deg) << "report " << i;  // the cache holds exact bits
+    // Against the full FEM: within the reduced model's verified accuracy (tests/engine/test_rom.cpp).
+    EXPECT_NEAR(ra.records[i].angle_deg, rf.records[i].angle_deg, 0.1) << "report " << i;
+  }
+}
+
+// A basis whose hyper-reduction fits its training forces only to 90 % (reduced_ecsw_tol = 0.9)
+// integrates the silicone wrongly. The indicator (the adjoint-weighted full residual) sees it, the
+// run falls back to the full FEM and says so; and the estimate is the actual error of the reduced
+// angles to within 30 % (it is first order in an error of ~0.1 deg at 8.6 deg).
+TEST(SimulateReduced, ABrokenBasisIsCaughtAndTheRunFallsBackToTheFullFem) {
+  const fs::path dir = temp_dir("broken"), full = temp_dir("full2");
+  const RunResult r = run(dir, {"solver.model=\"reduced\"", "solver.reduced_ecsw_tol=0.9"});
+  const RunResult rf = run(full, {});
+  const nlohmann::json s = summary(dir);
+  EXPECT_EQ(s["solver"]["model"], "full");
+  const std::string why = s["reduced_model"]["fallback"];
+  EXPECT_EQ(why.rfind("full FEM: the reduced model's estimated angle error", 0), 0u) << why;
+  EXPECT_NE(why.find("solver.reduced_check_deg = 0.25"), std::string::npos) << why;
+  ASSERT_EQ(r.records.size(), rf.records.size());
+  for (std::size_t i = 0; i < r.records.size(); ++i) EXPECT_EQ(r.records[i].angle_deg, rf.records[i].angle_deg);
+  // reduced_check.csv keeps the reduced angles and the estimates.
+  std::ifstream in(dir / "reduced_check.csv");
+  std::string line;
+  std::getline(in, line);
+  double worst_est = 0.0, actual_at_worst = 0.0;
+  for (std::size_t i = 0; std::getline(in, line); ++i) {
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    ASSERT_LT(i, rf.records.size());
+    if (std::abs(v[4]) > std::abs(worst_est)) worst_est = v[4], actual_at_worst = v[3] - rf.records[i].angle_deg;
+  }
+  EXPECT_GT(std::abs(worst_est), 0.25);
+  EXPECT_NEAR(worst_est, actual_at_worst, 0.3 * std::abs(actual_at_worst));
+}
+
+TEST(SimulateReduced, BadReducedKeysAreErrors) {
+  const fs::path dir = temp_dir("bad");
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"tiny\""}); }).find("solver.model"), std::string::npos);
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_modes=0"}); }).find("solver.reduced_modes"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_ecsw_tol=1.5"}); }).find("solver.reduced_ecsw_tol"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.mode=\"explicit\""}); }).find("quasi_static"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_check_deg=0.0"}); }).find("solver.reduced_check_deg"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace pneufem
