@@ -1,6 +1,7 @@
 #pragma once
-// Explicit central-difference time integration (real dynamics) and dynamic relaxation
-// (quasi-static equilibrium with fictitious masses), both on the lumped mass of the Assembler.
+// Explicit central-difference time integration (real dynamics) on the lumped mass of the
+// Assembler. Dynamic relaxation (quasi-static equilibrium with fictitious masses) is in
+// engine/relaxation.h.
 //
 // Central difference with mass-proportional damping (Belytschko, Liu & Moran 2014, box 6.1):
 //   v^{n+1/2} = [(1 - a dt/2) v^{n-1/2} + dt M^{-1} (f_ext^n - f_int^n)] / (1 + a dt/2)
@@ -11,7 +12,6 @@
 // Selective mass scaling raises only the masses of nodes that would force dt below the target
 // (the stiff fabric layer), and the added mass is reported.
 #include <functional>
-#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -85,32 +85,5 @@ class ExplicitIntegrator {
   EnergyBalance energy_;
   ExplicitStats stats_;
 };
-
-// ---------------------------------------------------------------------------------------------
-
-struct RelaxationOptions {
-  double rel_tol = 1e-8;           ///< same residual criterion as the static solver
-  double abs_tol_N = 1e-12;
-  long max_iterations = 2'000'000;
-  double mass_factor = 0.5;        ///< m_i = mass_factor * sum_j |K_ij| (stability needs >= 1/4 at dt = 1;
-                                   ///< 1/2 leaves room for stiffening between mass updates)
-  int mass_update_interval = 500;  ///< iterations between fictitious-mass updates
-};
-
-struct RelaxationReport {
-  bool converged = false;
-  long iterations = 0;
-  long kinetic_peaks = 0;
-  double residual_N = 0.0;
-  double reference_N = 0.0;
-};
-
-/// Dynamic relaxation with kinetic damping (Cundall 1976; Underwood 1983): pseudo-time step 1,
-/// per-node fictitious masses from the Gershgorin bound of the current tangent, velocities reset
-/// at every kinetic-energy peak. Converges to R(u) = 0 with the static solver's criterion, from
-/// the warm start u. Reads the committed state, writes the trial state.
-RelaxationReport relax(const Assembler& assembler, double p_Pa, const TimeStep& ts,
-                       std::span<const double> state_committed, std::span<double> state_trial,
-                       Eigen::VectorXd& u, const RelaxationOptions& options = {});
 
 }  // namespace pneufem

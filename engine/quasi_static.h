@@ -30,8 +30,8 @@
 #include <Eigen/Core>
 
 #include "engine/assembly.h"
-#include "engine/explicit.h"
 #include "engine/load_history.h"
+#include "engine/relaxation.h"
 #include "engine/static_solver.h"
 
 namespace pneufem {

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include "engine/explicit.h"
+#include "engine/relaxation.h"
 #include "engine/static_solver.h"
 #include "core/errors.h"
 #include "tests/engine/test_meshes.h"
