@@ -7,6 +7,12 @@
 //   * sweep:     --param materials.<m>.<name>.<param>=LO:HI:N
 //   * compare / diagnose / synth: as a candidate effect with the registered bounds (app/diagnose/effect_catalog.h).
 //
+// One source of truth. Each parameter (name with its unit, unit, one-line doc, default, calibration
+// range) is declared here and nowhere else: the default scene's effect tables are generated from it
+// (scenes/effect_tables.h; `pneufem scene --defaults` prints them), the scene reader takes its key
+// names and the defaults of keys a scene leaves out from it, the diagnose catalog its units and
+// calibration ranges, and docs/scene_reference.md is generated from it (a test keeps it current).
+//
 // Decoration order. Effects are applied around the (stiffness-scaled) hyperelastic base in
 // ascending `order`, ties in registration order. The built-ins have
 //     mullins 100, fatigue 200, viscoelastic 300
@@ -34,6 +40,17 @@ struct EffectParameter {
   double default_value = 0.0; ///< used when a scene omits the parameter
   double lo = 0.0, hi = 0.0;  ///< calibration bounds (diagnose/compare); physical validity is the decorator's job
   bool log = false;           ///< calibrate/sample in log space (then lo > 0)
+  /// The scene holds a list, one value per term (the Prony terms of viscoelastic); the registry
+  /// describes one term. Built-in effects only: their scene tables are read by scenes/scene_materials.cpp.
+  bool per_term = false;
+};
+
+/// A non-numeric key of an effect's scene table: one of a few words (fatigue's `driver`). Built-in
+/// effects only, like per_term parameters.
+struct EffectChoice {
+  std::string name;                 ///< scene key materials.<m>.<effect>.<name>
+  std::string doc;                  ///< one line
+  std::vector<std::string> values;  ///< the allowed words; the first is the default
 };
 
 struct MaterialEffect {
@@ -44,13 +61,16 @@ struct MaterialEffect {
   std::function<MaterialPtr(MaterialPtr base, const std::map<std::string, double>& values)> decorate;
   int order = 0;         ///< decoration order, see above
   bool history = true;   ///< the response depends on the load history (rate or damage); false = elastic
-  /// Extra non-numeric scene keys the scene reader handles itself (the built-ins' driver, arrays).
-  std::vector<std::string> extra_keys;
+  std::vector<EffectChoice> choices;  ///< non-numeric scene keys (built-ins only)
+
+  /// The parameter called `name`; throws InputError naming the effect and its parameters.
+  const EffectParameter& param(const std::string& name) const;
 };
 
 /// Adds an effect. Throws InputError on an empty or duplicate name, a name that is not
 /// [a-z][a-z0-9_]*, a parameter named "enabled" or twice, bounds with !(lo < hi), a default outside
-/// [lo, hi], a log parameter with lo <= 0, or no decorate function.
+/// [lo, hi], a log parameter with lo <= 0, no decorate function, or per_term parameters or choices
+/// (which only the built-ins' scene reader understands).
 void register_material_effect(MaterialEffect e);
 
 /// The effect called `name`, or nullptr.
@@ -60,7 +80,11 @@ const MaterialEffect* find_material_effect(const std::string& name);
 std::vector<const MaterialEffect*> material_effects();
 
 /// True for mullins, fatigue and viscoelastic, whose scene tables carry non-numeric keys and are
-/// read by scenes/scene_materials.cpp directly (the registry describes their numeric parameters).
+/// read by scenes/scene_materials.cpp directly (with the names, defaults and choices declared here).
 bool is_builtin_effect(const std::string& name);
+
+/// The built-in effect `name` (mullins, fatigue or viscoelastic); a programming error otherwise
+/// (std::logic_error): callers name the built-ins literally.
+const MaterialEffect& builtin_effect(const std::string& name);
 
 }  // namespace pneufem

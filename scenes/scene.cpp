@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "scenes/default_scene_text.h"
+#include "scenes/effect_tables.h"
 
 namespace pneufem {
 
@@ -131,7 +132,7 @@ struct Scene::Impl {
 };
 
 const std::string& Scene::default_text() {
-  static const std::string text(kDefaultSceneText);
+  static const std::string text = expand_effect_tables(kDefaultSceneText);  // the registry's effect tables
   return text;
 }
 

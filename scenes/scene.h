@@ -19,7 +19,8 @@ class Scene {
   /// Loads `path` ("" = built-in default only) and applies `overrides` ("key=value", value in
   /// TOML syntax; bare words are taken as strings).
   static Scene load(const std::string& path, const std::vector<std::string>& overrides = {});
-  /// The built-in default scene text.
+  /// The built-in default scene text: scenes/data/default_scene.toml with the effect tables
+  /// generated from the registry in place of its marker line (scenes/effect_tables.h).
   static const std::string& default_text();
 
   /// Typed access to a dotted key of the resolved scene. Throws InputError naming the key and

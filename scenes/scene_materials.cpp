@@ -25,35 +25,64 @@ using detail::kMPa;
 using detail::positive;
 using detail::require_keys;
 
-// Inelastic effects of a material table: [materials.NAME.mullins], .fatigue, .viscoelastic, each
-// with `enabled` and its constants. Applied in the canonical order viscoelastic(fatigue(mullins)).
+/// The keys the table of effect `fx` may hold: `enabled`, its parameters and its choices.
+std::set<std::string> effect_keys(const MaterialEffect& fx) {
+  std::set<std::string> keys{"enabled"};
+  for (const EffectParameter& p : fx.params) keys.insert(p.name);
+  for (const EffectChoice& c : fx.choices) keys.insert(c.name);
+  return keys;
+}
+
+/// Parameter `name` of the effect table K: the scene's value, or the registered default when the
+/// table leaves it out (damage/registry.h declares every default once).
+double effect_number(const Scene& s, const std::string& K, const MaterialEffect& fx, const std::string& name) {
+  return s.has(K + "." + name) ? s.number(K + "." + name) : fx.param(name).default_value;
+}
+
+/// A per-term parameter (a list, one value per Prony term): the scene's list, or one term at the default.
+std::vector<double> effect_terms(const Scene& s, const std::string& K, const MaterialEffect& fx, const std::string& name) {
+  return s.has(K + "." + name) ? s.numbers(K + "." + name) : std::vector<double>{fx.param(name).default_value};
+}
+
+/// Choice `c` of the effect table K: the scene's word, which must be one of c.values, or the default.
+std::string effect_choice(const Scene& s, const std::string& K, const EffectChoice& c) {
+  const std::string key = K + "." + c.name;
+  if (!s.has(key)) return c.values.front();
+  const std::string v = s.string(key);
+  if (std::find(c.values.begin(), c.values.end(), v) != c.values.end()) return v;
+  std::string allowed;
+  for (std::size_t i = 0; i < c.values.size(); ++i)
+    allowed += (i == 0 ? "" : i + 1 == c.values.size() ? " or " : ", ") + ("\"" + c.values[i] + "\"");
+  s.fail(key, "must be " + allowed);
+}
+
+// Built-in inelastic effects of a material table: [materials.NAME.mullins], .fatigue, .viscoelastic,
+// each with `enabled` and its constants (names and defaults from the registry). Applied in the
+// canonical order viscoelastic(fatigue(mullins)).
 EffectParams effect_params(const Scene& s, const std::string& T) {
   EffectParams e;
   auto on = [&](const std::string& k) { return s.has(T + "." + k) && s.boolean(T + "." + k + ".enabled"); };
   if (on("mullins")) {
     const std::string K = T + ".mullins";
-    require_keys(s, K, {"enabled", "r", "m_MPa", "beta"}, "mullins");
-    e.mullins = MullinsParams{s.number(K + ".r"), s.number(K + ".m_MPa") * kMPa, s.number(K + ".beta")};
+    const MaterialEffect& fx = builtin_effect("mullins");
+    require_keys(s, K, effect_keys(fx), "mullins");
+    e.mullins = MullinsParams{effect_number(s, K, fx, "r"), effect_number(s, K, fx, "m_MPa") * kMPa,
+                              effect_number(s, K, fx, "beta")};
   }
   if (on("fatigue")) {
     const std::string K = T + ".fatigue";
-    require_keys(s, K, {"enabled", "driver", "W_th_MPa", "lambda_th", "tau_s", "q", "n", "d_fail", "nonlocal_radius_mm"},
-                 "fatigue");
+    const MaterialEffect& fx = builtin_effect("fatigue");
+    require_keys(s, K, effect_keys(fx), "fatigue");
     FatigueParams f;
-    const std::string driver = s.string(K + ".driver");
-    if (driver == "energy")
-      f.driver = FatigueDriver::energy;
-    else if (driver == "max_principal_stretch")
-      f.driver = FatigueDriver::max_principal_stretch;
-    else
-      s.fail(K + ".driver", "must be \"energy\" or \"max_principal_stretch\"");
-    f.W_th_Pa = s.number(K + ".W_th_MPa") * kMPa;
-    f.lambda_th = s.number(K + ".lambda_th");
-    f.tau_s = s.number(K + ".tau_s");
-    f.q = s.number(K + ".q");
-    f.n = s.number(K + ".n");
-    f.d_fail = s.number(K + ".d_fail");
-    const double R_mm = s.number(K + ".nonlocal_radius_mm");
+    f.driver = effect_choice(s, K, fx.choices.at(0)) == "energy" ? FatigueDriver::energy
+                                                                 : FatigueDriver::max_principal_stretch;
+    f.W_th_Pa = effect_number(s, K, fx, "W_th_MPa") * kMPa;
+    f.lambda_th = effect_number(s, K, fx, "lambda_th");
+    f.tau_s = effect_number(s, K, fx, "tau_s");
+    f.q = effect_number(s, K, fx, "q");
+    f.n = effect_number(s, K, fx, "n");
+    f.d_fail = effect_number(s, K, fx, "d_fail");
+    const double R_mm = effect_number(s, K, fx, "nonlocal_radius_mm");
     if (!(std::isfinite(R_mm) && R_mm >= 0.0))
       s.fail(K + ".nonlocal_radius_mm", "must be >= 0 mm (0 = local driver; > 0: averaged over this radius)");
     f.nonlocal_radius_m = R_mm * 1e-3;
@@ -61,8 +90,9 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
   }
   if (on("viscoelastic")) {
     const std::string K = T + ".viscoelastic";
-    require_keys(s, K, {"enabled", "gamma", "tau_s"}, "viscoelastic");
-    e.viscoelastic = ViscoParams{s.numbers(K + ".gamma"), s.numbers(K + ".tau_s")};
+    const MaterialEffect& fx = builtin_effect("viscoelastic");
+    require_keys(s, K, effect_keys(fx), "viscoelastic");
+    e.viscoelastic = ViscoParams{effect_terms(s, K, fx, "gamma"), effect_terms(s, K, fx, "tau_s")};
   }
   return e;
 }
@@ -148,13 +178,9 @@ struct Layer {
 std::optional<Layer> registered_layer(const Scene& s, const std::string& T, const MaterialEffect& fx, std::size_t rank) {
   const std::string K = T + "." + fx.name;
   if (!s.has(K) || !s.boolean(K + ".enabled")) return std::nullopt;
-  std::set<std::string> allowed{"enabled"};
+  require_keys(s, K, effect_keys(fx), "effect " + fx.name);
   std::map<std::string, double> values;
-  for (const EffectParameter& p : fx.params) {
-    allowed.insert(p.name);
-    values[p.name] = s.has(K + "." + p.name) ? s.number(K + "." + p.name) : p.default_value;
-  }
-  require_keys(s, K, allowed, "effect " + fx.name);
+  for (const EffectParameter& p : fx.params) values[p.name] = effect_number(s, K, fx, p.name);
   const MaterialEffect* f = &fx;  // registry entries are never moved
   return Layer{fx.order, rank, K, [f, values](MaterialPtr b) { return f->decorate(std::move(b), values); }};
 }

@@ -1,28 +1,18 @@
 #include "app/diagnose/effect_catalog.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <mutex>
 
 #include "core/errors.h"
+#include "core/json_writer.h"
 #include "damage/registry.h"
 
 namespace pneufem {
 
 namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  for (int p = 6; p <= 17; ++p) {  // shortest representation that reads back exactly
-    std::snprintf(buf, sizeof buf, "%.*g", p, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
 
 void require_count(const CandidateEffect& c, const std::vector<double>& v) {
   if (v.size() != c.params.size())
@@ -41,9 +31,51 @@ std::vector<std::string> per_soft_material(const Scene& s, const std::vector<std
   return out;
 }
 
+/// Candidate parameter `name` of the material effect `fx`: its unit, calibration range and scale
+/// from the registry (damage/registry.h, where they are declared once), with the catalog's own
+/// calibration start and synth truth.
+CandidateParameter registry_parameter(const MaterialEffect& fx, const std::string& name, double start, double truth) {
+  const EffectParameter& p = fx.param(name);
+  return {p.name, p.unit, p.lo, p.hi, start, truth, p.log};
+}
+
+/// The overrides that switch material effect `fx` on at `values` (one per calibrated parameter of
+/// `c`, a one-term list where the scene holds one per term) in every soft material.
+std::vector<std::string> material_effect_sets(const Scene& s, const MaterialEffect& fx, const CandidateEffect& c,
+                                              const std::vector<double>& v) {
+  require_count(c, v);
+  std::vector<std::pair<std::string, std::string>> kv{{fx.name + ".enabled", "true"}};
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    std::string value = json::num(v[i]);
+    if (fx.param(c.params[i].name).per_term) {  // a one-term list (not "[" + value + "]": GCC 12's false -Wrestrict)
+      value.insert(value.begin(), '[');
+      value.push_back(']');
+    }
+    kv.emplace_back(fx.name + "." + c.params[i].name, value);
+  }
+  return per_soft_material(s, kv);
+}
+
+/// A candidate for built-in material effect `name` calibrating `params` (the others stay at the
+/// scene's values), with the calibration start and synth truth of each.
+CandidateEffect material_candidate(const std::string& name, const std::string& description, const std::string& signature,
+                                   const std::vector<std::array<double, 2>>& start_truth,
+                                   const std::vector<std::string>& params) {
+  const MaterialEffect& fx = builtin_effect(name);
+  CandidateEffect e;
+  e.name = name;
+  e.description = description;
+  e.signature = signature;
+  e.history = fx.history;
+  for (std::size_t i = 0; i < params.size(); ++i)
+    e.params.push_back(registry_parameter(fx, params[i], start_truth[i][0], start_truth[i][1]));
+  e.sets = [e, fxp = &fx](const Scene& s, const std::vector<double>& v) { return material_effect_sets(s, *fxp, e, v); };
+  return e;
+}
+
 std::vector<CandidateEffect> builtin_candidates() {
   std::vector<CandidateEffect> c;
-  // Bounds: the same physical ranges as the registry's built-ins (damage/registry.cpp explains them);
+  // stiffness, pressure_lag and gravity are not material effects: their ranges are declared here.
   // `truth` is a clearly visible but plausible effect, `initial` a neutral start inside the bounds.
   {
     CandidateEffect e;
@@ -60,56 +92,27 @@ std::vector<CandidateEffect> builtin_candidates() {
       for (const std::string& m : soft_materials(s)) {  // relative to the scene's own scale
         const std::string key = "materials." + m + ".stiffness_scale";
         const double own = s.has(key) ? s.number(key) : 1.0;
-        out.push_back(key + "=" + fmt(own * v[0]));
+        out.push_back(key + "=" + json::num(own * v[0]));
       }
       if (out.empty()) throw InputError("candidate 'stiffness': the scene has no soft material");
       return out;
     };
     c.push_back(e);
   }
-  {
-    CandidateEffect e;
-    e.name = "viscoelastic";
-    e.description = "the silicone creeps: one Prony term of relaxation stiffens it right after each step";
-    e.signature = "angle creeps upward during each hold (smaller at the 2.5 s mark than at the hold's end), "
-                  "recovering between trials";
-    e.history = true;
-    e.params = {{"gamma", "1", 0.02, 3.0, 0.2, 0.5, true}, {"tau_s", "s", 0.2, 30.0, 2.0, 4.0, true}};
-    e.sets = [e](const Scene& s, const std::vector<double>& v) {
-      require_count(e, v);
-      return per_soft_material(s, {{"viscoelastic.enabled", "true"},
-                                   {"viscoelastic.gamma", "[" + fmt(v[0]) + "]"},
-                                   {"viscoelastic.tau_s", "[" + fmt(v[1]) + "]"}});
-    };
-    c.push_back(e);
-  }
-  {
-    CandidateEffect e;
-    e.name = "mullins";
-    e.description = "Mullins softening: the silicone is softer below the largest strain it has seen";
-    e.signature = "first trial stiffer than the later ones, later trials nearly alike; the drop is largest "
-                  "at low and mid pressures";
-    e.history = true;
-    e.params = {{"r", "1", 1.1, 20.0, 5.0, 3.0, true}, {"m_MPa", "MPa", 1e-3, 0.1, 0.01, 0.01, true}};
-    e.sets = [e](const Scene& s, const std::vector<double>& v) {
-      require_count(e, v);  // beta stays at the scene's value
-      return per_soft_material(s, {{"mullins.enabled", "true"}, {"mullins.r", fmt(v[0])}, {"mullins.m_MPa", fmt(v[1])}});
-    };
-    c.push_back(e);
-  }
-  {
-    CandidateEffect e;
-    e.name = "fatigue";
-    e.description = "progressive fatigue damage of the most strained silicone, growing with time under load";
-    e.signature = "angle grows from trial to trial without settling, fastest at the highest pressures";
-    e.history = true;
-    e.params = {{"W_th_MPa", "MPa", 0.003, 0.1, 0.03, 0.02, true}, {"tau_s", "s", 100.0, 1e5, 5000.0, 2000.0, true}};
-    e.sets = [e](const Scene& s, const std::vector<double>& v) {
-      require_count(e, v);  // q and driver stay at the scene's values
-      return per_soft_material(s, {{"fatigue.enabled", "true"}, {"fatigue.W_th_MPa", fmt(v[0])}, {"fatigue.tau_s", fmt(v[1])}});
-    };
-    c.push_back(e);
-  }
+  // Material effects: units and ranges from the registry; the calibration start (a neutral point
+  // inside the range) and synth's truth (a clearly visible but plausible effect) are the catalog's.
+  c.push_back(material_candidate(
+      "viscoelastic", "the silicone creeps: one Prony term of relaxation stiffens it right after each step",
+      "angle creeps upward during each hold (smaller at the 2.5 s mark than at the hold's end), recovering between trials",
+      {{0.2, 0.5}, {2.0, 4.0}}, {"gamma", "tau_s"}));
+  c.push_back(material_candidate(  // beta stays at the scene's value
+      "mullins", "Mullins softening: the silicone is softer below the largest strain it has seen",
+      "first trial stiffer than the later ones, later trials nearly alike; the drop is largest at low and mid pressures",
+      {{5.0, 3.0}, {0.01, 0.01}}, {"r", "m_MPa"}));
+  c.push_back(material_candidate(  // q and driver stay at the scene's values
+      "fatigue", "progressive fatigue damage of the most strained silicone, growing with time under load",
+      "angle grows from trial to trial without settling, fastest at the highest pressures",
+      {{0.03, 0.02}, {5000.0, 2000.0}}, {"W_th_MPa", "tau_s"}));
   {
     CandidateEffect e;
     e.name = "pressure_lag";
@@ -120,7 +123,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     e.params = {{"tau_s", "s", 0.02, 3.0, 0.1, 0.5, true}};
     e.sets = [e](const Scene&, const std::vector<double>& v) {
       require_count(e, v);
-      return std::vector<std::string>{"load.pressure_lag_s=" + fmt(v[0])};
+      return std::vector<std::string>{"load.pressure_lag_s=" + json::num(v[0])};
     };
     c.push_back(e);
   }
@@ -139,7 +142,7 @@ std::vector<CandidateEffect> builtin_candidates() {
     e.interpolation = ParameterInterpolation::rig_angle;
     e.sets = [e](const Scene&, const std::vector<double>& v) {
       require_count(e, v);
-      return std::vector<std::string>{"gravity.g_m_s2=[0.0, 0.0, 0.0]", "gravity.rig_angle_deg=" + fmt(v[0])};
+      return std::vector<std::string>{"gravity.g_m_s2=[0.0, 0.0, 0.0]", "gravity.rig_angle_deg=" + json::num(v[0])};
     };
     c.push_back(e);
   }
@@ -152,15 +155,8 @@ CandidateEffect registered_candidate(const MaterialEffect& fx) {
   e.description = fx.doc;
   e.signature = "the signature of the registered material effect '" + fx.name + "' (" + fx.doc + ")";
   e.history = fx.history;
-  for (const EffectParameter& p : fx.params)
-    e.params.push_back({p.name, p.unit, p.lo, p.hi, p.default_value, p.default_value, p.log});
-  const std::string name = fx.name;
-  e.sets = [e, name](const Scene& s, const std::vector<double>& v) {
-    require_count(e, v);
-    std::vector<std::pair<std::string, std::string>> kv{{name + ".enabled", "true"}};
-    for (std::size_t i = 0; i < v.size(); ++i) kv.emplace_back(name + "." + e.params[i].name, fmt(v[i]));
-    return per_soft_material(s, kv);
-  };
+  for (const EffectParameter& p : fx.params) e.params.push_back(registry_parameter(fx, p.name, p.default_value, p.default_value));
+  e.sets = [e, fxp = &fx](const Scene& s, const std::vector<double>& v) { return material_effect_sets(s, *fxp, e, v); };
   return e;
 }
 

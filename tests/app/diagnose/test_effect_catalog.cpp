@@ -127,5 +127,33 @@ TEST(EffectCatalog, RegisteredMaterialEffectsBecomeCandidates) {
   EXPECT_EQ(soft_materials(base), std::vector<std::string>{"silicone"});
 }
 
+// The material candidates take their units and calibration ranges from the effect registry, the
+// one place they are declared (damage/registry.h); the catalog declares only which constants are
+// calibrated, where the calibration starts and the truth synth hides.
+TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
+  register_test_effect_once();
+  int checked = 0;
+  for (const CandidateEffect& c : candidate_effects()) {
+    const MaterialEffect* fx = find_material_effect(c.name);
+    if (!fx) continue;
+    EXPECT_EQ(c.history, fx->history) << c.name;
+    for (const CandidateParameter& p : c.params) {
+      const EffectParameter& r = fx->param(p.name);
+      EXPECT_EQ(p.unit, r.unit) << c.name << "." << p.name;
+      EXPECT_EQ(p.lo, r.lo) << c.name << "." << p.name;
+      EXPECT_EQ(p.hi, r.hi) << c.name << "." << p.name;
+      EXPECT_EQ(p.log, r.log) << c.name << "." << p.name;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 2 + 2 + 2 + 1);  // viscoelastic, mullins, fatigue, the test effect
+  // Calibration start and synth truth are the catalog's own, and not defaults: Mullins starts at
+  // r = 5 (near the middle of log [1.1, 20]) and hides r = 3, while a scene's default is 8.
+  const CandidateEffect& m = candidate_effect("mullins");
+  EXPECT_EQ(m.params[0].initial, 5.0);
+  EXPECT_EQ(m.params[0].truth, 3.0);
+  EXPECT_EQ(builtin_effect("mullins").param("r").default_value, 8.0);
+}
+
 }  // namespace
 }  // namespace pneufem
