@@ -145,6 +145,20 @@ std::string effect_truth_json(const CandidateEffect& c, const std::vector<std::s
 
 }  // namespace
 
+CommandedSteps commanded_steps(const TrialLoad& trial) {
+  CommandedSteps out;
+  double prev = 0.0;
+  for (std::size_t i = 0; i < trial.step_start_s.size(); ++i) {
+    const double level_kPa = trial.step_level_Pa[i] * 1e-3;
+    if (level_kPa != prev) {
+      out.t_s.push_back(trial.step_start_s[i]);
+      out.jump_kPa.push_back(level_kPa - prev);
+    }
+    prev = level_kPa;
+  }
+  return out;
+}
+
 double controller_pressure_kPa(const std::vector<double>& t_cmd, const std::vector<double>& dL, double f_n,
                                double zeta, double t) {
   const double w = 2.0 * kPi * f_n, wd = w * std::sqrt(1.0 - zeta * zeta), c = zeta / std::sqrt(1.0 - zeta * zeta);
@@ -232,26 +246,17 @@ SynthResult run_synth(const SynthOptions& o) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
   std::unique_ptr<BuiltModel> bm = build_model(scene);  // validates everything, staircase metadata
 
-  // 2-3. True inlet per trial, its piecewise-linear fit, reports.
-  // bm->load is the scene's staircase (lagged if load.pressure_lag_s > 0); the commanded steps come from
-  // the same staircase and the lag is re-applied below to the controller's inlet instead.
-  const LoadHistory commanded = staircase(scene.number("load.max_kPa") * 1e3, scene.number("load.step_kPa") * 1e3,
-                                          scene.number("load.hold_s"), scene.number("load.ramp_s"),
-                                          scene.integer("load.trials"), scene.number("load.mark_s"),
-                                          scene.number("load.rest_s"), 0.0);
+  // 2-3. True inlet per trial, its piecewise-linear fit, reports. The commanded steps are those of the
+  // scene's staircase, built where every command builds it (inlet_load, before any chamber lag); the
+  // lag is applied below to the controller's inlet instead.
+  const LoadHistory commanded = inlet_load(scene);
   LoadHistory inlet = commanded;
   std::vector<std::vector<double>> t_cmd(commanded.trials.size()), dL(commanded.trials.size());
   for (std::size_t k = 0; k < commanded.trials.size(); ++k) {
     const TrialLoad& c = commanded.trials[k];
-    double prev = 0.0;
-    for (std::size_t i = 0; i < c.step_start_s.size(); ++i) {
-      const double level_kPa = c.step_level_Pa[i] * 1e-3;
-      if (level_kPa != prev) {
-        t_cmd[k].push_back(c.step_start_s[i]);
-        dL[k].push_back(level_kPa - prev);
-      }
-      prev = level_kPa;
-    }
+    const CommandedSteps steps = commanded_steps(c);
+    t_cmd[k] = steps.t_s;
+    dL[k] = steps.jump_kPa;
     const double T = c.duration();
     const long n = static_cast<long>(std::floor(T * o.pressure_rate_Hz + 1e-9));
     std::vector<double> ts, ps;

@@ -6,8 +6,9 @@
 // Pipeline:
 //  1. scene = SCENE.toml + --set, then the hidden candidate effects (app/diagnose/effect_catalog.h) at their
 //     truth values, then --set again (so a user's --set overrides a hidden effect's value);
-//  2. commanded inlet: the scene's staircase as ideal steps at each step start (load.ramp_s is
-//     ignored: the controller model supplies the rise); the true inlet pressure is the closed-form
+//  2. commanded inlet: the scene's staircase (scenes/build_model.h inlet_load, as every command
+//     builds it) as ideal steps at each step start (load.ramp_s is ignored: the controller model
+//     supplies the rise); the true inlet pressure is the closed-form
 //     response of a second-order controller,
 //        p_in(t) = sum_k dL_k S(t - t_k),  S(s) = 1 - exp(-zeta w s) (cos(w_d s) + zeta/sqrt(1-zeta^2) sin(w_d s)),
 //     w = 2 pi f_n, w_d = w sqrt(1 - zeta^2) (zeta = 0.65, f_n = 1 Hz: 6.8 % overshoot, 10-90 % rise
@@ -32,6 +33,7 @@
 #include <vector>
 
 #include "analysis/measurements.h"
+#include "engine/load_history.h"
 
 namespace pneufem {
 
@@ -71,6 +73,15 @@ SynthResult run_synth(const SynthOptions& options);
 /// Splits "a,b" into names; "none" = no effect. Throws InputError for unknown or repeated names
 /// (listing the candidates).
 std::vector<std::string> parse_hidden(const std::string& spec);
+
+/// The commanded inlet of one staircase trial as ideal steps: the step starts where the level
+/// changes and the jumps (kPa), from the trial's step metadata (load.ramp_s is not used: the
+/// controller supplies the rise).
+struct CommandedSteps {
+  std::vector<double> t_s;
+  std::vector<double> jump_kPa;
+};
+CommandedSteps commanded_steps(const TrialLoad& trial);
 
 /// Closed-form inlet pressure (kPa) at time t of a second-order controller tracking steps of
 /// size step_kPa[k] commanded at t_cmd_s[k] from rest at 0 (see the header comment).

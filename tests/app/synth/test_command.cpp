@@ -15,6 +15,7 @@
 #include "app/synth/command.h"
 #include "core/errors.h"
 #include "core/json_writer.h"
+#include "scenes/build_model.h"
 #include "tests/app/cli_helpers.h"
 
 namespace pneufem {
@@ -209,6 +210,22 @@ TEST(Synth, CommandLine) {
   const auto [code_ok, out_ok] = run(args);
   EXPECT_EQ(code_ok, 0) << out_ok;
   EXPECT_NE(slurp(dir() / "cli_ok.truth.json").find("materials.silicone.stiffness_scale=1.3"), std::string::npos);
+}
+
+// The commanded steps come from the scene's staircase as every command builds it (inlet_load):
+// one step per level change at the step starts, whatever the report settings.
+TEST(Synth, CommandedStepsAreTheScenesStaircase) {
+  for (const char* every : {"load.output_every_s=0.0", "load.output_every_s=1.0"}) {
+    std::vector<std::string> sets = kSmall;
+    sets.push_back(every);
+    const LoadHistory load = inlet_load(Scene::load("", sets));
+    ASSERT_EQ(load.trials.size(), 2u);
+    for (const TrialLoad& t : load.trials) {
+      const CommandedSteps c = commanded_steps(t);
+      EXPECT_EQ(c.t_s, (std::vector<double>{4.0, 8.0})) << every;
+      EXPECT_EQ(c.jump_kPa, (std::vector<double>{5.0, 5.0})) << every;
+    }
+  }
 }
 
 }  // namespace
