@@ -13,6 +13,7 @@
 #include "scenes/build_model.h"
 #include "scenes/calculix_deck.h"
 #include "scenes/scene.h"
+#include "scenes/scene_reference.h"
 #include "viz/vtk_output.h"
 
 namespace pneufem {
@@ -105,12 +106,16 @@ int run_mesh_command(const MeshCommand& c) {
 std::unique_ptr<SceneCommand> add_scene_command(CLI::App& app) {
   auto c = std::make_unique<SceneCommand>();
   c->cmd = app.add_subcommand("scene", "Print the built-in default scene (every key, with units and comments)");
-  c->cmd->add_flag("--defaults", c->defaults, "Print the default scene (the default action)");
+  CLI::Option* d = c->cmd->add_flag("--defaults", c->defaults, "Print the default scene (the default action)");
+  c->cmd->add_flag("--reference", c->reference,
+                   "Print the scene reference in Markdown: every key with its default, unit and meaning "
+                   "(docs/scene_reference.md)")
+      ->excludes(d);
   return c;
 }
 
-int run_scene_command(const SceneCommand&) {
-  std::cout << Scene::default_text();
+int run_scene_command(const SceneCommand& c) {
+  std::cout << (c.reference ? scene_reference_markdown() : Scene::default_text());
   return 0;
 }
 

@@ -47,12 +47,13 @@ int run_mesh_command(const MeshCommand& c);
 struct SceneCommand {
   CLI::App* cmd = nullptr;
   bool defaults = false;
+  bool reference = false;
 };
 
-/// Adds `scene [--defaults]` to `app`.
+/// Adds `scene [--defaults | --reference]` to `app`.
 std::unique_ptr<SceneCommand> add_scene_command(CLI::App& app);
 
-/// Prints the built-in default scene; returns the exit code.
+/// Prints the built-in default scene, or the scene reference (Markdown); returns the exit code.
 int run_scene_command(const SceneCommand& c);
 
 }  // namespace pneufem
