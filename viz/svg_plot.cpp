@@ -1,6 +1,7 @@
 #include "viz/svg_plot.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/atomic_file.h"
+#include "core/json_writer.h"
 
 namespace pneufem::svg {
 
@@ -22,7 +24,12 @@ constexpr int kPaletteSize = 8;
 // Stands for the id prefix while rendering; escape() drops control characters, so user text
 // can never contain it.
 constexpr const char* kIdToken = "\x01";
-constexpr double kTickFont = 11, kLabelFont = 12, kTitleFont = 13, kFigureTitleFont = 15;
+// Fonts for print: a figure kColumnWidthPx wide (per column of axes) is printed at a journal's single
+// column, 3.5 in, where 1 px = 3.5 * 72 / 480 = 0.525 pt; the smallest text (ticks, legend) is then
+// 14 px = 7.4 pt, labels 7.9 pt, titles 8.4-8.9 pt, exponents 7.1 pt (journals ask for 6-8 pt).
+constexpr double kTickFont = 14, kLabelFont = 15, kTitleFont = 16, kFigureTitleFont = 17, kExponentFont = 13.5;
+// Padding of an axis range beyond its data, as a fraction of the span (points stay off the frame).
+constexpr double kPad = 0.04;
 constexpr const char* kInk = "#222222";
 
 /// Pixel coordinates: two decimals, trailing zeros dropped, never "-0".
@@ -58,7 +65,7 @@ bool inside(double v, double lo, double hi) {
 }
 
 /// Log-axis label as SVG markup: plain numbers for 0.001 .. 10000, else m x 10^k.
-std::string log_label(double v) {
+std::string log_label(double v, double exponent_font) {
   const int e = static_cast<int>(std::floor(std::log10(v) + 1e-9));
   const double m = std::round(v / pow10i(e) * 1e6) / 1e6;
   char buf[48];
@@ -72,7 +79,7 @@ std::string log_label(double v) {
     s = std::string(buf) + "\xC3\x97";  // U+00D7 multiplication sign
   }
   std::snprintf(buf, sizeof buf, "%d", e);
-  return s + "10<tspan dy=\"-5\" font-size=\"8\">" + buf + "</tspan>";
+  return s + "10<tspan dy=\"" + px(-0.45 * exponent_font) + "\" font-size=\"" + px(exponent_font) + "\">" + buf + "</tspan>";
 }
 
 std::string marker_svg(Marker m, double cx, double cy, double r) {
@@ -133,6 +140,25 @@ void replace_all(std::string& s, const std::string& from, const std::string& to)
   for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
 }
 
+/// Text for a '#' comment line: newlines become spaces.
+std::string csv_comment(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
+  return text;
+}
+
+/// The axis range of data [lo, hi]: padded by kPad of the span (of the decades on a log axis) on
+/// each side, but not across zero where the data stop at zero (bars, a pressure starting at rest).
+std::pair<double, double> padded(double lo, double hi, bool log) {
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo)) return {lo, hi};
+  if (log) {
+    const double f = std::pow(hi / lo, kPad);
+    return {lo / f, hi * f};
+  }
+  const double d = kPad * (hi - lo);
+  return {lo >= 0.0 ? std::max(0.0, lo - d) : lo - d, hi <= 0.0 ? std::min(0.0, hi + d) : hi + d};
+}
+
 void check_sizes(std::size_t a, std::size_t b, const char* what) {
   if (a != b)
     throw std::invalid_argument(std::string("svg::Axes::") + what + ": the data vectors differ in length (" +
@@ -144,7 +170,7 @@ void check_sizes(std::size_t a, std::size_t b, const char* what) {
 // ---------------------------------------------------------------------------------------------
 // Ticks
 
-Ticks linear_ticks(double lo, double hi, int target, bool widen) {
+Ticks linear_ticks(double lo, double hi, int target, bool widen, bool integer) {
   Ticks t;
   if (!std::isfinite(lo) || !std::isfinite(hi)) lo = 0.0, hi = 1.0;
   if (lo > hi) std::swap(lo, hi);
@@ -160,6 +186,7 @@ Ticks linear_ticks(double lo, double hi, int target, bool widen) {
   const double f = raw / pow10i(e);
   int nice = f <= 1.0 + 1e-9 ? 1 : f <= 2.0 + 1e-9 ? 2 : f <= 5.0 + 1e-9 ? 5 : 10;
   if (nice == 10) nice = 1, ++e;
+  if (integer && e < 0) nice = 1, e = 0;  // whole numbers: a step of at least 1
   t.step = scaled(nice, e);
   if (widen) {
     lo = scaled(std::floor(lo / t.step + 1e-9) * nice, e);
@@ -236,6 +263,36 @@ std::string escape(const std::string& text) {
   return out;
 }
 
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos && (text.empty() || text[0] != '#')) return text;
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string csv_number(double v) { return std::isfinite(v) ? json::num(v) : ""; }
+
+std::string palette_color(std::size_t i) { return kPalette[i % kPaletteSize]; }
+
+std::string diverging_color(double v) {
+  // ColorBrewer RdBu (Brewer & Harrower), 9 classes from blue to red, interpolated linearly.
+  static constexpr unsigned kStops[] = {0x2166AC, 0x4393C3, 0x92C5DE, 0xD1E5F0, 0xF7F7F7,
+                                        0xFDDBC7, 0xF4A582, 0xD6604D, 0xB2182B};
+  constexpr int n = 9;
+  const double x = (std::clamp(std::isfinite(v) ? v : 0.0, -1.0, 1.0) + 1.0) * 0.5 * (n - 1);
+  const int i = std::min(static_cast<int>(x), n - 2);
+  const double w = x - i;
+  char buf[8];
+  unsigned rgb[3];
+  for (int c = 0; c < 3; ++c) {
+    const int sh = 16 - 8 * c;
+    const double a = (kStops[i] >> sh) & 0xFF, b = (kStops[i + 1] >> sh) & 0xFF;
+    rgb[c] = static_cast<unsigned>(std::lround((1.0 - w) * a + w * b));
+  }
+  std::snprintf(buf, sizeof buf, "#%02X%02X%02X", rgb[0], rgb[1], rgb[2]);
+  return buf;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Scale
 
@@ -258,6 +315,7 @@ Axes& Axes::xlabel(const std::string& text) { return xlabel_ = text, *this; }
 Axes& Axes::ylabel(const std::string& text) { return ylabel_ = text, *this; }
 Axes& Axes::y2label(const std::string& text) { return y2label_ = text, *this; }
 Axes& Axes::xlog(bool on) { return xlog_ = on, *this; }
+Axes& Axes::xinteger(bool on) { return xinteger_ = on, *this; }
 Axes& Axes::legend(Legend where) { return legend_ = where, *this; }
 Axes& Axes::note(const std::string& text) { return note_ = text, *this; }
 
@@ -355,12 +413,13 @@ Figure::Layout Figure::layout(int row, int col) const {
   L.y2_on = !a.y2label_.empty() || a.has_y2lim_ ||
             std::any_of(a.series_.begin(), a.series_.end(), [](const Axes::Series& s) { return s.style.axis == YAxis::Right; });
 
-  const double top0 = title_.empty() ? 0.0 : margins.figure_title;
+  const double k = text_scale();
+  const double top0 = title_.empty() ? 0.0 : k * margins.figure_title;
   const double cw = width_ / cols_, ch = (height_ - top0) / rows_;
-  L.area.x = col * cw + margins.left;
-  L.area.y = top0 + row * ch + margins.top + (a.title_.empty() ? 0.0 : margins.axes_title);
-  L.area.width = std::max(1.0, cw - margins.left - (L.y2_on ? margins.right_y2 : margins.right));
-  L.area.height = std::max(1.0, top0 + (row + 1) * ch - margins.bottom - L.area.y);
+  L.area.x = col * cw + k * margins.left;
+  L.area.y = top0 + row * ch + k * (margins.top + (a.title_.empty() ? 0.0 : margins.axes_title));
+  L.area.width = std::max(1.0, cw - k * (margins.left + (L.y2_on ? margins.right_y2 : margins.right)));
+  L.area.height = std::max(1.0, top0 + (row + 1) * ch - k * margins.bottom - L.area.y);
 
   // Data ranges.
   const bool xlog = a.xlog_ && !L.categorical;
@@ -387,20 +446,22 @@ Figure::Layout Figure::layout(int row, int col) const {
       }
   }
 
-  const int xt = std::clamp(static_cast<int>(std::lround(L.area.width / 100.0)), 3, 8);
-  const int yt = std::clamp(static_cast<int>(std::lround(L.area.height / 60.0)), 3, 8);
+  const int xt = std::clamp(static_cast<int>(std::lround(L.area.width / (80.0 * k))), 3, 8);
+  const int yt = std::clamp(static_cast<int>(std::lround(L.area.height / (60.0 * k))), 3, 8);
   if (L.categorical) {
     const int n = static_cast<int>(a.categories_.size());
     L.x.lo = -0.5, L.x.hi = n - 0.5, L.x.step = 1.0;
     for (int i = 0; i < n; ++i) L.x.major.push_back(i);
-  } else if (a.has_xlim_) {
-    L.x = xlog ? log_ticks(a.xlim_[0], a.xlim_[1], false) : linear_ticks(a.xlim_[0], a.xlim_[1], xt, false);
   } else {
-    L.x = xlog ? log_ticks(x0, x1, true) : linear_ticks(x0, x1, xt, true);
+    const auto [lo, hi] = a.has_xlim_ ? std::pair(a.xlim_[0], a.xlim_[1]) : padded(x0, x1, xlog);
+    L.x = xlog ? log_ticks(lo, hi, false) : linear_ticks(lo, hi, xt, false, a.xinteger_);
   }
-  L.y = a.has_ylim_ ? linear_ticks(a.ylim_[0], a.ylim_[1], yt, false) : linear_ticks(y0[0], y1[0], yt, true);
-  if (L.y2_on)
-    L.y2 = a.has_y2lim_ ? linear_ticks(a.y2lim_[0], a.y2lim_[1], yt, false) : linear_ticks(y0[1], y1[1], yt, true);
+  const auto [ylo, yhi] = a.has_ylim_ ? std::pair(a.ylim_[0], a.ylim_[1]) : padded(y0[0], y1[0], false);
+  L.y = linear_ticks(ylo, yhi, yt, false);
+  if (L.y2_on) {
+    const auto [lo, hi] = a.has_y2lim_ ? std::pair(a.y2lim_[0], a.y2lim_[1]) : padded(y0[1], y1[1], false);
+    L.y2 = linear_ticks(lo, hi, yt, false);
+  }
   return L;
 }
 
@@ -423,10 +484,40 @@ Ticks Figure::y_ticks(int row, int col, YAxis which) const {
   return which == YAxis::Right ? L.y2 : L.y;
 }
 
+std::vector<std::array<double, 2>> Figure::ink_samples(const Axes& a, const Scale& X, const Scale& Y, const Scale& Y2) {
+  // Pixel positions where the data put ink: every point, 8 points along every line segment and
+  // range bar, a 5 x 5 grid over every bar. Enough to tell a crowded corner from an empty one.
+  std::vector<std::array<double, 2>> ink;
+  auto add = [&](double x, double y) {
+    if (std::isfinite(x) && std::isfinite(y)) ink.push_back({x, y});
+  };
+  for (const Axes::Series& ser : a.series_) {
+    const Scale& SY = ser.style.axis == YAxis::Right ? Y2 : Y;
+    for (std::size_t i = 0; i < ser.x.size(); ++i) {
+      const double x = X(ser.x[i]), y = SY(ser.y[i]);
+      add(x, y);
+      const bool segment = ser.kind == Axes::Kind::Line && ser.style.line_width > 0.0 && i + 1 < ser.x.size();
+      const double x1 = segment ? X(ser.x[i + 1]) : x, y1 = segment ? SY(ser.y[i + 1]) : SY(ser.kind == Axes::Kind::Range ? ser.y_hi[i] : ser.y[i]);
+      for (int j = 1; j < 8 && (segment || ser.kind == Axes::Kind::Range); ++j) add(x + (x1 - x) * j / 8.0, y + (y1 - y) * j / 8.0);
+    }
+  }
+  const int G = static_cast<int>(a.bars_.size());
+  for (int g = 0; g < G; ++g)
+    for (std::size_t i = 0; i < a.bars_[g].values.size(); ++i) {
+      const double v = a.bars_[g].values[i], w = 0.8 / G;
+      if (!std::isfinite(v)) continue;
+      for (int u = 0; u < 5; ++u)
+        for (int t = 0; t < 5; ++t)
+          add(X(static_cast<double>(i) - 0.4 + (g + (u + 0.5) / 5.0) * w), Y(v * (t + 0.5) / 5.0));
+    }
+  return ink;
+}
+
 std::string Figure::render_axes(int row, int col) const {
   const Axes& a = at(row, col);
   const Layout L = layout(row, col);
   const Rect& R = L.area;
+  const double k = text_scale(), tick_font = k * kTickFont, label_font = k * kLabelFont;
   const double left = R.x, right = R.x + R.width, top = R.y, bottom = R.y + R.height;
   const bool xlog = a.xlog_ && !L.categorical;
   const Scale X(L.x.lo, L.x.hi, left, right, xlog);
@@ -519,47 +610,48 @@ std::string Figure::render_axes(int row, int col) const {
   std::size_t every = 1;  // categorical axis: label every k-th category when they would overlap
   if (L.categorical) {
     double widest = 0;
-    for (const std::string& c : a.categories_) widest = std::max(widest, text_width(c, kTickFont));
-    every = static_cast<std::size_t>(std::max(1.0, std::ceil((widest + 6) * a.categories_.size() / R.width)));
+    for (const std::string& c : a.categories_) widest = std::max(widest, text_width(c, tick_font));
+    every = static_cast<std::size_t>(std::max(1.0, std::ceil((widest + 6 * k) * a.categories_.size() / R.width)));
   }
+  const std::string major = px(5 * k), minor = px(3 * k);
   for (double v : L.x.major) {
-    ticks += "M" + px(X(v)) + " " + px(bottom) + "v5";
+    ticks += "M" + px(X(v)) + " " + px(bottom) + "v" + major;
     std::string label;
     if (L.categorical) {
       const auto i = static_cast<std::size_t>(std::lround(v));
       if (i % every == 0) label = escape(a.categories_[i]);
     } else {
-      label = xlog ? log_label(v) : escape(tick_label(v, L.x.step));
+      label = xlog ? log_label(v, k * kExponentFont) : escape(tick_label(v, L.x.step));
     }
-    if (!label.empty()) labels += text_el(X(v), bottom + 18, "middle", kTickFont, label);
+    if (!label.empty()) labels += text_el(X(v), bottom + 20 * k, "middle", tick_font, label);
   }
-  for (double v : L.x.minor) ticks += "M" + px(X(v)) + " " + px(bottom) + "v3";
+  for (double v : L.x.minor) ticks += "M" + px(X(v)) + " " + px(bottom) + "v" + minor;
   for (double v : L.y.major) {
-    ticks += "M" + px(left) + " " + px(Y(v)) + "h-5";
-    labels += text_el(left - 8, Y(v) + 4, "end", kTickFont, escape(tick_label(v, L.y.step)));
+    ticks += "M" + px(left) + " " + px(Y(v)) + "h-" + major;
+    labels += text_el(left - 8 * k, Y(v) + 5 * k, "end", tick_font, escape(tick_label(v, L.y.step)));
   }
   if (L.y2_on)
     for (double v : L.y2.major) {
-      ticks += "M" + px(right) + " " + px(Y2(v)) + "h5";
-      labels += text_el(right + 8, Y2(v) + 4, "start", kTickFont, escape(tick_label(v, L.y2.step)));
+      ticks += "M" + px(right) + " " + px(Y2(v)) + "h" + major;
+      labels += text_el(right + 8 * k, Y2(v) + 5 * k, "start", tick_font, escape(tick_label(v, L.y2.step)));
     }
   s += "<path d=\"" + ticks + "\" fill=\"none\" stroke=\"#333333\" stroke-width=\"1\"/>\n";
   s += "<g fill=\"" + std::string(kInk) + "\">\n" + labels;
 
   // Axis labels and title.
-  if (!a.xlabel_.empty()) s += text_el(0.5 * (left + right), bottom + 40, "middle", kLabelFont, escape(a.xlabel_));
+  if (!a.xlabel_.empty()) s += text_el(0.5 * (left + right), bottom + 46 * k, "middle", label_font, escape(a.xlabel_));
   if (!a.ylabel_.empty()) {
-    const double x = left - margins.left + 16, y = 0.5 * (top + bottom);
+    const double x = left - k * (margins.left - 18), y = 0.5 * (top + bottom);
     s += "<text transform=\"translate(" + px(x) + "," + px(y) + ") rotate(-90)\" text-anchor=\"middle\" font-size=\"" +
-         px(kLabelFont) + "\">" + escape(a.ylabel_) + "</text>\n";
+         px(label_font) + "\">" + escape(a.ylabel_) + "</text>\n";
   }
   if (L.y2_on && !a.y2label_.empty()) {
-    const double x = right + margins.right_y2 - 16, y = 0.5 * (top + bottom);
+    const double x = right + k * (margins.right_y2 - 18), y = 0.5 * (top + bottom);
     s += "<text transform=\"translate(" + px(x) + "," + px(y) + ") rotate(90)\" text-anchor=\"middle\" font-size=\"" +
-         px(kLabelFont) + "\">" + escape(a.y2label_) + "</text>\n";
+         px(label_font) + "\">" + escape(a.y2label_) + "</text>\n";
   }
-  if (!a.title_.empty()) s += text_el(0.5 * (left + right), top - 8, "middle", kTitleFont, escape(a.title_));
-  if (!a.note_.empty()) s += text_el(0.5 * (left + right), 0.5 * (top + bottom), "middle", kLabelFont, escape(a.note_), " fill=\"#777777\"");
+  if (!a.title_.empty()) s += text_el(0.5 * (left + right), top - 9 * k, "middle", k * kTitleFont, escape(a.title_));
+  if (!a.note_.empty()) s += text_el(0.5 * (left + right), 0.5 * (top + bottom), "middle", label_font, escape(a.note_), " fill=\"#777777\"");
   s += "</g>\n";
 
   // Legend: series, then bar groups, in the order they were added.
@@ -570,7 +662,7 @@ std::string Figure::render_axes(int row, int col) const {
   };
   std::vector<Entry> entries;
   for (const Axes::Series& ser : a.series_)
-    if (!ser.label.empty()) entries.push_back({ser.label, ser.style, static_cast<int>(ser.kind)});
+    if (!ser.label.empty() && ser.style.in_legend) entries.push_back({ser.label, ser.style, static_cast<int>(ser.kind)});
   for (const BarGroup& b : a.bars_)
     if (!b.label.empty()) {
       Style st;
@@ -578,18 +670,34 @@ std::string Figure::render_axes(int row, int col) const {
       entries.push_back({b.label, st, 3});
     }
   if (a.legend_ != Legend::None && !entries.empty()) {
-    constexpr double row_h = 17, pad = 7, sample = 24;
+    const double row_h = 19 * k, pad = 7 * k, sample = 24 * k, gap = 6 * k, edge = 8 * k;
     double tw = 0;
-    for (const Entry& e : entries) tw = std::max(tw, text_width(e.label, kLabelFont));
-    const double bw = pad + sample + 6 + tw + pad, bh = 2 * pad + row_h * entries.size() - 4;
-    const bool at_right = a.legend_ == Legend::UpperRight || a.legend_ == Legend::LowerRight;
-    const bool at_top = a.legend_ == Legend::UpperRight || a.legend_ == Legend::UpperLeft;
-    const double bx = at_right ? right - 8 - bw : left + 8, by = at_top ? top + 8 : bottom - 8 - bh;
+    for (const Entry& e : entries) tw = std::max(tw, text_width(e.label, tick_font));
+    const double bw = pad + sample + gap + tw + pad, bh = 2 * pad + row_h * entries.size() - 4 * k;
+    auto corner = [&](Legend where) {
+      const bool at_right = where == Legend::UpperRight || where == Legend::LowerRight;
+      const bool at_top = where == Legend::UpperRight || where == Legend::UpperLeft;
+      return Rect{at_right ? right - edge - bw : left + edge, at_top ? top + edge : bottom - edge - bh, bw, bh};
+    };
+    Legend where = a.legend_;
+    if (where == Legend::Best) {
+      const std::vector<std::array<double, 2>> ink = ink_samples(a, X, Y, Y2);
+      std::size_t fewest = std::numeric_limits<std::size_t>::max();
+      for (Legend c : {Legend::UpperRight, Legend::UpperLeft, Legend::LowerRight, Legend::LowerLeft}) {
+        const Rect r = corner(c);
+        const auto n = static_cast<std::size_t>(std::count_if(ink.begin(), ink.end(), [&](const std::array<double, 2>& p) {
+          return p[0] >= r.x && p[0] <= r.x + r.width && p[1] >= r.y && p[1] <= r.y + r.height;
+        }));
+        if (n < fewest) fewest = n, where = c;
+      }
+    }
+    const Rect box = corner(where);
+    const double bx = box.x, by = box.y;
     s += "<g>\n<rect x=\"" + px(bx) + "\" y=\"" + px(by) + "\" width=\"" + px(bw) + "\" height=\"" + px(bh) +
          "\" fill=\"#ffffff\" fill-opacity=\"0.85\" stroke=\"#bbbbbb\" stroke-width=\"0.8\"/>\n";
     for (std::size_t i = 0; i < entries.size(); ++i) {
       const Entry& e = entries[i];
-      const double cy = by + pad + row_h * i + 6.5, x0 = bx + pad, xm = x0 + 0.5 * sample;
+      const double cy = by + pad + row_h * i + 7.5 * k, x0 = bx + pad, xm = x0 + 0.5 * sample;
       if (e.kind == 0 && e.style.line_width > 0)
         s += "<path d=\"M" + px(x0) + " " + px(cy) + "H" + px(x0 + sample) + "\"" + stroke_attrs(e.style) + "/>\n";
       if ((e.kind == 0 || e.kind == 1) && e.style.marker != Marker::None)
@@ -598,13 +706,14 @@ std::string Figure::render_axes(int row, int col) const {
         Style st = e.style;
         st.dash.clear();
         st.line_width = std::max(1.0, std::min(st.line_width, 1.5));
-        s += "<path d=\"M" + px(xm) + " " + px(cy - 6) + "V" + px(cy + 6) + "M" + px(xm - 4) + " " + px(cy - 6) + "H" +
-             px(xm + 4) + "M" + px(xm - 4) + " " + px(cy + 6) + "H" + px(xm + 4) + "\"" + stroke_attrs(st) + "/>\n";
+        const double h = 6 * k, w = 4 * k;
+        s += "<path d=\"M" + px(xm) + " " + px(cy - h) + "V" + px(cy + h) + "M" + px(xm - w) + " " + px(cy - h) + "H" +
+             px(xm + w) + "M" + px(xm - w) + " " + px(cy + h) + "H" + px(xm + w) + "\"" + stroke_attrs(st) + "/>\n";
       }
       if (e.kind == 3)
-        s += "<rect x=\"" + px(xm - 5) + "\" y=\"" + px(cy - 5) + "\" width=\"10\" height=\"10\" fill=\"" +
-             escape(e.style.color) + "\"/>\n";
-      s += text_el(x0 + sample + 6, cy + 4, "start", kLabelFont, escape(e.label), " fill=\"" + std::string(kInk) + "\"");
+        s += "<rect x=\"" + px(xm - 5 * k) + "\" y=\"" + px(cy - 5 * k) + "\" width=\"" + px(10 * k) + "\" height=\"" +
+             px(10 * k) + "\" fill=\"" + escape(e.style.color) + "\"/>\n";
+      s += text_el(x0 + sample + gap, cy + 5 * k, "start", tick_font, escape(e.label), " fill=\"" + std::string(kInk) + "\"");
     }
     s += "</g>\n";
   }
@@ -614,7 +723,8 @@ std::string Figure::render_axes(int row, int col) const {
 std::string Figure::svg_element() const {
   std::string body;
   if (!title_.empty())
-    body += text_el(0.5 * width_, 20, "middle", kFigureTitleFont, escape(title_), " fill=\"" + std::string(kInk) + "\"");
+    body += text_el(0.5 * width_, 22 * text_scale(), "middle", text_scale() * kFigureTitleFont, escape(title_),
+                    " fill=\"" + std::string(kInk) + "\"");
   for (int r = 0; r < rows_; ++r)
     for (int c = 0; c < cols_; ++c) body += render_axes(r, c);
   std::string prefix = id_;
@@ -632,6 +742,48 @@ std::string Figure::svg_element() const {
 
 std::string Figure::svg() const { return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n" + svg_element(); }
 
-void Figure::save(const std::string& path) const { write_file_atomic(path, svg()); }
+std::string Figure::csv() const {
+  std::string out = "# " + csv_comment(title_.empty() ? "figure" : title_) +
+                    ": every plotted series, one row per point (pandas.read_csv(path, comment=\"#\"))\n";
+  auto panel_name = [&](int i) {
+    const Axes& a = axes_[static_cast<std::size_t>(i)];
+    return a.title_.empty() ? std::to_string(i + 1) : a.title_;
+  };
+  for (int i = 0; i < rows_ * cols_; ++i) {
+    const Axes& a = axes_[static_cast<std::size_t>(i)];
+    out += "# panel " + csv_comment(panel_name(i)) + ": x = " + csv_comment(a.xlabel_) + "; y = " + csv_comment(a.ylabel_);
+    if (!a.y2label_.empty()) out += "; right y = " + csv_comment(a.y2label_);
+    out += "\n";
+  }
+  out += "panel,series,axis,x,y,y_low,y_high\n";
+  for (int i = 0; i < rows_ * cols_; ++i) {
+    const Axes& a = axes_[static_cast<std::size_t>(i)];
+    const std::string panel = csv_field(panel_name(i));
+    int unnamed = 0;
+    for (const Axes::Series& ser : a.series_) {
+      const std::string head = panel + "," + csv_field(ser.label.empty() ? "series " + std::to_string(++unnamed) : ser.label) +
+                               (ser.style.axis == YAxis::Right ? ",right," : ",left,");
+      for (std::size_t j = 0; j < ser.x.size(); ++j)
+        out += head + csv_number(ser.x[j]) +
+               (ser.kind == Axes::Kind::Range ? ",," + csv_number(ser.y[j]) + "," + csv_number(ser.y_hi[j])
+                                              : "," + csv_number(ser.y[j]) + ",,") +
+               "\n";
+    }
+    for (const BarGroup& b : a.bars_) {
+      const std::string head = panel + "," + csv_field(b.label.empty() ? "series " + std::to_string(++unnamed) : b.label) + ",left,";
+      for (std::size_t j = 0; j < b.values.size(); ++j) {
+        const double e = b.errors.empty() ? kNaN : std::abs(b.errors[j]);
+        out += head + csv_field(a.categories_[j]) + "," + csv_number(b.values[j]) + "," + csv_number(b.values[j] - e) + "," +
+               csv_number(b.values[j] + e) + "\n";
+      }
+    }
+  }
+  return out;
+}
+
+void Figure::save(const std::string& path) const {
+  write_file_atomic(path, svg());
+  write_file_atomic(std::filesystem::path(path).replace_extension(".csv").string(), csv());
+}
 
 }  // namespace pneufem::svg

@@ -297,7 +297,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   write_file_atomic((dir / "metrics.csv").string(), metrics_csv_text(r.comparison));
   write_file_atomic((dir / "scene.toml").string(), r.drive.scene_text);
   const std::vector<ReportFigure> figs = compare_figures(rec, r, history);
-  for (const ReportFigure& f : figs) write_file_atomic((dir / (f.name + ".svg")).string(), f.svg);
+  write_report_figures(dir.string(), figs, r.comparison);  // fig_*.svg, their fig_*.csv, model_vs_measured.csv
   write_file_atomic((dir / "report.html").string(), compare_report_html(rec, r, figs, history, label, opt.data_path));
   // The study history plots the error of each model variant; an incomplete run's error covers
   // other frames than the others', so it is not added there.

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "analysis/hampel.h"
+#include "core/atomic_file.h"
 #include "viz/svg_plot.h"
 
 namespace pneufem {
@@ -42,19 +43,7 @@ std::vector<double> field(const std::vector<StepComparison>& st, double StepComp
 ReportFigure make(const std::string& name, const std::string& title, const std::string& caption,
                   const std::string& section, svg::Figure& fig) {
   fig.id(name);
-  return {name, title, caption, section, fig.svg()};
-}
-
-/// Diverging colour for v in [-1, 1]: blue (negative: model below the measurement) - white - red.
-std::string diverging(double v) {
-  v = std::clamp(v, -1.0, 1.0);
-  const double w = 1.0 - std::abs(v);
-  const int r = v > 0 ? 255 : static_cast<int>(std::lround(255 * w + 33 * (1 - w)));
-  const int g = static_cast<int>(std::lround(255 * w + (v > 0 ? 60 : 102) * (1 - w)));
-  const int b = v < 0 ? 255 : static_cast<int>(std::lround(255 * w + 40 * (1 - w)));
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "#%02X%02X%02X", std::clamp(r, 0, 255), std::clamp(g, 0, 255), std::clamp(b, 0, 255));
-  return buf;
+  return {name, title, caption, section, fig.svg(), fig.csv()};
 }
 
 /// The SVG element of a complete document (drops the XML declaration for inlining).
@@ -66,10 +55,12 @@ std::string inline_svg(const std::string& doc) {
 }  // namespace
 
 std::string heatmap_svg(const std::vector<std::vector<double>>& values, const std::vector<std::string>& rows,
-                        const std::vector<std::string>& cols, const std::string& title, const std::string& unit) {
-  const double cw = 56, ch = 26, left = 80, top = 48, bottom = 64;
+                        const std::vector<std::string>& cols, const std::string& title, const std::string& unit,
+                        const std::string& col_axis) {
+  // Sizes for print as the svg::Figure ones (viz/svg_plot.h): 14 px text in a 480 px wide figure.
+  const double cw = 64, ch = 30, left = 84, top = 52, bottom = 100;
   // Wide enough for the colour note below the cells.
-  const double width = std::max(480.0, left + cw * static_cast<double>(std::max<std::size_t>(cols.size(), 1)) + 20);
+  const double width = std::max(svg::kColumnWidthPx, left + cw * static_cast<double>(std::max<std::size_t>(cols.size(), 1)) + 20);
   const double height = top + ch * static_cast<double>(std::max<std::size_t>(rows.size(), 1)) + bottom;
   double vmax = 0;
   for (const auto& r : values)
@@ -79,108 +70,152 @@ std::string heatmap_svg(const std::vector<std::vector<double>>& values, const st
   std::string s = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   s += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + fmt("%.0f", width) + "\" height=\"" + fmt("%.0f", height) +
        "\" viewBox=\"0 0 " + fmt("%.0f", width) + " " + fmt("%.0f", height) +
-       "\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"11\">\n";
+       "\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"14\">\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  s += "<text x=\"" + fmt("%.1f", width / 2) + "\" y=\"20\" text-anchor=\"middle\" font-size=\"13\">" + escape(title) +
+  s += "<text x=\"" + fmt("%.1f", width / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"16\">" + escape(title) +
        "</text>\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const double y = top + ch * static_cast<double>(i);
-    s += "<text x=\"" + fmt("%.1f", left - 6) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 4) + "\" text-anchor=\"end\">" +
+    s += "<text x=\"" + fmt("%.1f", left - 6) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 5) + "\" text-anchor=\"end\">" +
          escape(rows[i]) + "</text>\n";
     for (std::size_t j = 0; j < cols.size(); ++j) {
       const double x = left + cw * static_cast<double>(j);
       const double v = i < values.size() && j < values[i].size() ? values[i][j] : std::nan("");
-      const std::string fill = std::isfinite(v) ? diverging(v / scale) : "#DDDDDD";
+      const std::string fill = std::isfinite(v) ? svg::diverging_color(v / scale) : "#DDDDDD";
+      // Dark cells (the ends of the map) get white numbers.
+      const std::string ink = std::isfinite(v) && std::abs(v / scale) > 0.6 ? " fill=\"#FFFFFF\"" : "";
       s += "<rect x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", y) + "\" width=\"" + fmt("%.1f", cw - 1) +
            "\" height=\"" + fmt("%.1f", ch - 1) + "\" fill=\"" + fill + "\"><title>" + escape(rows[i] + ", " + cols[j]) +
            ": " + fmt("%.3f", v) + " " + escape(unit) + "</title></rect>\n";
-      s += "<text x=\"" + fmt("%.1f", x + cw / 2) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 4) +
-           "\" text-anchor=\"middle\" font-size=\"10\">" + fmt("%.2f", v) + "</text>\n";
+      s += "<text x=\"" + fmt("%.1f", x + cw / 2) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 5) +
+           "\" text-anchor=\"middle\"" + ink + ">" + fmt("%.2f", v) + "</text>\n";
     }
   }
   for (std::size_t j = 0; j < cols.size(); ++j)
     s += "<text x=\"" + fmt("%.1f", left + cw * (static_cast<double>(j) + 0.5)) + "\" y=\"" +
-         fmt("%.1f", top + ch * static_cast<double>(rows.size()) + 14) + "\" text-anchor=\"middle\">" + escape(cols[j]) +
+         fmt("%.1f", top + ch * static_cast<double>(rows.size()) + 17) + "\" text-anchor=\"middle\">" + escape(cols[j]) +
          "</text>\n";
-  s += "<text x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", height - 26) +
-       "\">colour: blue = model below, red = model above the measurement;</text>\n";
-  s += "<text x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", height - 10) + "\">full colour = " + fmt("%.3g", scale) +
+  const double grid_right = left + cw * static_cast<double>(std::max<std::size_t>(cols.size(), 1));
+  if (!col_axis.empty())
+    s += "<text x=\"" + fmt("%.1f", 0.5 * (left + grid_right)) + "\" y=\"" +
+         fmt("%.1f", top + ch * static_cast<double>(rows.size()) + 40) + "\" text-anchor=\"middle\" font-size=\"15\">" +
+         escape(col_axis) + "</text>\n";
+  s += "<text x=\"" + fmt("%.1f", 12) + "\" y=\"" + fmt("%.1f", height - 30) +
+       "\">blue: model below the measurement, red: above;</text>\n";
+  s += "<text x=\"" + fmt("%.1f", 12) + "\" y=\"" + fmt("%.1f", height - 11) + "\">full colour: " + fmt("%.3g", scale) +
        " " + escape(unit) + "</text>\n";
   return s + "</svg>\n";
+}
+
+std::string heatmap_csv(const std::vector<std::vector<double>>& values, const std::vector<std::string>& rows,
+                        const std::vector<std::string>& cols, const std::string& row_name, const std::string& col_name,
+                        const std::string& value_name) {
+  std::string s = row_name + "," + col_name + "," + value_name + "\n";
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      const double v = i < values.size() && j < values[i].size() ? values[i][j] : std::nan("");
+      s += svg::csv_field(rows[i]) + "," + svg::csv_field(cols[j]) + "," + svg::csv_number(v) + "\n";
+    }
+  return s;
+}
+
+std::string model_vs_measured_csv(const Comparison& c) {
+  std::string s = "trial,time_s,measured_deg,model_deg,residual_deg\n";
+  for (const ComparedFrame& f : c.frames)
+    s += std::to_string(c.trials.at(static_cast<std::size_t>(f.trial_index)).trial) + "," + svg::csv_number(f.t_s) + "," +
+         svg::csv_number(f.measured_deg) + "," + svg::csv_number(f.model_deg) + "," +
+         svg::csv_number(f.model_deg - f.measured_deg) + "\n";
+  return s;
+}
+
+void write_report_figures(const std::string& dir, const std::vector<ReportFigure>& figs, const Comparison& c) {
+  const std::filesystem::path d(dir);
+  for (const ReportFigure& f : figs) {
+    write_file_atomic((d / (f.name + ".svg")).string(), f.svg);
+    write_file_atomic((d / (f.name + ".csv")).string(), f.csv);
+  }
+  write_file_atomic((d / "model_vs_measured.csv").string(), model_vs_measured_csv(c));
 }
 
 std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRunResult& r,
                                           const std::vector<HistoryEntry>& history) {
   std::vector<ReportFigure> out;
   const Comparison& c = r.comparison;
+  // One colour per trial, in every figure: measured and model of a trial alike (viz/svg_plot.h).
+  auto trial_style = [](std::size_t k) {
+    svg::Style st;
+    st.color = svg::palette_color(k);
+    return st;
+  };
 
   // 1. Pressure and angle against time, per trial.
   for (std::size_t k = 0; k < rec.trials.size(); ++k) {
     const TrialRecording& tr = rec.trials[k];
-    svg::Figure fig(760, 360);
+    svg::Figure fig(svg::kColumnWidthPx, 320);
     svg::Axes& ax = fig.axes();
-    ax.xlabel("time (s)").ylabel("bending angle (deg)").y2label("pressure (kPa)").legend(svg::Legend::UpperLeft);
+    ax.xlabel("time (s)").ylabel("bending angle (deg)").y2label("pressure (kPa)");
     const Series p = decimate(tr.pressure_kPa, 2000);
     svg::Style ps;
     ps.color = "#999999";
     ps.line_width = 1.0;
     ps.axis = svg::YAxis::Right;
     ax.line(p.t_s, p.value, "pressure (measured)", ps);
-    svg::Style ms;
+    svg::Style ms = trial_style(k);
     ms.marker = svg::Marker::Circle;
     ms.marker_size = 1.5;
     ms.line_width = 0;
-    ms.color = "#000000";
     // Outlier frames (dropped from every metric) are left out here too, so the axis shows the
     // response rather than a tracking glitch tens of degrees away.
     const Series a = decimate(hampel_filter(tr.angle_deg).series, 3000);
     ax.line(a.t_s, a.value, "angle (measured)", ms);
-    svg::Style mod;
-    mod.color = "#D55E00";
     const Series m = decimate(r.drive.trials[k].angle_deg, 3000);
-    ax.line(m.t_s, m.value, "angle (model)", mod);
+    ax.line(m.t_s, m.value, "angle (model)", trial_style(k));
     fig.title("Trial " + std::to_string(tr.trial) + ": NRMSE " + fmt("%.4f", c.trials[k].nrmse) + ", " +
-              std::to_string(c.trials[k].outliers) + " outlier frame(s) not shown");
+              std::to_string(c.trials[k].outliers) + " outlier(s) hidden");
     out.push_back(make("fig_trial_" + std::to_string(tr.trial), "Trial " + std::to_string(tr.trial) + ": time series",
                        "Measured pressure (grey, right axis), measured angle (dots) and the model driven by that "
-                       "pressure (line).",
+                       "pressure (line, in the dots' colour).",
                        "figures", fig));
   }
 
   // 2. Angle vs pressure at the marks, with the spread to the end of the hold.
   {
-    svg::Figure fig(640, 420);
+    svg::Figure fig(svg::kColumnWidthPx, 360);
     svg::Axes& ax = fig.axes();
-    ax.xlabel("pressure step level (kPa)").ylabel("bending angle at the mark (deg)").legend(svg::Legend::UpperLeft);
-    for (const TrialComparison& t : c.trials) {
+    ax.xlabel("pressure step level (kPa)").ylabel("bending angle at the mark (deg)");
+    for (std::size_t k = 0; k < c.trials.size(); ++k) {
+      const TrialComparison& t = c.trials[k];
+      const std::string trial = "trial " + std::to_string(t.trial);
       const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
       const std::vector<double> mm = field(t.steps, &StepComparison::measured_mark_deg);
       const std::vector<double> me = field(t.steps, &StepComparison::measured_end_deg);
       const std::vector<double> pm = field(t.steps, &StepComparison::model_mark_deg);
-      svg::Style dots;
+      svg::Style dots = trial_style(k);
       dots.marker = svg::Marker::Circle;
       dots.line_width = 0;
-      ax.line(lv, mm, "trial " + std::to_string(t.trial) + " measured", dots);
+      ax.line(lv, mm, trial + " measured", dots);
       std::vector<double> lo(mm.size()), hi(mm.size());
       for (std::size_t i = 0; i < mm.size(); ++i) lo[i] = std::min(mm[i], me[i]), hi[i] = std::max(mm[i], me[i]);
-      svg::Style bars;
+      svg::Style bars = trial_style(k);
       bars.line_width = 1.0;
-      ax.range_bars(lv, lo, hi, "", bars);
-      svg::Style line;
+      bars.in_legend = false;
+      ax.range_bars(lv, lo, hi, trial + " spread to the end of the hold", bars);
+      svg::Style line = trial_style(k);
       line.dash = "5 3";
-      ax.line(lv, pm, "trial " + std::to_string(t.trial) + " model", line);
+      line.in_legend = false;
+      ax.line(lv, pm, trial + " model", line);
     }
     out.push_back(make("fig_angle_pressure", "Angle vs pressure",
                        "Measured angle at the 2.5 s mark of each step (dots) with the spread to the end of the hold "
-                       "(bars), and the model at the marks (dashed).",
+                       "(bars), and the model at the marks (dashed), each trial in its own colour.",
                        "figures", fig));
   }
 
   // 3. NRMSE per trial.
   {
-    svg::Figure fig(560, 360);
+    svg::Figure fig(svg::kColumnWidthPx, 320);
     svg::Axes& ax = fig.axes();
-    ax.xlabel("trial").ylabel("NRMSE").legend(svg::Legend::UpperLeft);
+    ax.xlabel("trial").ylabel("NRMSE").xinteger();
     std::vector<double> x, full, mark, floor;
     for (const TrialComparison& t : c.trials) {
       x.push_back(t.trial);
@@ -208,20 +243,23 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
     std::string lab = "step " + std::to_string(k + 1);
     if (!c.trials.empty() && k < c.trials.front().steps.size()) {
       const double v = std::round(c.trials.front().steps[k].level_kPa * 10.0) / 10.0;
-      lab = fmt("%.1f", v == 0.0 ? 0.0 : v) + " kPa";  // no "-0.0" for a rest level of -0.0008 kPa
+      // Whole kPa without decimals, so ten steps fit a column's width; no "-0" for a rest level
+      // of -0.0008 kPa.
+      lab = fmt(v == std::round(v) ? "%.0f" : "%.1f", v == 0.0 ? 0.0 : v);
     }
     cats.push_back(lab);
   }
   {
-    svg::Figure fig(760, 380);
+    svg::Figure fig(svg::kColumnWidthPx, 320);
     svg::Axes& ax = fig.axes();
-    ax.xlabel("pressure step").ylabel("absolute error at the mark (deg)");
+    ax.xlabel("pressure step (kPa)").ylabel("absolute error at the mark (deg)");
     std::vector<svg::BarGroup> groups;
-    for (const TrialComparison& t : c.trials) {
+    for (std::size_t k = 0; k < c.trials.size(); ++k) {
       svg::BarGroup g;
-      g.label = "trial " + std::to_string(t.trial);
-      g.values = field(t.steps, &StepComparison::abs_error_deg);
+      g.label = "trial " + std::to_string(c.trials[k].trial);
+      g.values = field(c.trials[k].steps, &StepComparison::abs_error_deg);
       g.values.resize(nsteps, std::nan(""));
+      g.color = svg::palette_color(k);
       groups.push_back(g);
     }
     ax.grouped_bars(cats, groups);
@@ -229,43 +267,49 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
                        "|model - measured| at the 2.5 s mark of each step, grouped by trial.", "figures", fig));
   }
   {
-    svg::Figure fig(900, 380, 1, 2);
+    svg::Figure fig(2 * svg::kColumnWidthPx, 320, 1, 2);
     svg::Axes& e = fig.axes(0, 0);
     svg::Axes& sp = fig.axes(0, 1);
-    e.title("absolute error at the mark").xlabel("pressure (kPa)").ylabel("deg").legend(svg::Legend::UpperLeft);
-    sp.title("spread: end of hold - mark").xlabel("pressure (kPa)").ylabel("deg").legend(svg::Legend::UpperLeft);
-    for (const TrialComparison& t : c.trials) {
+    e.title("absolute error at the mark").xlabel("pressure (kPa)").ylabel("deg");
+    sp.title("spread: end of hold - mark").xlabel("pressure (kPa)").ylabel("deg");
+    for (std::size_t k = 0; k < c.trials.size(); ++k) {
+      const TrialComparison& t = c.trials[k];
+      const std::string trial = "trial " + std::to_string(t.trial);
       const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
-      svg::Style m;
+      svg::Style m = trial_style(k);
       m.marker = svg::Marker::Circle;
-      e.line(lv, field(t.steps, &StepComparison::abs_error_deg), "trial " + std::to_string(t.trial), m);
-      sp.line(lv, field(t.steps, &StepComparison::spread_measured_deg), "trial " + std::to_string(t.trial) + " measured", m);
-      svg::Style d;
+      e.line(lv, field(t.steps, &StepComparison::abs_error_deg), trial, m);
+      sp.line(lv, field(t.steps, &StepComparison::spread_measured_deg), trial + " measured", m);
+      svg::Style d = trial_style(k);
       d.dash = "5 3";
-      sp.line(lv, field(t.steps, &StepComparison::spread_model_deg), "trial " + std::to_string(t.trial) + " model", d);
+      sp.line(lv, field(t.steps, &StepComparison::spread_model_deg), trial + " model", d);
     }
     out.push_back(make("fig_error_spread", "Error and spread per step",
                        "Left: absolute error at the mark. Right: creep after the mark, measured (solid) and model "
-                       "(dashed) — a model without time dependence has zero spread.",
+                       "(dashed), each trial in its own colour — a model without time dependence has zero spread.",
                        "figures", fig));
   }
 
   // 6. Residual map (step x trial).
   {
-    std::vector<std::string> rows;
-    for (const TrialComparison& t : c.trials) rows.push_back("trial " + std::to_string(t.trial));
+    std::vector<std::string> rows, trials;
+    for (const TrialComparison& t : c.trials) {
+      rows.push_back("trial " + std::to_string(t.trial));
+      trials.push_back(std::to_string(t.trial));
+    }
     out.push_back({"fig_residual_map", "Residual map",
                    "Mean residual (model - measured) over each step of each trial. A pattern along a row is a "
                    "trial-to-trial drift (fatigue, softening); along a column a pressure-dependent error (stiffness "
                    "curve).",
-                   "fails", heatmap_svg(c.residual_map_deg, rows, cats, "mean residual per step (deg)", "deg")});
+                   "fails", heatmap_svg(c.residual_map_deg, rows, cats, "mean residual per step (deg)", "deg", "pressure step (kPa)"),
+                   heatmap_csv(c.residual_map_deg, trials, cats, "trial", "step_kPa", "mean_residual_deg")});
   }
 
   // 7. Residual vs time since the step start.
   {
-    svg::Figure fig(640, 380);
+    svg::Figure fig(svg::kColumnWidthPx, 320);
     svg::Axes& ax = fig.axes();
-    ax.xlabel("time since the step start (s)").ylabel("mean residual (deg)").legend(svg::Legend::UpperRight);
+    ax.xlabel("time since the step start (s)").ylabel("mean residual (deg)");
     svg::Style a, e, l;
     a.color = "#000000";
     e.color = "#0072B2";
@@ -284,7 +328,7 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
 
   // 8. Region sensitivity.
   if (!r.regions.empty()) {
-    svg::Figure fig(640, 360);
+    svg::Figure fig(svg::kColumnWidthPx, 320);
     svg::Axes& ax = fig.axes();
     ax.xlabel("region").ylabel("fraction of residual removed");
     std::vector<std::string> names;
@@ -304,7 +348,7 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
 
   // 9. History of the study: one bar per run, labelled "#i label" (the x axis is the run order).
   {
-    svg::Figure fig(std::max(640.0, 90.0 * static_cast<double>(history.size())), 360);
+    svg::Figure fig(std::max(svg::kColumnWidthPx, 70.0 * static_cast<double>(history.size())), 320);
     svg::Axes& ax = fig.axes();
     ax.xlabel("run (in order)").ylabel("pooled NRMSE").legend(svg::Legend::None);
     std::vector<std::string> names;

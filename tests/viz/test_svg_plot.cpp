@@ -181,41 +181,48 @@ TEST(SvgTicks, LogDecadesAndMantissas) {
 }
 
 TEST(SvgFigure, DataPointMapsToTheExpectedPixel) {
-  svg::Figure fig(400, 300);
+  svg::Figure fig(480, 320);  // one column at the print width: margins as given
   fig.axes().xlim(0, 10).ylim(0, 100).scatter({5.0}, {25.0}, "", style("#123456"));
-  // Plot area = figure minus the default margins: left 68, right 20, top 14, bottom 50.
+  // Plot area = figure minus the default margins: left 76, right 20, top 16, bottom 58.
   const svg::Rect r = fig.plot_area();
-  EXPECT_EQ(r.x, 68.0);
-  EXPECT_EQ(r.y, 14.0);
-  EXPECT_EQ(r.width, 312.0);
-  EXPECT_EQ(r.height, 236.0);
-  EXPECT_DOUBLE_EQ(fig.x_scale()(5.0), 224.0);  // 68 + 312 / 2
-  EXPECT_DOUBLE_EQ(fig.y_scale()(25.0), 191.0);  // 14 + 236 * (1 - 0.25)
+  EXPECT_EQ(r.x, 76.0);
+  EXPECT_EQ(r.y, 16.0);
+  EXPECT_EQ(r.width, 384.0);
+  EXPECT_EQ(r.height, 246.0);
+  EXPECT_DOUBLE_EQ(fig.x_scale()(5.0), 268.0);  // 76 + 384 / 2
+  EXPECT_DOUBLE_EQ(fig.y_scale()(25.0), 200.5);  // 16 + 246 * (1 - 0.25)
   const std::string s = fig.svg();
-  EXPECT_NE(s.find("<circle cx=\"224\" cy=\"191\" r=\"3.5\"/>"), std::string::npos) << s;
+  EXPECT_NE(s.find("<circle cx=\"268\" cy=\"200.5\" r=\"3.5\"/>"), std::string::npos) << s;
   EXPECT_EQ(xml_problem(s), "");
+  // A figure twice as wide per column has twice the margins (and text): the same figure, scaled.
+  svg::Figure big(960, 640);
+  big.axes().xlim(0, 10).ylim(0, 100);
+  EXPECT_EQ(big.plot_area().x, 152.0);
+  EXPECT_EQ(big.plot_area().width, 768.0);
 }
 
 TEST(SvgFigure, LogAxisMapsDecadesEvenly) {
-  svg::Figure fig(400, 300);
+  svg::Figure fig(480, 320);
   svg::Axes& ax = fig.axes();
   ax.xlog().xlim(10, 1000).ylim(0, 1).scatter({100.0, std::sqrt(10.0) * 100.0, -1.0}, {0.5, 0.5, 0.5});
   const svg::Scale x = fig.x_scale();
   EXPECT_TRUE(x.log());
-  EXPECT_DOUBLE_EQ(x(10.0), 68.0);
-  EXPECT_DOUBLE_EQ(x(100.0), 68.0 + 156.0);
-  EXPECT_NEAR(x(std::sqrt(10.0) * 100.0), 68.0 + 234.0, 1e-9);
+  EXPECT_DOUBLE_EQ(x(10.0), 76.0);
+  EXPECT_DOUBLE_EQ(x(100.0), 76.0 + 192.0);
+  EXPECT_NEAR(x(std::sqrt(10.0) * 100.0), 76.0 + 288.0, 1e-9);
   EXPECT_TRUE(std::isnan(x(-1.0)));  // not drawable on a log axis
   const std::string s = fig.svg();
   EXPECT_EQ(count(s, "<circle"), 2u);  // the negative x is left out
   EXPECT_EQ(xml_problem(s), "");
 
-  // Auto range widens to decades; labels outside 1e-3..1e4 use a superscript exponent.
-  svg::Figure f2(400, 300);
+  // The auto range is the data's, padded by 4 % of its decades (not widened to whole decades);
+  // labels outside 1e-3..1e4 use a superscript exponent, printed at 7 pt in a column.
+  svg::Figure f2(480, 320);
   f2.axes().xlog().line({2e-7, 3e-5}, {1.0, 2.0});
-  EXPECT_DOUBLE_EQ(f2.x_ticks().lo, 1e-7);
-  EXPECT_DOUBLE_EQ(f2.x_ticks().hi, 1e-4);
-  EXPECT_NE(f2.svg().find("10<tspan dy=\"-5\" font-size=\"8\">-5</tspan>"), std::string::npos);
+  const double pad = std::pow(3e-5 / 2e-7, 0.04);
+  EXPECT_DOUBLE_EQ(f2.x_ticks().lo, 2e-7 / pad);
+  EXPECT_DOUBLE_EQ(f2.x_ticks().hi, 3e-5 * pad);
+  EXPECT_NE(f2.svg().find("font-size=\"13.5\">-5</tspan>"), std::string::npos) << f2.svg();
 }
 
 TEST(SvgFigure, TextIsEscaped) {
@@ -278,9 +285,11 @@ TEST(SvgFigure, ComplexFigureIsWellFormedAndDeterministic) {
   EXPECT_EQ(xml_problem(fig.svg_element()), "");
 
   // The right-hand axis widens the right margin and has its own scale.
+  // 360 px per column: margins at 360/480 of theirs.
   const svg::Rect r = fig.plot_area(0, 0);
-  EXPECT_DOUBLE_EQ(r.width, 360.0 - 68.0 - 68.0);
-  EXPECT_EQ(fig.y_ticks(0, 0, svg::YAxis::Left).hi, 10.0);
+  EXPECT_DOUBLE_EQ(r.width, 360.0 - 0.75 * (76.0 + 76.0));
+  EXPECT_DOUBLE_EQ(fig.y_ticks(0, 0, svg::YAxis::Left).lo, 0.0);  // the data start at 0: no padding below
+  EXPECT_NEAR(fig.y_ticks(0, 0, svg::YAxis::Left).hi, 10.4, 1e-12);
   const svg::Ticks right = fig.y_ticks(0, 0, svg::YAxis::Right);
   EXPECT_GE(right.hi, 62.0);
   EXPECT_LT(right.hi, 100.0);
@@ -299,13 +308,13 @@ TEST(SvgFigure, ComplexFigureIsWellFormedAndDeterministic) {
 }
 
 TEST(SvgFigure, GroupedBarHeightsFollowTheScale) {
-  svg::Figure fig(400, 300);
+  svg::Figure fig(480, 320);
   fig.axes().ylim(0, 20).grouped_bars({"a", "b"}, {{"g", {10, 20}, {}, "#111111"}});
-  // Plot height 236: value 10 is half of it, value 20 all of it; bars fill 80 % of each slot.
+  // Plot height 246: value 10 is half of it, value 20 all of it; bars fill 80 % of each slot.
   const std::string s = fig.svg();
-  EXPECT_NE(s.find("height=\"118\""), std::string::npos) << s;
-  EXPECT_NE(s.find("height=\"236\"/>"), std::string::npos);
-  EXPECT_NE(s.find("width=\"124.8\""), std::string::npos);  // 0.8 * 312 / 2
+  EXPECT_NE(s.find("height=\"123\""), std::string::npos) << s;
+  EXPECT_NE(s.find("height=\"246\"/>"), std::string::npos);
+  EXPECT_NE(s.find("width=\"153.6\""), std::string::npos);  // 0.8 * 384 / 2
   EXPECT_THROW(fig.axes().line({1, 2}, {1}), std::invalid_argument);
   EXPECT_THROW(fig.axes(1, 0), std::out_of_range);
 }
@@ -317,13 +326,147 @@ TEST(SvgFigure, SaveIsAtomic) {
   const svg::Figure fig = everything();
   const fs::path f = dir / "fig.svg";
   fig.save(f.string());
-  std::ifstream in(f);
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(text.str(), fig.svg());
+  auto read = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  EXPECT_EQ(read(f), fig.svg());
+  EXPECT_EQ(read(dir / "fig.csv"), fig.csv());  // the series next to the picture
   EXPECT_FALSE(fs::exists(dir / "fig.svg.tmp"));
+  EXPECT_FALSE(fs::exists(dir / "fig.csv.tmp"));
   EXPECT_THROW(fig.save((dir / "missing" / "fig.svg").string()), std::runtime_error);
   fs::remove_all(dir);
+}
+
+// Axes start at the data: a measured pressure that dips to -0.3 kPa (sensor noise) and reaches 45
+// kPa gets an axis from just below -0.3 to just above 45 (before 2026-11-27: -10 to 50, widened to
+// whole ticks), with its ticks inside; an axis whose data start at 0 starts at 0.
+TEST(SvgFigure, AxesSpanTheDataNotWholeTicks) {
+  svg::Figure fig;
+  svg::Axes& ax = fig.axes();
+  ax.line({0, 10, 20}, {-0.3, 20.0, 45.0}, "pressure").line({0, 10, 20}, {0.0, 5.0, 33.0}, "angle", style("", svg::Marker::None, svg::YAxis::Right));
+  const svg::Ticks y = fig.y_ticks(), y2 = fig.y_ticks(0, 0, svg::YAxis::Right), x = fig.x_ticks();
+  EXPECT_NEAR(y.lo, -0.3 - 0.04 * 45.3, 1e-12);
+  EXPECT_NEAR(y.hi, 45.0 + 0.04 * 45.3, 1e-12);
+  EXPECT_EQ(y.major.front(), 0.0);  // ticks inside the data's range
+  EXPECT_LE(y.major.back(), 45.0);
+  EXPECT_EQ(y2.lo, 0.0);
+  EXPECT_EQ(x.lo, 0.0);
+  EXPECT_NEAR(x.hi, 20.8, 1e-12);
+  // Negative data keep their padding; data ending at 0 end there.
+  svg::Figure neg;
+  neg.axes().line({0, 1}, {-4.0, 0.0});
+  EXPECT_NEAR(neg.y_ticks().lo, -4.16, 1e-12);
+  EXPECT_EQ(neg.y_ticks().hi, 0.0);
+}
+
+TEST(SvgFigure, IntegerAxisTicksOnlyWholeNumbers) {
+  for (int n : {1, 2, 3, 10}) {
+    svg::Figure fig;
+    std::vector<double> trial, nrmse;
+    for (int k = 1; k <= n; ++k) trial.push_back(k), nrmse.push_back(0.01 * k);
+    fig.axes().xinteger().line(trial, nrmse);
+    const svg::Ticks t = fig.x_ticks();
+    ASSERT_FALSE(t.major.empty()) << n;
+    for (double m : t.major) EXPECT_EQ(m, std::round(m)) << n;
+    EXPECT_GE(t.major.front(), 1.0) << n;
+    EXPECT_LE(t.major.back(), n) << n;
+    if (n <= 3) {
+      EXPECT_EQ(t.major.front(), 1.0) << n;
+    }
+  }
+  EXPECT_EQ(svg::linear_ticks(0.9, 3.1, 5, false, true).major, v({1, 2, 3}));
+  EXPECT_EQ(svg::linear_ticks(0.9, 3.1, 5, false, false).step, 0.5);
+}
+
+/// Every font-size of an SVG document, px.
+std::vector<double> font_sizes(const std::string& svg) {
+  std::vector<double> out;
+  for (std::size_t p = svg.find("font-size=\""); p != std::string::npos; p = svg.find("font-size=\"", p + 1))
+    out.push_back(std::stod(svg.substr(p + 11)));
+  return out;
+}
+
+// Printed at a journal's single column (3.5 in = 252 pt per column of axes), no text of any
+// figure is below 7 pt, whatever the figure's pixel size.
+TEST(SvgFigure, TextIsAtLeastSevenPointAtASingleColumnWidth) {
+  struct Case {
+    double width, height;
+    int rows, cols;
+  };
+  for (const Case c : {Case{480, 320, 1, 1}, Case{320, 240, 1, 1}, Case{640, 420, 1, 1}, Case{960, 320, 1, 2},
+                       Case{720, 640, 2, 2}}) {
+    svg::Figure fig(c.width, c.height, c.rows, c.cols);
+    fig.title("a title");
+    for (int r = 0; r < c.rows; ++r)
+      for (int k = 0; k < c.cols; ++k)
+        fig.axes(r, k).title("t").xlabel("x").ylabel("y").y2label("y2").xlog().line({1e-6, 1e-5}, {1, 2}, "a");
+    const double pt_per_px = 252.0 / (c.width / c.cols);
+    const std::vector<double> sizes = font_sizes(fig.svg());
+    ASSERT_GE(sizes.size(), 5u);
+    for (double f : sizes) EXPECT_GE(f * pt_per_px, 7.0 - 1e-9) << c.width << " px: " << f;
+  }
+}
+
+TEST(SvgFigure, CsvHoldsEveryPlottedPoint) {
+  const svg::Figure fig = everything();
+  const std::string csv = fig.csv();
+  EXPECT_EQ(csv.rfind("# Pneu-net <fatigue> & creep: every plotted series", 0), 0u) << csv;
+  EXPECT_NE(csv.find("# panel trial 1: x = time (s); y = pressure (kPa); right y = angle (deg)\n"), std::string::npos);
+  EXPECT_NE(csv.find("\npanel,series,axis,x,y,y_low,y_high\n"), std::string::npos);
+  // A line point, a NaN (an empty cell), a right-axis point, a range bar, an error bar, a bar with its
+  // error and a bar without a value.
+  EXPECT_NE(csv.find("trial 1,pressure,left,3,10,,\n"), std::string::npos);
+  EXPECT_NE(csv.find("trial 1,angle,right,,60,,\n"), std::string::npos);  // x NaN: an empty cell
+  EXPECT_NE(csv.find("trial 1,angle,right,4,62,,\n"), std::string::npos);
+  EXPECT_NE(csv.find("2,spread,left,10,,22,27\n"), std::string::npos);
+  EXPECT_NE(csv.find("2,series 1,left,15,,41,47\n"), std::string::npos);  // unlabelled error bars
+  EXPECT_NE(csv.find("3,trial 1,left,15 kPa,3," + svg::csv_number(3 - 0.3) + "," + svg::csv_number(3 + 0.3) + "\n"),
+            std::string::npos);
+  EXPECT_NE(csv.find("3,trial 2,left,10 kPa,,,\n"), std::string::npos);
+  // One row per point: 5 + 5 + 3 + 3 + 3 + 3 (panel 2) + 3 + 3 (bars) + 3 + 1 + 1 (log panel).
+  const std::string body = csv.substr(csv.find("\npanel,series") + 1);
+  EXPECT_EQ(count(body, "\n"), 1u + 33u);
+  EXPECT_EQ(svg::csv_field("a,b"), "\"a,b\"");
+  EXPECT_EQ(svg::csv_field("say \"x\""), "\"say \"\"x\"\"\"");
+  EXPECT_EQ(svg::csv_field("#1"), "\"#1\"");
+  EXPECT_EQ(svg::csv_number(0.1), "0.1");
+  EXPECT_EQ(svg::csv_number(std::nan("")), "");
+}
+
+TEST(SvgColours, PaletteAndDivergingMapAreColourBlindSafe) {
+  EXPECT_EQ(svg::palette_color(0), "#0072B2");  // Okabe & Ito blue, vermillion, bluish green ...
+  EXPECT_EQ(svg::palette_color(1), "#D55E00");
+  EXPECT_EQ(svg::palette_color(8), svg::palette_color(0));
+  EXPECT_EQ(svg::diverging_color(-1.0), "#2166AC");  // ColorBrewer RdBu ends and centre
+  EXPECT_EQ(svg::diverging_color(0.0), "#F7F7F7");
+  EXPECT_EQ(svg::diverging_color(1.0), "#B2182B");
+  EXPECT_EQ(svg::diverging_color(7.0), "#B2182B");
+  EXPECT_EQ(svg::diverging_color(std::nan("")), "#F7F7F7");
+  EXPECT_EQ(svg::diverging_color(0.25), "#FDDBC7");  // a stop of the map: (0.25 + 1) / 2 * 8 = 5
+}
+
+// The default legend takes the emptiest corner: data rising to the upper right push it to the upper
+// left; a falling line to the upper right.
+TEST(SvgFigure, BestLegendCornerAvoidsTheData) {
+  auto legend_x = [](const svg::Figure& f) {
+    const std::string s = f.svg();
+    const std::size_t p = s.find("fill-opacity=\"0.85\"");
+    const std::size_t r = s.rfind("<rect x=\"", p);
+    return std::stod(s.substr(r + 9));
+  };
+  svg::Figure rising;
+  rising.axes().line({0, 1, 2, 3, 4}, {0, 1, 4, 9, 16}, "rising");
+  svg::Figure falling;
+  falling.axes().line({0, 1, 2, 3, 4}, {16, 9, 4, 1, 0}, "falling");
+  const double mid = rising.plot_area().x + 0.5 * rising.plot_area().width;
+  EXPECT_LT(legend_x(rising), mid);
+  EXPECT_GT(legend_x(falling), mid);
+  svg::Figure pinned;
+  pinned.axes().legend(svg::Legend::LowerRight).line({0, 1, 2, 3, 4}, {0, 1, 4, 9, 16}, "rising");
+  EXPECT_GT(legend_x(pinned), mid);  // a chosen corner is kept even where it covers data
 }
 
 }  // namespace
