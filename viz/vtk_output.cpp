@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -34,6 +35,7 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include "core/errors.h"
+#include "engine/static_solver.h"
 
 namespace pneufem {
 
@@ -128,6 +130,63 @@ void add_cell_scalars(vtkUnstructuredGrid* grid, const char* name, const std::ve
   auto a = double_array(name, 1, static_cast<vtkIdType>(values.size()));
   for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
   grid->GetCellData()->AddArray(a);
+}
+
+/// The stiff layer (the fabric): elements whose material is stiffer in shear than the softest by the
+/// ratio the static solver's stiff-layer elimination uses (StaticOptions::stiff_modulus_ratio).
+std::vector<char> stiff_layer(const Model& model) {
+  const int ne = model.mesh.num_elements();
+  double mu_min = std::numeric_limits<double>::infinity();
+  for (int e = 0; e < ne; ++e) mu_min = std::min(mu_min, model.material_of(e).initial_shear_modulus());
+  const double ratio = StaticOptions{}.stiff_modulus_ratio;
+  std::vector<char> stiff(static_cast<std::size_t>(ne), 0);
+  for (int e = 0; e < ne; ++e) stiff[e] = model.material_of(e).initial_shear_modulus() > ratio * mu_min;
+  return stiff;
+}
+
+/// `values` where `keep[e]`, NaN elsewhere (ParaView leaves NaN out of the colour range).
+std::vector<double> only(const std::vector<double>& values, const std::vector<char>& keep, bool want) {
+  std::vector<double> out(values.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t e = 0; e < values.size(); ++e)
+    if (static_cast<bool>(keep[e]) == want) out[e] = values[e];
+  return out;
+}
+
+/// Point values from element values: at each node the mean over the elements around it with
+/// stiff[e] == `want` (NaN at a node with none), so the two layers are never averaged together.
+/// `per_element` holds `components` values per element.
+std::vector<double> to_points(const Mesh& mesh, const std::vector<double>& per_element, int components,
+                              const std::vector<char>& stiff, bool want) {
+  const auto nc = static_cast<std::size_t>(components);
+  std::vector<double> sum(static_cast<std::size_t>(mesh.num_nodes()) * nc, 0.0);
+  std::vector<int> count(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    if (static_cast<bool>(stiff[e]) != want) continue;
+    for (int a = 0; a < mesh.npe(); ++a) {
+      const auto n = static_cast<std::size_t>(mesh.element(e)[a]);
+      ++count[n];
+      for (std::size_t c = 0; c < nc; ++c) sum[n * nc + c] += per_element[static_cast<std::size_t>(e) * nc + c];
+    }
+  }
+  for (std::size_t n = 0; n < count.size(); ++n)
+    for (std::size_t c = 0; c < nc; ++c)
+      sum[n * nc + c] = count[n] > 0 ? sum[n * nc + c] / count[n] : std::numeric_limits<double>::quiet_NaN();
+  return sum;
+}
+
+vtkNew<vtkDoubleArray> tensor_array(const char* name, const std::vector<double>& rows9) {
+  // Row-major components XX XY XZ YX ... (ParaView's convention for 9-component tensors).
+  static constexpr const char* kComp[9] = {"XX", "XY", "XZ", "YX", "YY", "YZ", "ZX", "ZY", "ZZ"};
+  auto a = double_array(name, 9, static_cast<vtkIdType>(rows9.size() / 9));
+  for (int c = 0; c < 9; ++c) a->SetComponentName(c, kComp[c]);
+  for (std::size_t i = 0; i < rows9.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), rows9[i]);
+  return a;
+}
+
+void add_point_scalars(vtkUnstructuredGrid* grid, const char* name, const std::vector<double>& values) {
+  auto a = double_array(name, 1, static_cast<vtkIdType>(values.size()));
+  for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
+  grid->GetPointData()->AddArray(a);
 }
 
 void add_field_scalar(vtkFieldData* fd, const char* name, double value) {
@@ -284,15 +343,24 @@ void write_vtu(const std::string& path, const Model& model, const StateFields& f
   grid->GetPointData()->AddArray(u);
   grid->GetPointData()->SetActiveVectors("displacement_m");
 
-  // Row-major components XX XY XZ YX ... (ParaView's convention for 9-component tensors).
-  auto sigma = double_array("cauchy_stress_Pa", 9, ne);
-  static constexpr const char* kComp[9] = {"XX", "XY", "XZ", "YX", "YY", "YZ", "ZX", "ZY", "ZZ"};
-  for (int c = 0; c < 9; ++c) sigma->SetComponentName(c, kComp[c]);
-  for (int e = 0; e < ne; ++e)
+  // Stress. The fabric is ~1000x stiffer than the silicone (19 MPa against 0.1 MPa at 45 kPa), so
+  // one colour range over both shows the silicone as one colour: von Mises is split into the soft
+  // material (von_mises_Pa) and the stiff layer (fabric_von_mises_Pa), NaN in the other, as cell
+  // data and as point data (nodal means over each layer's own elements, never across the two).
+  const std::vector<char> stiff = stiff_layer(model);
+  const bool has_stiff = std::find(stiff.begin(), stiff.end(), 1) != stiff.end();
+  std::vector<double> sigma9(9 * sne);
+  for (std::size_t e = 0; e < sne; ++e)
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) sigma->SetComponent(e, 3 * i + j, fields.cauchy_Pa[e](i, j));
-  grid->GetCellData()->AddArray(sigma);
-  add_cell_scalars(grid, "von_mises_Pa", fields.von_mises_Pa);
+      for (int j = 0; j < 3; ++j) sigma9[9 * e + 3 * i + j] = fields.cauchy_Pa[e](i, j);
+  grid->GetCellData()->AddArray(tensor_array("cauchy_stress_Pa", sigma9));
+  grid->GetPointData()->AddArray(tensor_array("cauchy_stress_Pa", to_points(mesh, sigma9, 9, stiff, false)));
+  add_cell_scalars(grid, "von_mises_Pa", only(fields.von_mises_Pa, stiff, false));
+  add_point_scalars(grid, "von_mises_Pa", to_points(mesh, fields.von_mises_Pa, 1, stiff, false));
+  if (has_stiff) {
+    add_cell_scalars(grid, "fabric_von_mises_Pa", only(fields.von_mises_Pa, stiff, true));
+    add_point_scalars(grid, "fabric_von_mises_Pa", to_points(mesh, fields.von_mises_Pa, 1, stiff, true));
+  }
   add_cell_scalars(grid, "max_principal_stretch", fields.max_principal_stretch);
   add_cell_scalars(grid, "strain_energy_density_J_m3", fields.energy_density_J_m3);
   add_cell_scalars(grid, "damage", fields.damage);

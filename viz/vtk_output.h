@@ -32,6 +32,11 @@ StateFields compute_fields(const Assembler& assembler, const Eigen::VectorXd& u,
 /// the point field "displacement_m" (apply ParaView's Warp By Vector to see the deformed shape),
 /// and cell fields cauchy_stress_Pa (9 comps), von_mises_Pa, max_principal_stretch,
 /// strain_energy_density_J_m3, damage, W_max_J_m3, viscous_strain, region_id, material_id.
+/// The stiff layer (parts stiffer in shear than the softest by StaticOptions::stiff_modulus_ratio,
+/// 100: the fabric) has its von Mises stress in its own field, fabric_von_mises_Pa, and NaN in
+/// von_mises_Pa, so colouring by von_mises_Pa shows the silicone's range. Point data besides the
+/// displacement: cauchy_stress_Pa and von_mises_Pa (means over the soft elements around each node),
+/// fabric_von_mises_Pa (over the stiff ones); NaN at nodes with no such element.
 /// Field data: time_s, trial, pressure_kPa, angle_deg.
 void write_vtu(const std::string& path, const Model& model, const StateFields& fields, double time_s, int trial,
                double pressure_kPa, double angle_deg);

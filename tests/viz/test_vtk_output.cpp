@@ -337,6 +337,80 @@ TEST_P(VtkOutput, VtuRoundTripThroughVtkReader) {
   EXPECT_EQ(parts->GetValue(1), "tagged");
 }
 
+// The fabric's stress is ~1000x the silicone's: it gets its own von Mises field (NaN in the
+// silicone's, and the other way round) so that colouring by von_mises_Pa shows the silicone, and
+// stress is also point data, averaged over each layer's own elements (never across the two).
+// Here elements 3-5 are made 1000x stiffer than 0-2, the ratio of the fabric to the silicone.
+TEST_P(VtkOutput, StiffLayerHasItsOwnFieldsAndPointDataAveragesEachLayer) {
+  Model model = cube_model(GetParam());
+  model.parts[1] = Part{"fabric", std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(1000 * kC10, 1000 * kK))};
+  const Assembler assembler(model);
+  const StateFields f = compute_fields(assembler, homogeneous_u(model.mesh, kStretch), assembler.initial_state());
+  const double vm_soft = von_mises_components(neo_hookean_exact(kStretch).sigma);
+  ASSERT_GT(vm_soft, 1e4);
+  const TempDir dir;
+  const fs::path file = dir.path / "stiff.vtu";
+  write_vtu(file.string(), model, f, 0.0, 1, 0.0, 0.0);
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName(file.c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+
+  vtkDataArray* soft_cells = grid->GetCellData()->GetArray("von_mises_Pa");
+  vtkDataArray* stiff_cells = grid->GetCellData()->GetArray("fabric_von_mises_Pa");
+  ASSERT_TRUE(soft_cells && stiff_cells);
+  for (int e = 0; e < 6; ++e) {
+    const bool stiff = model.element_part[e] == 1;
+    EXPECT_EQ(std::isnan(soft_cells->GetTuple1(e)), stiff) << e;
+    EXPECT_EQ(std::isnan(stiff_cells->GetTuple1(e)), !stiff) << e;
+    EXPECT_EQ(stiff ? stiff_cells->GetTuple1(e) : soft_cells->GetTuple1(e), f.von_mises_Pa[e]) << e;
+  }
+  EXPECT_GT(f.von_mises_Pa[3], 500 * vm_soft);  // the layer really is the 1000x stiffer one
+
+  // Points: the homogeneous state gives every soft element the closed-form stress, so every node
+  // of a soft element carries exactly it (to rounding) and a node of stiff elements only, NaN.
+  std::vector<int> soft_node(model.mesh.num_nodes(), 0), stiff_node(model.mesh.num_nodes(), 0);
+  for (int e = 0; e < 6; ++e)
+    for (int a = 0; a < model.mesh.npe(); ++a) (model.element_part[e] == 1 ? stiff_node : soft_node)[model.mesh.element(e)[a]] = 1;
+  vtkDataArray* vm = grid->GetPointData()->GetArray("von_mises_Pa");
+  vtkDataArray* vm_fabric = grid->GetPointData()->GetArray("fabric_von_mises_Pa");
+  vtkDataArray* sigma = grid->GetPointData()->GetArray("cauchy_stress_Pa");
+  ASSERT_TRUE(vm && vm_fabric && sigma);
+  ASSERT_EQ(sigma->GetNumberOfComponents(), 9);
+  const Mat3 exact = neo_hookean_exact(kStretch).sigma;
+  int soft_only = 0, stiff_only = 0;
+  for (int n = 0; n < model.mesh.num_nodes(); ++n) {
+    SCOPED_TRACE("node " + std::to_string(n));
+    if (soft_node[n]) {
+      EXPECT_NEAR(vm->GetTuple1(n), vm_soft, 1e-10 * vm_soft);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) EXPECT_NEAR(sigma->GetComponent(n, 3 * i + j), exact(i, j), 1e-10 * exact.norm());
+    } else {
+      EXPECT_TRUE(std::isnan(vm->GetTuple1(n)));
+      EXPECT_TRUE(std::isnan(sigma->GetComponent(n, 0)));
+    }
+    EXPECT_EQ(std::isnan(vm_fabric->GetTuple1(n)), !stiff_node[n]);
+    if (stiff_node[n]) {
+      EXPECT_GT(vm_fabric->GetTuple1(n), 500 * vm_soft);
+    }
+    soft_only += soft_node[n] && !stiff_node[n];
+    stiff_only += stiff_node[n] && !soft_node[n];
+  }
+  EXPECT_GT(soft_only + stiff_only, 0);  // the test sees both kinds of node, or proves less
+
+  // One material throughout: no stiff layer, no fabric field.
+  const Model plain = cube_model(GetParam());
+  const Assembler plain_asm(plain);
+  const fs::path plain_file = dir.path / "plain.vtu";
+  write_vtu(plain_file.string(), plain,
+            compute_fields(plain_asm, homogeneous_u(plain.mesh, kStretch), tagged_state(plain_asm)), 0.0, 1, 0.0, 0.0);
+  vtkNew<vtkXMLUnstructuredGridReader> plain_reader;
+  plain_reader->SetFileName(plain_file.c_str());
+  plain_reader->Update();
+  EXPECT_EQ(plain_reader->GetOutput()->GetCellData()->GetArray("fabric_von_mises_Pa"), nullptr);
+  EXPECT_NE(plain_reader->GetOutput()->GetPointData()->GetArray("von_mises_Pa"), nullptr);
+}
+
 INSTANTIATE_TEST_SUITE_P(Elements, VtkOutput, ::testing::Values(ElementType::Tet4, ElementType::Tet10),
                          [](const ::testing::TestParamInfo<ElementType>& p) {
                            return p.param == ElementType::Tet4 ? "Tet4" : "Tet10";

@@ -1,0 +1,109 @@
+"""Opens a pneufem run directory in ParaView with the standard views.
+
+    pvpython viz/paraview/open_run.py out/default            # opens, then saves views.png there
+    paraview --script=viz/paraview/open_run.py                # GUI; run directory from PNEUFEM_RUN
+                                                              # or the current directory
+
+Views (the last reported state; the time slider walks through the states of results.pvd):
+  * left:  the deformed actuator (Warp By Vector, displacement_m), mirrored about x = 0 when the
+           run is a half model, coloured by the silicone's von Mises stress (point data
+           von_mises_Pa; the fabric has its own field, fabric_von_mises_Pa, and is left grey);
+  * right: the same shape coloured by damage (cell data; 0 everywhere without a damage law);
+  * below: angle against pressure from angles.csv, one line per trial's reports.
+Colour maps are Viridis (perceptually uniform, readable by colour-blind readers). Needs ParaView
+5.9 or later (paraview.simple); pneufem itself does not need ParaView.
+"""
+import os
+import sys
+
+from paraview.simple import (AssignViewToLayout, ColorBy, CreateLayout, CreateView, CSVReader, GetActiveViewOrCreate,
+                             GetAnimationScene, GetColorTransferFunction, GetLayout, GetScalarBar, PVDReader, Reflect,
+                             Render, ResetCamera, SaveScreenshot, SetActiveView, Show, WarpByVector)
+
+
+def run_directory():
+    args = [a for a in sys.argv[1:] if not a.startswith("-")]
+    return os.path.abspath(args[0] if args else os.environ.get("PNEUFEM_RUN", os.getcwd()))
+
+
+def shape(reader):
+    """The deformed actuator, mirrored when the run modelled the half x >= 0."""
+    warp = WarpByVector(Input=reader)
+    warp.Vectors = ["POINTS", "displacement_m"]
+    warp.ScaleFactor = 1.0
+    reader.UpdatePipeline()
+    x_min = reader.GetDataInformation().GetBounds()[0]
+    span = reader.GetDataInformation().GetBounds()[1] - x_min
+    if abs(x_min) <= 1e-9 * max(span, 1e-12):  # a half model sits on its symmetry plane x = 0
+        mirrored = Reflect(Input=warp)
+        mirrored.Plane = "X Min"
+        mirrored.CopyInput = 1
+        return mirrored
+    return warp
+
+
+def coloured(source, view, association, field, title):
+    display = Show(source, view)
+    ColorBy(display, (association, field))
+    lut = GetColorTransferFunction(field)
+    lut.ApplyPreset("Viridis (matplotlib)", True)
+    lut.NanColor = [0.75, 0.75, 0.75]
+    display.RescaleTransferFunctionToDataRange(True, False)
+    display.SetScalarBarVisibility(view, True)
+    GetScalarBar(lut, view).Title = title
+    view.OrientationAxesVisibility = 1
+    return display
+
+
+def main():
+    run = run_directory()
+    pvd = os.path.join(run, "results.pvd")
+    if not os.path.exists(pvd):
+        sys.exit("open_run.py: no results.pvd in %s (run `pneufem simulate --out DIR` with output.vtu other than "
+                 "\"none\")" % run)
+    reader = PVDReader(FileName=pvd)
+    scene = GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    if reader.TimestepValues:
+        scene.AnimationTime = list(reader.TimestepValues)[-1]
+    actuator = shape(reader)
+
+    stress_view = GetActiveViewOrCreate("RenderView")
+    layout = GetLayout(stress_view)
+    if layout is None:  # pvpython: views have no layout until given one
+        layout = CreateLayout("pneufem")
+        AssignViewToLayout(view=stress_view, layout=layout, hint=0)
+    coloured(actuator, stress_view, "POINTS", "von_mises_Pa", "von Mises, silicone (Pa)")
+    damage_view = CreateView("RenderView")
+    layout.SplitHorizontal(0, 0.5)
+    layout.AssignView(2, damage_view)
+    coloured(actuator, damage_view, "CELLS", "damage", "damage")
+    for view in (stress_view, damage_view):
+        view.CameraPosition = [0.25, -0.15, 0.12]  # metres: in front of the clamped end, above
+        view.CameraFocalPoint = [0.0, 0.06, 0.0]
+        view.CameraViewUp = [0.0, 0.0, 1.0]
+        ResetCamera(view)
+
+    angles = os.path.join(run, "angles.csv")
+    if os.path.exists(angles):
+        chart = CreateView("XYChartView")
+        layout.SplitVertical(1, 0.6)
+        layout.AssignView(4, chart)
+        table = CSVReader(FileName=[angles])
+        line = Show(table, chart)
+        line.UseIndexForXAxis = 0
+        line.XArrayName = "pressure_kPa"
+        line.SeriesVisibility = ["angle_deg"]
+        chart.LeftAxisTitle = "bending angle (deg)"
+        chart.BottomAxisTitle = "pressure (kPa)"
+
+    SetActiveView(stress_view)
+    Render()
+    if "--no-screenshot" not in sys.argv and not hasattr(sys, "ps1"):
+        try:
+            SaveScreenshot(os.path.join(run, "views.png"), layout, ImageResolution=[1600, 1000])
+        except Exception as err:  # an on-screen GUI session need not save; say why and go on
+            print("open_run.py: views.png not saved (%s)" % err)
+
+
+main()
