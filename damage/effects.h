@@ -2,6 +2,14 @@
 // Factory for the inelastic effects of damage/: each wraps a split base law (yeoh, neo_hookean,
 // mooney_rivlin, ogden) and modifies its isochoric response only.
 //
+// Why viscoelasticity lives in damage/. The folder holds the inelastic decorators, of which two are
+// damage (Mullins, fatigue) and one is not (Prony viscoelasticity); all three are the same kind of
+// object: a Material wrapping a base law, with its own committed/trial history in front of the
+// base's (damage/decorator.h), one entry of the effect registry (damage/registry.h) and one derivative
+// battery (tests/damage/), so they are kept together under the name of the majority, as FEBio's
+// damage materials (FEDamageMaterial) wrap an elastic base the same way. Renaming the folder and the
+// pneufem::damage target would touch every include for no change in what the code does.
+//
 //   make_mullins      Ogden-Roxburgh Mullins softening (mullins.h): depends on the peak energy only.
 //   make_fatigue      progressive, irreversible fatigue damage driven by time above a threshold (fatigue.h).
 //   make_viscoelastic Prony-series finite-strain viscoelasticity; the base is the long-term law (viscoelastic.h).
