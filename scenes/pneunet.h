@@ -5,7 +5,7 @@
 // (scenes/pneunet.cpp explains the choices). Volumes and areas are exact; the build is
 // deterministic, elements are ordered along y and nodes by first use.
 //
-// Frame (as the CalculiX reference, ../shared/reference/calculix): x = width (centred on 0),
+// Frame (as the CalculiX reference, bench/calculix/README.md): x = width (centred on 0),
 // y = length (0 at the fixed inlet end), z = up (0 at the bottom of the base). SI units (m).
 #include <cstdint>
 #include <string>

@@ -12,7 +12,7 @@
 
 Needs Debian's python3-numpy (run with /usr/bin/python3) and a ccx binary. Stock ccx 2.20 stalls
 near 6.5 kPa (its static tangent lacks the follower-pressure load stiffness); build the patched
-one with ../shared/reference/calculix/ccx_patch/build_ccx_patched.sh (tangent-only fix).
+one with bench/calculix/ccx_patch/build_ccx_patched.sh (tangent-only fix, bench/calculix/README.md).
 
 usage: scripts/crosscheck_calculix.py [--ccx /tmp/ccx-2.20-patched/ccx] [--out bench/results/ccx_h2]
                                       [--set key=value ...] [--threads 2] [--reuse-ccx]
