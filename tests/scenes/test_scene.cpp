@@ -1,6 +1,7 @@
 // Scene files: defaults, merging, overrides, and the errors a user sees for bad input.
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +29,35 @@ std::string error_of(const std::function<void()>& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+// scenes/examples/small_actuator.toml, the tutorial's scene (docs/user_guide.md), is the scene the
+// recordings of tests/data/hidden were made with (scripts/make_hidden_datasets.sh): every --set of a
+// recording's command line has the example's value, so the tutorial compares like with like.
+TEST(ExampleScenes, SmallActuatorIsTheSceneOfTheHiddenEffectRecordings) {
+  const std::string root = std::string(PNEUFEM_TEST_DATA_DIR) + "/../..";
+  const Scene example = Scene::load(root + "/scenes/examples/small_actuator.toml");
+  for (const char* name : {"none", "viscoelastic"}) {
+    std::ifstream in(std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/" + name + ".truth.json");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string json = text.str();
+    const std::string field = "\"command_line\": \"";
+    const std::size_t at = json.find(field);
+    ASSERT_NE(at, std::string::npos) << name;
+    const std::size_t begin = at + field.size();
+    std::istringstream words(json.substr(begin, json.find('"', begin) - begin));
+    int sets = 0;
+    for (std::string w, previous; words >> w; previous = w) {
+      if (previous != "--set") continue;
+      const std::string key = w.substr(0, w.find('=')), value = w.substr(w.find('=') + 1);
+      EXPECT_EQ(example.number(key), std::stod(value)) << name << ": " << key;
+      ++sets;
+    }
+    EXPECT_EQ(sets, 6) << name;  // chambers, h_mm, max_kPa, step_kPa, hold_s, trials
+  }
+  // Everything else is the default scene's.
+  EXPECT_EQ(example.string("materials.silicone.model"), Scene::load("").string("materials.silicone.model"));
 }
 
 TEST(Scene, DefaultsAreTheEngineIssueActuator) {

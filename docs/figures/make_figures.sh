@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Regenerates the figures of the user guide (docs/user_guide.md) and the README by running its
+# tutorial on the small actuator of the test recordings: a compare of the hidden-creep recording,
+# a diagnose, and a compare of the fitted scene. About 3 min on 2 cores.
+# Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+EXE=${1:-build/app/pneufem}
+RUN=out/tutorial
+DATA=tests/data/hidden/viscoelastic.csv
+rm -rf "$RUN"
+"$EXE" simulate scenes/examples/small_actuator.toml --out "$RUN/first"
+"$EXE" compare scenes/examples/small_actuator.toml --data "$DATA" --out "$RUN/study"
+cp "$RUN/study/fig_trial_1.svg" docs/figures/tutorial_compare_trial_1.svg
+cp "$RUN/study/fig_trial_1.csv" docs/figures/tutorial_compare_trial_1.csv
+"$EXE" diagnose scenes/examples/small_actuator.toml --data "$DATA" --out "$RUN/diagnosis"
+"$EXE" compare "$RUN/diagnosis/fitted.toml" --data "$DATA" --out "$RUN/study"
+cp "$RUN/study/fig_trial_1.svg" docs/figures/tutorial_fitted_trial_1.svg
+cp "$RUN/study/fig_trial_1.csv" docs/figures/tutorial_fitted_trial_1.csv
+cp "$RUN/study/fig_history.svg" docs/figures/tutorial_history.svg
+cp "$RUN/study/fig_history.csv" docs/figures/tutorial_history.csv
+echo "figures written to docs/figures (runs in $RUN)"
