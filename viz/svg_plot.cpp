@@ -496,9 +496,14 @@ std::vector<std::array<double, 2>> Figure::ink_samples(const Axes& a, const Scal
     for (std::size_t i = 0; i < ser.x.size(); ++i) {
       const double x = X(ser.x[i]), y = SY(ser.y[i]);
       add(x, y);
-      const bool segment = ser.kind == Axes::Kind::Line && ser.style.line_width > 0.0 && i + 1 < ser.x.size();
-      const double x1 = segment ? X(ser.x[i + 1]) : x, y1 = segment ? SY(ser.y[i + 1]) : SY(ser.kind == Axes::Kind::Range ? ser.y_hi[i] : ser.y[i]);
-      for (int j = 1; j < 8 && (segment || ser.kind == Axes::Kind::Range); ++j) add(x + (x1 - x) * j / 8.0, y + (y1 - y) * j / 8.0);
+      double x1 = x, y1 = y;  // the other end of what is drawn from this point: a bar's top, a segment's end
+      if (ser.kind == Axes::Kind::Range)
+        y1 = SY(ser.y_hi[i]);
+      else if (ser.kind == Axes::Kind::Line && ser.style.line_width > 0.0 && i + 1 < ser.x.size())
+        x1 = X(ser.x[i + 1]), y1 = SY(ser.y[i + 1]);
+      else
+        continue;
+      for (int j = 1; j < 8; ++j) add(x + (x1 - x) * j / 8.0, y + (y1 - y) * j / 8.0);
     }
   }
   const int G = static_cast<int>(a.bars_.size());
