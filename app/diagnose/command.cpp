@@ -223,7 +223,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   if (opt.progress)
     std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
                  opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");
-  const RomEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
+  const PathModelEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
                          opt.cache_dir);
   if (opt.progress) {
     std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s; path %s%s%s)\n",

@@ -78,7 +78,7 @@ struct DiagnoseOptions {
   /// FEM (bounded derivative-free search from the reduced-model or refined constants); 0 = none.
   int fem_calibration_runs = 0;
   /// > 0: calibrate on the built-in mesher at this element size (mm) instead of the scene's mesh,
-  /// with an elastic mesh correction from one static sweep of each mesh (see RomEvaluator in
+  /// with an elastic mesh correction from one static sweep of each mesh (see PathModelEvaluator in
   /// app/diagnose/evaluator.h); the FEM runs and fitted.toml keep the scene's mesh. 0 = the scene's mesh;
   /// < 0 = auto: 3x the scene's element size for a built-in mesh of more than 50k dof, else the
   /// scene's mesh (a note on stderr says which).

@@ -2,7 +2,7 @@
 // What the files of `pneufem diagnose` (app/diagnose/command.h) share; internal to them:
 //   command.cpp             run_diagnosis: the baseline, the rounds of forward selection and their
 //                           significance tests, then the FEM stages and the outputs below;
-//   evaluator.h/.cpp        RomEvaluator, the reduced-model replay of the recording;
+//   evaluator.h/.cpp        PathModelEvaluator, the reduced-model replay of the recording;
 //   calibrate.cpp           parameter scaling, interpolation nodes and the calibration of a
 //                           candidate's constants (grid, then golden section or BOBYQA);
 //   evidence.cpp            the residual's signature and the plain-words reason per candidate;
@@ -27,7 +27,7 @@
 
 namespace pneufem::diagnose_detail {
 
-class RomEvaluator;
+class PathModelEvaluator;
 
 /// The selected effects with their calibrated constants, in the order they were selected.
 using ChosenEffects = std::vector<std::pair<const CandidateEffect*, std::vector<double>>>;
@@ -125,7 +125,7 @@ std::string evidence(const std::string& effect, const Signature& s);
 /// a refinement run computed them (else it is left empty). Does nothing when neither is asked for
 /// or nothing was selected.
 void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
-                     const std::vector<ComparedFrame>& frames, const RomEvaluator& rom, const DiagnoseOptions& opt,
+                     const std::vector<ComparedFrame>& frames, const PathModelEvaluator& rom, const DiagnoseOptions& opt,
                      ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
                      DiagnosisResult& out, std::vector<Series>* fitted_fem = nullptr);
 
@@ -139,7 +139,7 @@ void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& r
 
 /// Writes diagnosis.json, fitted.toml, diagnosis.csv and calibration.csv to opt.out_dir and
 /// appends the baseline and the fitted model to its history.jsonl.
-void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator& rom, const ChosenEffects& chosen,
+void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEvaluator& rom, const ChosenEffects& chosen,
                      const DiagnoseOptions& opt, const DiagnosisResult& out);
 
 }  // namespace pneufem::diagnose_detail

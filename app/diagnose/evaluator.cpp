@@ -1,4 +1,4 @@
-// RomEvaluator (app/diagnose/evaluator.h): the reduced-model replay of a recording, its calibration
+// PathModelEvaluator (app/diagnose/evaluator.h): the reduced-model replay of a recording, its calibration
 // mesh's pressure map and its cache of elastic FEM curves. Kept apart from the calibration and
 // the selection, which only see angles per frame: this is where diagnose drives the path model
 // and the static FEM sweeps (the full-FEM runs of --refine and --verify are fem.cpp).
@@ -36,7 +36,7 @@ bool has_history(const Model& m) {
 
 }  // namespace
 
-RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
+PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
                            int rom_points, const Scene* mesh_scene, const std::string& cache_dir)
     : cache_dir_(cache_dir), rec_(rec), frames_(frames) {
   ref_ = build_model(elastic_reference_scene(base));
@@ -121,7 +121,7 @@ RomEvaluator::RomEvaluator(const Scene& base, const Recording& rec, const std::v
   }
 }
 
-std::vector<double> RomEvaluator::at_frames(const Scene& variant) const {
+std::vector<double> PathModelEvaluator::at_frames(const Scene& variant) const {
   const std::vector<std::vector<double>> per_trial = simulate(variant, true);
   std::vector<double> out(frames_.size());
   std::vector<std::size_t> next(rec_.trials.size(), 0);
@@ -129,7 +129,7 @@ std::vector<double> RomEvaluator::at_frames(const Scene& variant) const {
   return out;
 }
 
-std::vector<Series> RomEvaluator::series(const Scene& variant) const {
+std::vector<Series> PathModelEvaluator::series(const Scene& variant) const {
   const std::vector<std::vector<double>> a = simulate(variant, false);
   std::vector<Series> out(rec_.trials.size());
   for (std::size_t k = 0; k < rec_.trials.size(); ++k) {
@@ -139,12 +139,12 @@ std::vector<Series> RomEvaluator::series(const Scene& variant) const {
   return out;
 }
 
-bool RomEvaluator::uses_fem_sweeps(const Scene& variant) const {
+bool PathModelEvaluator::uses_fem_sweeps(const Scene& variant) const {
   const std::unique_ptr<BuiltModel> bm = build_model(variant);
   return !has_history(bm->model) && bm->model.gravity_m_s2.norm() > 0.0;
 }
 
-std::vector<std::vector<double>> RomEvaluator::simulate(const Scene& variant, bool kept_only) const {
+std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& variant, bool kept_only) const {
   const std::unique_ptr<BuiltModel> bm = build_model(variant);
   const double lag = variant.has("load.pressure_lag_s") ? variant.number("load.pressure_lag_s") : 0.0;
   const LoadHistory load = lag > 0.0 ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
@@ -260,13 +260,13 @@ std::vector<std::vector<double>> RomEvaluator::simulate(const Scene& variant, bo
   return out;
 }
 
-std::string RomEvaluator::fmt_kPa(double p_Pa) {
+std::string PathModelEvaluator::fmt_kPa(double p_Pa) {
   char b[32];
   std::snprintf(b, sizeof b, "%.2f kPa", p_Pa * 1e-3);
   return b;
 }
 
-double RomEvaluator::interpolate_quadratic(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
+double PathModelEvaluator::interpolate_quadratic(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
   const std::size_t n = xs.size();
   if (n < 3) return n ? ys.front() : 0.0;
   const std::size_t k = static_cast<std::size_t>(std::upper_bound(xs.begin(), xs.end(), x) - xs.begin());
@@ -276,7 +276,7 @@ double RomEvaluator::interpolate_quadratic(const std::vector<double>& xs, const 
          ys[c + 1] * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1));
 }
 
-double RomEvaluator::curve_at(const std::vector<double>& th, double hi, double p) {
+double PathModelEvaluator::curve_at(const std::vector<double>& th, double hi, double p) {
   const int n = static_cast<int>(th.size()) - 1;
   const double x = hi > 0.0 ? std::clamp(p / hi, 0.0, 1.0) * n : 0.0;
   const int c = std::clamp(static_cast<int>(std::lround(x)), 1, n - 1);
@@ -284,7 +284,7 @@ double RomEvaluator::curve_at(const std::vector<double>& th, double hi, double p
   return th[c] + 0.5 * u * (th[c + 1] - th[c - 1]) + 0.5 * u * u * (th[c + 1] - 2 * th[c] + th[c - 1]);
 }
 
-std::vector<double> RomEvaluator::elastic_curve(const Scene& variant, const BuiltModel* bm_in, double hi, int n) const {
+std::vector<double> PathModelEvaluator::elastic_curve(const Scene& variant, const BuiltModel* bm_in, double hi, int n) const {
   const std::string key = curve_key(variant);
   {
     std::lock_guard<std::mutex> lock(cache_mu_);
@@ -300,7 +300,7 @@ std::vector<double> RomEvaluator::elastic_curve(const Scene& variant, const Buil
   return th;
 }
 
-std::vector<double> RomEvaluator::stored_curve(const Scene& variant, const BuiltModel& bm, double hi, int n,
+std::vector<double> PathModelEvaluator::stored_curve(const Scene& variant, const BuiltModel& bm, double hi, int n,
                                                std::string* source) const {
   if (source) *source = "computed";
   if (cache_dir_.empty()) return static_angle_curve(bm, hi, n);

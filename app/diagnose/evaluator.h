@@ -36,11 +36,11 @@ namespace pneufem::diagnose_detail {
 /// see the deformation the scene's mesh would have (same angle), so their strain-driven evolution
 /// is alike. Without any correction the coarse mesh's stiffness is itself "a missing stiffness
 /// effect". On the default actuator at 45 kPa the h = 6 mesh bends 55 deg, the h = 2 mesh 77 deg.
-class RomEvaluator {
+class PathModelEvaluator {
  public:
   /// `cache_dir` (may be empty: none): stores and reads the elastic path's trace, the scene mesh's
   /// sweep and the static FEM curves there (app/simulate/result_cache.h), so re-runs on one actuator skip them.
-  RomEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points,
+  PathModelEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames, int rom_points,
                const Scene* mesh_scene = nullptr, const std::string& cache_dir = "");
 
   /// Where the elastic path and the scene mesh's sweep came from: "computed", "cache <file>", ...

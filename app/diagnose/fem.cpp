@@ -17,7 +17,7 @@
 namespace pneufem::diagnose_detail {
 
 void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
-                     const std::vector<ComparedFrame>& frames, const RomEvaluator& rom, const DiagnoseOptions& opt,
+                     const std::vector<ComparedFrame>& frames, const PathModelEvaluator& rom, const DiagnoseOptions& opt,
                      ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
                      DiagnosisResult& out, std::vector<Series>* fitted_fem) {
   // Space mapping (output correction): the reduced model is a 1-dof Ritz model and misjudges

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 
 namespace pneufem::diagnose_detail {
 
-void write_diagnosis(const Scene& scene, const Scene& fitted, const RomEvaluator& rom, const ChosenEffects& chosen,
+void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEvaluator& rom, const ChosenEffects& chosen,
                      const DiagnoseOptions& opt, const DiagnosisResult& out) {
   fs::create_directories(opt.out_dir);
   json::Object root;

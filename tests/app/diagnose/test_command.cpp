@@ -300,7 +300,7 @@ TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
 }
 
 // --calibration-h: calibrate on a coarser built-in mesh, driven through the pressure map that makes
-// its elastic path the scene mesh's (app/diagnose/evaluator.h, RomEvaluator). Case: a 3-chamber actuator
+// its elastic path the scene mesh's (app/diagnose/evaluator.h, PathModelEvaluator). Case: a 3-chamber actuator
 // whose h = 8 mesh is 19 % stiffer in angle than its h = 3 mesh, data from the h = 3 FEM with the
 // silicone 20 % softer (noise-free). Measured: scene mesh baseline 0.1696 and scale 0.8037; calibration
 // mesh 0.1696 and 0.8123; the raw h = 8 mesh 0.2275 and 0.7346 (before the reduced model sampled
