@@ -45,17 +45,6 @@ std::uint64_t fnv(const std::string& s) {
   return h;
 }
 
-Scene elastic_reference(const Scene& scene) {
-  std::vector<std::string> sets;
-  for (const std::string& m : scene.table_keys("materials"))
-    for (const std::string& sub : scene.table_keys("materials." + m))
-      if (scene.has("materials." + m + "." + sub + ".enabled")) sets.push_back("materials." + m + "." + sub + ".enabled=false");
-  sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
-  sets.push_back("gravity.rig_angle_deg=-1.0");
-  sets.push_back("load.pressure_lag_s=0.0");
-  return scene.with(sets);
-}
-
 void write_doubles(const fs::path& p, const std::vector<double>& v) {
   std::ofstream f(p, std::ios::binary);
   const std::uint64_t n = v.size();
@@ -135,7 +124,7 @@ int main(int argc, char** argv) {
   fs::create_directories(work);
   const Scene base = Scene::load(scene_path, sets);
   const Scene scene = base.with(model_sets);
-  const Scene ref_scene = elastic_reference(base).with({"load.trials=1"});
+  const Scene ref_scene = elastic_reference_scene(base).with({"load.trials=1"});
   auto bm = build_model(scene);
   auto ref = build_model(ref_scene);
   std::printf("model: %d nodes, %d elements, %d dof\n", bm->model.mesh.num_nodes(), bm->model.mesh.num_elements(),

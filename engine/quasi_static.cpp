@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "engine/angle.h"
+#include "engine/history_step.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -43,29 +44,6 @@ std::vector<double> get_vec(std::istream& is) {
   return v;
 }
 
-// One physical step's history measures over points (history_scalars layout: 2 values per point):
-// the largest change |d' - d| + |e' - e| (cur -> next), and, with the previous step (prev non-empty,
-// r = h / h_prev), the largest local-error estimate: the change minus the previous change
-// extrapolated at constant rate, times r / (1 + r) (Milne's device for a first-order update).
-struct HistoryStep {
-  double change = 0.0, error = 0.0;
-  int change_point = -1, error_point = -1;  ///< where they are largest (-1: nothing changed)
-};
-HistoryStep history_step(const std::vector<double>& prev, const std::vector<double>& cur, const std::vector<double>& next,
-                         double r) {
-  HistoryStep out;
-  for (std::size_t i = 0; i < next.size(); i += 2) {
-    const int point = static_cast<int>(i / 2);
-    const double c = std::abs(next[i] - cur[i]) + std::abs(next[i + 1] - cur[i + 1]);
-    if (c > out.change) out.change = c, out.change_point = point;
-    if (prev.empty()) continue;
-    double e = 0.0;
-    for (std::size_t k = i; k < i + 2; ++k) e += std::abs((next[k] - cur[k]) - r * (cur[k] - prev[k]));
-    e *= r / (1.0 + r);
-    if (e > out.error) out.error = e, out.error_point = point;
-  }
-  return out;
-}
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {

@@ -13,6 +13,7 @@
 #include <Eigen/LU>
 
 #include "engine/angle.h"
+#include "engine/history_step.h"
 #include "engine/path_spline.h"
 #include "engine/rom_points.h"
 #include "engine/tet_element.h"
@@ -431,33 +432,6 @@ struct ReducedRun::Segment {
   double t0, t1, g0, g1, p0, p1;
   bool report;
 };
-
-namespace {
-
-struct HistoryStep {
-  double change = 0.0, error = 0.0;
-  int change_point = -1, error_point = -1;
-};
-
-// As engine/quasi_static.cpp: the largest change of (fatigue damage, viscous strain) over the kept
-// points, and with the previous step the largest local-error estimate (Milne's device).
-HistoryStep history_step(const std::vector<double>& prev, const std::vector<double>& cur, const std::vector<double>& next,
-                         double r) {
-  HistoryStep out;
-  for (std::size_t i = 0; i < next.size(); i += 2) {
-    const int point = static_cast<int>(i / 2);
-    const double c = std::abs(next[i] - cur[i]) + std::abs(next[i + 1] - cur[i + 1]);
-    if (c > out.change) out.change = c, out.change_point = point;
-    if (prev.empty()) continue;
-    double e = 0.0;
-    for (std::size_t k = i; k < i + 2; ++k) e += std::abs((next[k] - cur[k]) - r * (cur[k] - prev[k]));
-    e *= r / (1.0 + r);
-    if (e > out.error) out.error = e, out.error_point = point;
-  }
-  return out;
-}
-
-}  // namespace
 
 ReducedRun::ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options) : rom_(rom), opt_(options) {
   z_.q = Eigen::VectorXd::Zero(rom.num_modes());
