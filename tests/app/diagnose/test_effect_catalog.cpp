@@ -1,10 +1,14 @@
 // The candidate-effect catalog (app/diagnose/effect_catalog.h): bounds are sane, every candidate's overrides
-// build on the default scene and land on the right keys, registered material effects appear.
+// build on the default scene and land on the right keys, registered material effects appear, and the
+// creep candidate in both moduli conventions names the one a recording shows (one diagnosis, ~1 min).
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <functional>
 
 #include <gtest/gtest.h>
 
+#include "app/diagnose/command.h"
 #include "app/diagnose/effect_catalog.h"
 #include "core/errors.h"
 #include "damage/registry.h"
@@ -213,6 +217,50 @@ TEST(EffectCatalog, CreepIsTriedInBothModuliConventions) {
   // A scene whose creep is switched off is free for either.
   const Scene off = with_lt.with({"materials.silicone.viscoelastic.enabled=false"});
   EXPECT_EQ(off.with(inst.sets(off, {0.3, 2.0})).string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+}
+
+// End to end: a recording whose creep goes beyond the elastic model (tests/data/hidden/
+// viscoelastic_instantaneous.csv: synth with gamma 0.5, tau 4 s in the instantaneous convention on
+// the hidden-effect datasets' actuator, scripts/make_hidden_datasets.sh) is diagnosed as
+// viscoelastic_instantaneous; the long-term candidate, whose creep can only approach the elastic
+// model from the stiff side, explains nothing (its constants go to their lower bounds). Its
+// long-term twin, tests/data/hidden/viscoelastic.csv, is HiddenEffect.Viscoelastic
+// (test_command.cpp), with every candidate. Measured (2026-11-27): NRMSE 0.2040 -> 0.0264 at a noise
+// floor of 0.0053, gamma 0.495, tau 4.64 s; stiffness 0.0996 (scale 0.82), long-term creep 0.2040
+// (at its lower bounds). The remainder is the reduced model's own error for creep under the
+// overshooting inlet, as for the twin (0.023 there; ~1 % of the angle range), which is 5x this
+// recording's floor: its creep enlarges the angle range the floor is relative to. Hence the bound on
+// the error is relative to the baseline: below 0.2x (measured 0.13x; issue 35 asks <= 0.4x). gamma and
+// tau trade off over 4 s holds: within 50 % and 30 % of the truth, as for the twin.
+TEST(CreepConventions, ARecordingThatCreepsBeyondTheElasticModelIsInstantaneousCreep) {
+  const std::vector<std::string> scene = {"geometry.chambers=5", "mesh.h_mm=6.0", "load.max_kPa=30.0",
+                                          "load.step_kPa=10.0",  "load.hold_s=4.0", "load.trials=3"};
+  DiagnoseOptions o;
+  o.data_path = std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/viscoelastic_instantaneous.csv";
+  o.out_dir = (std::filesystem::temp_directory_path() / "pneufem_diag_creep_conventions").string();
+  std::filesystem::remove_all(o.out_dir);
+  o.max_effects = 1;
+  o.candidates = {"stiffness", "viscoelastic", "viscoelastic_instantaneous"};
+  o.cache_dir = (std::filesystem::temp_directory_path() / "pneufem_diagnose_cache").string();  // as test_command's
+  const DiagnosisResult r = run_diagnosis(Scene::load("", scene), o);
+  for (const CandidateResult& c : r.candidates) {
+    std::printf("%s NRMSE %.4f%s", c.effect.c_str(), c.nrmse, c.significant ? " (sig)" : "");
+    for (std::size_t i = 0; i < c.params.size(); ++i) std::printf(" %s=%.4g", c.param_names[i].c_str(), c.params[i]);
+    std::printf("; ");
+  }
+  std::printf("\nbaseline %.4f, floor %.4f, final %.4f\n", r.baseline_nrmse, r.noise_floor_nrmse, r.final_nrmse);
+  EXPECT_EQ(r.missing_effect, "viscoelastic_instantaneous");
+  EXPECT_LT(r.final_nrmse, 0.2 * r.baseline_nrmse);
+  const CandidateEffect& truth = candidate_effect("viscoelastic_instantaneous");
+  for (const CandidateResult& c : r.candidates) {
+    if (c.effect == "viscoelastic") {
+      EXPECT_FALSE(c.significant) << c.why;
+    }
+    if (c.effect != "viscoelastic_instantaneous") continue;
+    ASSERT_EQ(c.params.size(), 2u);
+    EXPECT_NEAR(c.params[0], truth.params[0].truth, 0.5 * truth.params[0].truth);
+    EXPECT_NEAR(c.params[1], truth.params[1].truth, 0.3 * truth.params[1].truth);
+  }
 }
 
 }  // namespace
