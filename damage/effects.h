@@ -12,7 +12,8 @@
 //
 //   make_mullins      Ogden-Roxburgh Mullins softening (mullins.h): depends on the peak energy only.
 //   make_fatigue      progressive, irreversible fatigue damage driven by time above a threshold (fatigue.h).
-//   make_viscoelastic Prony-series finite-strain viscoelasticity; the base is the long-term law (viscoelastic.h).
+//   make_viscoelastic Prony-series finite-strain viscoelasticity; the base is the instantaneous or the
+//                     long-term law (ViscoParams::moduli, viscoelastic.h).
 //
 // Order. Mullins and fatigue are driven by the base's isochoric energy and need it to be a potential
 // of the base's stress, so they reject a fatigue or viscoelastic base; decorate() applies the effects

@@ -33,8 +33,8 @@ constexpr double kMPa = 1e6;
 //    so m spans "abrupt" to "gradual" over that range); beta in [0, 1];
 //  * fatigue W_th in [0.003, 0.1] MPa (same energy range), tau in [100, 1e5] s (damage visible
 //    after one 160 s trial down to barely visible over ten), q in [1, 4];
-//  * viscoelastic gamma in [0.02, 3] (2 % to 300 % instantaneous overstiffness), tau in [0.2, 30] s
-//    (faster than the controller's rise down to a whole hold).
+//  * viscoelastic gamma in [0.02, 3] (instantaneous modulus 2 % to 300 % above the long-term one, in
+//    either moduli convention), tau in [0.2, 30] s (faster than the controller's rise down to a whole hold).
 std::vector<MaterialEffect> builtins() {
   std::vector<MaterialEffect> v;
   {
@@ -84,12 +84,25 @@ std::vector<MaterialEffect> builtins() {
   {
     MaterialEffect e;
     e.name = "viscoelastic";
-    e.doc = "Prony-series finite-strain viscoelasticity; the base law is the long-term response";
-    e.params = {{"gamma", "1", "relative stiffness of each Prony term (Abaqus g_i: gamma = g/(1 - sum g))", 0.1, 0.02,
-                 3.0, true, true},
+    e.doc = "Prony-series finite-strain viscoelasticity of the isochoric response; `moduli` says whether the "
+            "hyperelastic constants are its instantaneous or its long-term response";
+    e.params = {{"gamma", "1",
+                 "stiffness of each Prony term relative to the long-term modulus (Abaqus g_i: gamma = g/(1 - sum g))",
+                 0.1, 0.02, 3.0, true, true},
                 {"tau_s", "s", "relaxation time of each term", 6.0, 0.2, 30.0, true, true}};
+    // Default "instantaneous", as Abaqus (MODULI=INSTANTANEOUS with *VISCOELASTIC): the hyperelastic
+    // constants are the response right after a step, which relaxes to 1/(1 + sum gamma) = 1 - sum g of
+    // it. "long_term" is the convention pneufem had before 2026-11-27 (damage/viscoelastic.h).
+    e.choices = {{"moduli",
+                  "which response the material's hyperelastic constants describe: the instantaneous one (Abaqus's "
+                  "default; the isochoric stress relaxes to 1/(1 + sum gamma) of it) or the long-term one (the "
+                  "instantaneous stress is 1 + sum gamma times it); a deck's MODULI= sets it",
+                  {"instantaneous", "long_term"}}};
+    // Registered-effect callers pass numbers only: the choice takes its default (the scene reader,
+    // scenes/scene_materials.cpp, passes the scene's word).
     e.decorate = [](MaterialPtr base, const std::map<std::string, double>& p) {
-      return make_viscoelastic(std::move(base), ViscoParams{{p.at("gamma")}, {p.at("tau_s")}});
+      return make_viscoelastic(std::move(base),
+                               ViscoParams{{p.at("gamma")}, {p.at("tau_s")}, ViscoModuli::instantaneous});
     };
     e.order = 300;
     v.push_back(e);

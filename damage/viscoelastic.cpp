@@ -92,7 +92,9 @@ void pack_lanes(const double S[9][N], int n, std::size_t block, std::size_t offs
 
 }  // namespace
 
-ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<double>& tau_s) {
+const char* to_string(ViscoModuli m) { return m == ViscoModuli::instantaneous ? "instantaneous" : "long_term"; }
+
+ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<double>& tau_s, ViscoModuli moduli) {
   const std::string me = "viscoelastic";
   double sum = 0.0;
   for (std::size_t i = 0; i < g.size(); ++i) {
@@ -103,7 +105,7 @@ ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<do
   detail::require(sum < 1.0, me,
                   "the Abaqus g_i must sum to < 1 (the long-term modulus G_0 (1 - sum g) must stay positive), got " +
                       short_num(sum));
-  ViscoParams p{g, tau_s};
+  ViscoParams p{g, tau_s, moduli};
   for (double& gi : p.gamma) gi /= 1.0 - sum;
   return p;
 }
@@ -126,7 +128,12 @@ Viscoelastic::Viscoelastic(MaterialPtr base, const ViscoParams& p) : base_(std::
     gamma_sum_ += p.gamma[i];
   }
   n_ = static_cast<int>(n);
-  mu_inf_ = base_->initial_shear_modulus();
+  moduli_ = p.moduli;
+  // beta = 1 (long_term) or 1 - sum g = 1 / (1 + sum gamma) (instantaneous); a_i = beta gamma_i, which
+  // is gamma_i bit for bit in the long-term convention (the arithmetic before the choice existed).
+  beta_ = moduli_ == ViscoModuli::instantaneous ? 1.0 / (1.0 + gamma_sum_) : 1.0;
+  for (int i = 0; i < n_; ++i) a_[i] = moduli_ == ViscoModuli::instantaneous ? beta_ * gamma_[i] : gamma_[i];
+  mu_base_ = base_->initial_shear_modulus();
 }
 
 void Viscoelastic::init_state(std::span<double> state) const {
@@ -136,18 +143,24 @@ void Viscoelastic::init_state(std::span<double> state) const {
 }
 
 struct Viscoelastic::Increment {
-  std::array<double, kMaxTerms> decay{}, gk{};  // exp(-x_i), gamma_i k_i
-  double c = 0.0;                               // sum_i gamma_i k_i
+  std::array<double, kMaxTerms> decay{}, gk{};  // exp(-x_i), a_i k_i
+  double b = 1.0;                               // beta + sum_i a_i k_i, the factor of P0_iso
 };
 
+// b = 1 + sum gamma_i k_i (long_term: as before the choice existed, bit for bit) or
+// 1 - sum g_i (1 - k_i) (instantaneous: exactly 1 at dt = 0, where k_i = 1).
 Viscoelastic::Increment Viscoelastic::increment(double dt_s) const {
   Increment inc;
+  double c = 0.0, loss = 0.0;  // sum a_i k_i, sum a_i (1 - k_i)
   for (int i = 0; i < n_; ++i) {
     const double x = dt_s / tau_[i];
+    const double k = k_factor(x);
     inc.decay[i] = std::exp(-x);
-    inc.gk[i] = gamma_[i] * k_factor(x);
-    inc.c += inc.gk[i];
+    inc.gk[i] = a_[i] * k;
+    c += inc.gk[i];
+    loss += a_[i] * (1.0 - k);
   }
+  inc.b = moduli_ == ViscoModuli::instantaneous ? 1.0 - loss : 1.0 + c;
   return inc;
 }
 
@@ -171,24 +184,24 @@ void Viscoelastic::evaluate(std::span<const Mat3> F, const TimeStep& step, std::
       const Mat3 Q_old = virgin ? Mat3::Zero() : unpack(ps.own_old.subspan(6 * (i + 1), 6));
       const Mat3 Q_new = inc.decay[i] * Q_old + inc.gk[i] * (S0 - S0_old);
       H += inc.decay[i] * Q_old - inc.gk[i] * S0_old;
-      if (gamma_[i] > 0.0) psi_branches += Q_new.squaredNorm() / (4.0 * gamma_[i] * mu_inf_);
+      if (a_[i] > 0.0) psi_branches += Q_new.squaredNorm() / (4.0 * a_[i] * mu_base_);
       if (!ps.own_new.empty()) pack(Q_new, ps.own_new.subspan(6 * (i + 1), 6));
     }
     if (!ps.own_new.empty()) pack(S0, ps.own_new.subspan(0, 6));
 
     if (tangent) {
-      r.A_iso *= 1.0 + inc.c;
+      r.A_iso *= inc.b;
       for (int i = 0; i < 3; ++i)  // + delta_ik H_JL
         for (int J = 0; J < 3; ++J)
           for (int L = 0; L < 3; ++L) r.A_iso(flat(i, J), flat(i, L)) += H(J, L);
     }
-    r.P_iso = (1.0 + inc.c) * r.P_iso + F[q] * H;
-    r.psi_iso += psi_branches;
+    r.P_iso = inc.b * r.P_iso + F[q] * H;
+    r.psi_iso = beta_ * r.psi_iso + psi_branches;
   }
 }
 
 // evaluate()'s force part for the whole batch in structure-of-arrays form (the helpers above): the base's
-// batched stress, then S0 = sym(F^-1 P0_iso), the Prony update of each term and P_iso = (1 + c) P0_iso + F H.
+// batched stress, then S0 = sym(F^-1 P0_iso), the Prony update of each term and P_iso = b P0_iso + F H.
 void Viscoelastic::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
                           std::span<double> state_new) const {
   assert(step.dt_s >= 0.0);
@@ -217,18 +230,18 @@ void Viscoelastic::stress(StressBatch& b, const TimeStep& step, std::span<const 
         Q_new[k][l] = decay * Q_old[k][l] + gk * (S0[k][l] - S0_old[k][l]);
         H[k][l] += decay * Q_old[k][l] - gk * S0_old[k][l];
       }
-    if (gamma_[i] > 0.0) {
-      const double scale = 4.0 * gamma_[i] * mu_inf_;
+    if (a_[i] > 0.0) {
+      const double scale = 4.0 * a_[i] * mu_base_;
       for (int l = 0; l < n; ++l) psi_branches[l] += squared_norm(Q_new, l) / scale;
     }
     if (!state_new.empty()) pack_lanes(Q_new, n, block, offset, state_new);
   }
   if (!state_new.empty()) pack_lanes(S0, n, block, 0, state_new);
   product(b.F, H, FH, n);
-  const double one_plus_c = 1.0 + inc.c;
+  const double factor = inc.b;
   for (int k = 0; k < 9; ++k)
-    for (int l = 0; l < n; ++l) b.P_iso[k][l] = one_plus_c * b.P_iso[k][l] + FH[k][l];
-  for (int l = 0; l < n; ++l) b.psi_iso[l] += psi_branches[l];
+    for (int l = 0; l < n; ++l) b.P_iso[k][l] = factor * b.P_iso[k][l] + FH[k][l];
+  for (int l = 0; l < n; ++l) b.psi_iso[l] = beta_ * b.psi_iso[l] + psi_branches[l];
 }
 
 PointFields Viscoelastic::fields(std::span<const double> state) const {
@@ -236,7 +249,7 @@ PointFields Viscoelastic::fields(std::span<const double> state) const {
   PointFields f = base_->fields(state.subspan(own));
   Mat3 Q = Mat3::Zero();
   for (int i = 0; i < n_; ++i) Q += unpack(state.subspan(6 * (i + 1), 6));
-  f.viscous_strain = Q.norm() / (2.0 * mu_inf_);
+  f.viscous_strain = Q.norm() / (2.0 * long_term_shear_modulus());
   return f;
 }
 

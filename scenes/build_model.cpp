@@ -5,6 +5,7 @@
 #include "scenes/build_model.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -221,6 +222,52 @@ Mesh read_model_mesh(const Scene& s, const std::string& source, InpDeck& deck, s
   return std::move(deck.mesh);
 }
 
+/// "MODULI=LONG TERM" / "MODULI=INSTANTANEOUS" of a deck's *MATERIAL (for messages).
+std::string to_words(const InpModuli& d) {
+  return std::string("MODULI=") + (d.value == "long_term" ? "LONG TERM" : "INSTANTANEOUS") +
+         (d.material.empty() ? std::string() : " of *MATERIAL " + d.material);
+}
+
+/// The deck's MODULI= (Abaqus: whether the hyperelastic constants are the instantaneous or the
+/// long-term response of a viscoelastic material; InpDeck::moduli) as materials.M.viscoelastic.moduli
+/// of every material M whose viscoelastic table is enabled and leaves `moduli` to the default scene:
+/// the value of the deck's *MATERIAL of the same name (case-insensitive), else the one value all
+/// the deck's MODULI= agree on. A scene that sets the key itself keeps it, with a note when the deck
+/// says otherwise; MODULI= values that differ, none for a material of this name: an error naming the
+/// lines. Each value taken is noted in `warnings`.
+Scene with_deck_moduli(const Scene& s, const InpDeck& deck, std::vector<std::string>& warnings) {
+  if (deck.moduli.empty()) return s;
+  std::vector<std::string> sets;
+  for (const std::string& m : s.table_keys("materials")) {
+    const std::string K = "materials." + m + ".viscoelastic";
+    std::string m_upper = m;  // deck names are stored upper-cased
+    std::transform(m_upper.begin(), m_upper.end(), m_upper.begin(), [](unsigned char c) { return std::toupper(c); });
+    if (!s.has(K + ".enabled") || !s.boolean(K + ".enabled")) continue;
+    const InpModuli* from = nullptr;
+    for (const InpModuli& d : deck.moduli)
+      if (d.material == m_upper) from = &d;  // the last one, as a repeated keyword overrides
+    if (!from) {
+      from = &deck.moduli.front();
+      for (const InpModuli& d : deck.moduli)
+        if (d.value != from->value)
+          s.fail(K + ".moduli", "the deck's MODULI= differ (" + to_words(*from) + " at " + from->where + ", " +
+                                    to_words(d) + " at " + d.where + ") and none belongs to a *MATERIAL named '" + m +
+                                    "'; set moduli = \"instantaneous\" or \"long_term\" here");
+    }
+    const std::string key = K + ".moduli";
+    const bool set_by_scene = s.has(key) && s.origin(key) != "default scene";
+    if (set_by_scene) {
+      if (s.string(key) != from->value)
+        warnings.push_back(key + " = \"" + s.string(key) + "\" (" + s.origin(key) + ") is kept over the deck's " +
+                           to_words(*from) + " (" + from->where + ")");
+      continue;
+    }
+    sets.push_back(key + "=" + from->value);
+    warnings.push_back(key + " = \"" + from->value + "\" from the deck's " + to_words(*from) + " (" + from->where + ")");
+  }
+  return s.with(sets);
+}
+
 /// mesh.regions (element sets of a deck as regions), then the [[parts]]: every element gets one part,
 /// the elements of a region with a stiffness scale a part of their own. With a membrane fabric an
 /// empty element set (FABRIC) makes no part.
@@ -423,7 +470,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   Mesh& mesh = model.mesh;
   mesh.ensure_ids();
   const bool membrane_fabric = fabric_is_membrane(s);
-  assign_parts(s, model, membrane_fabric);
+  assign_parts(with_deck_moduli(s, deck, out->warnings), model, membrane_fabric);  // s itself without MODULI=
 
   // Boundary conditions.
   model.fixed.assign(3 * mesh.num_nodes(), 0);

@@ -92,7 +92,9 @@ EffectParams effect_params(const Scene& s, const std::string& T) {
     const std::string K = T + ".viscoelastic";
     const MaterialEffect& fx = builtin_effect("viscoelastic");
     require_keys(s, K, effect_keys(fx), "viscoelastic");
-    e.viscoelastic = ViscoParams{effect_terms(s, K, fx, "gamma"), effect_terms(s, K, fx, "tau_s")};
+    const std::string moduli = effect_choice(s, K, fx.choices.at(0));
+    e.viscoelastic = ViscoParams{effect_terms(s, K, fx, "gamma"), effect_terms(s, K, fx, "tau_s"),
+                                 moduli == "instantaneous" ? ViscoModuli::instantaneous : ViscoModuli::long_term};
   }
   return e;
 }

@@ -19,6 +19,9 @@ gen() {  # name hidden extra-sets...
 gen none none
 gen stiffness stiffness
 gen viscoelastic viscoelastic
+# The same creep with the Yeoh constants as the instantaneous response (moduli = "instantaneous",
+# Abaqus's default): the angle creeps beyond the elastic model's (test_effect_catalog.cpp).
+gen viscoelastic_instantaneous viscoelastic_instantaneous
 gen pressure_lag pressure_lag
 gen gravity gravity
 gen mullins mullins --set materials.silicone.mullins.m_MPa=0.001

@@ -31,6 +31,10 @@
 //        *END INSTANCE with the optional data lines "dx, dy, dz" and "xa, ya, za, xb, yb, zb, angle"
 //        (translate, then turn by angle degrees about the axis a -> b, right-handed; Abaqus
 //        Keywords Reference, *INSTANCE). Decks as Abaqus/CAE writes them (see below).
+//   MODULI=INSTANTANEOUS | LONG TERM of *HYPERELASTIC or *VISCOELASTIC (Abaqus: whether the hyperelastic
+//        constants are the instantaneous or the long-term response of a viscoelastic material), with
+//        the *MATERIAL, NAME= above it, into InpDeck::moduli (build_model applies it to the scene's
+//        materials.<m>.viscoelastic.moduli); any other value is an error naming the line
 // Everything else (materials, sections, steps, outputs, amplitudes) is skipped with a warning:
 // the scene maps sets to materials. Ties, couplings, equations and contact (*TIE, *COUPLING,
 // *MPC, *EQUATION, *CONTACT PAIR, ...) are ignored with a warning that says to merge the
@@ -97,11 +101,19 @@ struct InpPressure {
   double magnitude = 0.0;  ///< in the deck's stress unit (not converted)
 };
 
+/// A MODULI= parameter of the deck (see above).
+struct InpModuli {
+  std::string material;  ///< NAME= of the *MATERIAL it follows, upper case; empty before any *MATERIAL
+  std::string value;     ///< the scene's word: "instantaneous" or "long_term"
+  std::string where;     ///< "<file>:<line>" of its keyword line
+};
+
 struct InpDeck {
   Mesh mesh;  ///< coordinates scaled to metres
   std::vector<InpPressure> pressure_faces;         ///< all *DLOAD Pn, *DSLOAD P faces in order of appearance
   std::vector<std::pair<int, int>> fixed_dofs;     ///< (node index, dof 0..2) from *BOUNDARY
   std::vector<std::string> warnings;               ///< skipped keywords etc.
+  std::vector<InpModuli> moduli;                   ///< every MODULI= of *HYPERELASTIC / *VISCOELASTIC, in order
   /// Instances (as the deck names them) that hold solid elements; empty for a deck without
   /// *INSTANCE. Instances share no node, so more than one is a mesh pneufem cannot simulate.
   std::vector<std::string> solid_instances;

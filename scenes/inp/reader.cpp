@@ -53,6 +53,7 @@ void DeckReader::begin_block(std::string_view text, const Loc& loc) {
   if (recording_) return record_in_part(kw, text, loc);
   if (pending_instance_ >= 0) instantiate();  // its placement lines are read: now its part
   block_ = Block::Skip;
+  material_keyword(kw, loc);  // and then skipped with a warning, as the rest of a material
   if (kw.name == "NODE")
     begin_nodes(kw, loc);
   else if (kw.name == "ELEMENT")
@@ -98,6 +99,32 @@ void DeckReader::begin_block(std::string_view text, const Loc& loc) {
               "*" + kw.name +
                   " skipped (only the mesh, sets, surfaces, *DLOAD Pn, *DSLOAD P and *BOUNDARY are read; "
                   "materials and steps come from the scene)");
+}
+
+// Abaqus: *HYPERELASTIC, MODULI=LONG TERM | INSTANTANEOUS (the default) says which response the
+// hyperelastic constants are when the material is also *VISCOELASTIC (Abaqus Analysis User's Manual,
+// "Time domain viscoelasticity"); the parameter is read on *VISCOELASTIC too. The value's case, and
+// an underscore for its space, are free.
+void DeckReader::material_keyword(const Keyword& kw, const Loc& loc) {
+  if (kw.name == "MATERIAL") {
+    material_ = upper(kw.get("NAME"));
+    return;
+  }
+  if ((kw.name != "HYPERELASTIC" && kw.name != "VISCOELASTIC") || !kw.has("MODULI")) return;
+  const std::string written = kw.get("MODULI");
+  std::string v = upper(written);
+  std::replace(v.begin(), v.end(), '_', ' ');
+  v.erase(std::unique(v.begin(), v.end(), [](char a, char b) { return a == ' ' && b == ' '; }), v.end());
+  std::string word;
+  if (v == "INSTANTANEOUS")
+    word = "instantaneous";
+  else if (v == "LONG TERM")
+    word = "long_term";
+  else
+    fail(loc, "*" + kw.name + ", MODULI=" + written + ": unknown value",
+         "use MODULI=INSTANTANEOUS (the hyperelastic constants are the instantaneous response, Abaqus's default) or "
+         "MODULI=LONG TERM (they are the long-term, fully relaxed response)");
+  deck_.moduli.push_back(InpModuli{material_, word, where(loc)});
 }
 
 void DeckReader::end_block() {

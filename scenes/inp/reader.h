@@ -122,6 +122,9 @@ class DeckReader {
   void end_instance(const Loc& loc);
   void end_of_structure();
 
+  // ---- *MATERIAL, MODULI= of *HYPERELASTIC / *VISCOELASTIC (reader.cpp) -----------------------
+  void material_keyword(const Keyword& kw, const Loc& loc);
+
   // ---- *NODE, *ELEMENT (reader.cpp) ---------------------------------------------------------------
   void begin_nodes(const Keyword& kw, const Loc& loc);
   void node_line(const Loc& loc);
@@ -268,6 +271,8 @@ class DeckReader {
   int pending_instance_ = -1;  // instance whose placement lines are being read (its part follows)
   int placement_lines_ = 0;
   std::string context_;        // "part 'P' (instance 'I'): " while a part is read for an instance
+
+  std::string material_;  // NAME= of the last *MATERIAL (upper case)
 
   std::unordered_map<long long, std::size_t> load_index_;
   std::unordered_set<long long> fixed_;

@@ -265,9 +265,20 @@ TEST(PathModel, HistoryEffectsFollowTheFem) {
   const std::vector<Case> cases = {
       {"stiffness", {"materials.silicone.stiffness_scale=0.8"}, 0.03, 0, 0},
       {"viscoelastic",
-       {"materials.silicone.viscoelastic.enabled=true", "materials.silicone.viscoelastic.gamma=[0.5]",
-        "materials.silicone.viscoelastic.tau_s=[2.0]"},
+       {"materials.silicone.viscoelastic.enabled=true", "materials.silicone.viscoelastic.moduli=long_term",
+        "materials.silicone.viscoelastic.gamma=[0.5]", "materials.silicone.viscoelastic.tau_s=[2.0]"},
        0.02, 0, 0},
+      // The same term with the Yeoh constants as the instantaneous response (Abaqus's default): the
+      // angle creeps beyond the elastic one, towards the long-term material 1/(1 + gamma) = 0.67 times
+      // as stiff, softer than the stiffness case. Measured (2026-11-27): effect 55.8 % of the peak
+      // angle, reduced-model error 3.01 % (long-term case 0.44 % of a 21.5 % effect, stiffness 0.93 % of
+      // 37.3 %): further along the elastic path the 1-dof model's shape error grows. Bound 4 %: the
+      // measured error with the headroom of the other uniform cases (the error of this case is ~5 % of
+      // its effect, that of the long-term one 2 %).
+      {"viscoelastic_instantaneous",
+       {"materials.silicone.viscoelastic.enabled=true", "materials.silicone.viscoelastic.moduli=instantaneous",
+        "materials.silicone.viscoelastic.gamma=[0.5]", "materials.silicone.viscoelastic.tau_s=[2.0]"},
+       0.04, 0, 0},
       {"mullins",
        {"materials.silicone.mullins.enabled=true", "materials.silicone.mullins.r=3.0",
         "materials.silicone.mullins.m_MPa=0.0005"},
@@ -313,6 +324,7 @@ TEST(PathModel, HistoryEffectsFollowTheFem) {
 // default actuator with 500 elements) and the 2 % of the uniform effects above.
 TEST(PathModel, SampledElementsFollowTheFemsCreep) {
   const std::vector<std::string> visco = {"materials.silicone.viscoelastic.enabled=true",
+                                          "materials.silicone.viscoelastic.moduli=long_term",  // as measured
                                           "materials.silicone.viscoelastic.gamma=[0.5]",
                                           "materials.silicone.viscoelastic.tau_s=[2.0]"};
   const Histories e = compare({});

@@ -110,7 +110,9 @@ std::vector<State> battery_states() {
 const MullinsParams kMullins{2.0, 20e3, 0.3};
 const FatigueParams kFatigue{2e3, 100.0, 2.0, 0.5};
 const FatigueParams kFatigueStretch{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2};
-const ViscoParams kVisco{{0.5, 0.3}, {0.1, 2.0}};
+const ViscoParams kVisco{{0.5, 0.3}, {0.1, 2.0}};  // long_term: the base is the relaxed response
+// The same terms with the base as the instantaneous response (Abaqus's MODULI=INSTANTANEOUS).
+const ViscoParams kViscoInstantaneous{{0.5, 0.3}, {0.1, 2.0}, ViscoModuli::instantaneous};
 const FatigueParams kFatigueInStack{2e3, 50.0, 2.0, 0.95};  // d_fail above the damage the cases reach
 // Saturating law (integrity exponent n = 3): the tangent goes through the scalar Newton's ds/da.
 const FatigueParams kFatigueSaturating{0.0, 100.0, 2.5, 0.5, FatigueDriver::max_principal_stretch, 1.2, 3.0};
@@ -142,14 +144,21 @@ double scaled_extra(const Mat3& F, double, const PointResponse& r) {  // P_iso =
   return max_abs(r.A_iso - s * r0.A_iso);
 }
 
-double visco_extra(const Mat3& F, double dt, const PointResponse& r) {  // P_iso = (1 + c) P0 + F H
-  const PointResponse r0 = eval(*ecoflex(), F, 0.0, {});
-  double c = 0.0;
-  for (std::size_t i = 0; i < kVisco.gamma.size(); ++i) {
-    const double x = dt / kVisco.tau_s[i];
-    c += kVisco.gamma[i] * (x > 0.0 ? -std::expm1(-x) / x : 1.0);
-  }
-  return max_abs(r.A_iso - (1.0 + c) * r0.A_iso);
+// P_iso = b P0 + F H with b = beta + sum a_i k_i, a_i = beta gamma_i, beta = 1 (long_term) or
+// 1 / (1 + sum gamma) (instantaneous): the part of A_iso beyond b A0_iso is delta (x) H.
+ExtraTerm visco_extra(const ViscoParams& p) {
+  return [p](const Mat3& F, double dt, const PointResponse& r) {
+    const PointResponse r0 = eval(*ecoflex(), F, 0.0, {});
+    double sum = 0.0;
+    for (double g : p.gamma) sum += g;
+    const double beta = p.moduli == ViscoModuli::instantaneous ? 1.0 / (1.0 + sum) : 1.0;
+    double b = beta;
+    for (std::size_t i = 0; i < p.gamma.size(); ++i) {
+      const double x = dt / p.tau_s[i];
+      b += beta * p.gamma[i] * (x > 0.0 ? -std::expm1(-x) / x : 1.0);
+    }
+    return max_abs(r.A_iso - b * r0.A_iso);
+  };
 }
 
 struct Case {
@@ -199,7 +208,19 @@ std::vector<Case> cases() {
          const Mat3 R = random_rotation(rng);
          for (int n = 1; n <= 5; ++n) mp.advance(R * uniaxial(1.0 + 0.1 * n), 0.05);
        },
-       0.05, false, visco_extra},
+       0.05, false, visco_extra(kVisco)},
+      {"viscoelastic_instantaneous", [] { return make_viscoelastic(ecoflex(), kViscoInstantaneous); },
+       [](MaterialPoint& mp) {
+         std::mt19937 rng(5);
+         const Mat3 R = random_rotation(rng);
+         for (int n = 1; n <= 5; ++n) mp.advance(R * uniaxial(1.0 + 0.1 * n), 0.05);
+       },
+       0.05, false, visco_extra(kViscoInstantaneous)},
+      {"viscoelastic_instantaneous_glassy", [] { return make_viscoelastic(ecoflex(), kViscoInstantaneous); },
+       [](MaterialPoint& mp) {  // dt = 0 from a loaded state: b = 1 exactly, the H term alone
+         for (int n = 1; n <= 3; ++n) mp.advance(uniaxial(1.0 + 0.15 * n), 0.3);
+       },
+       0.0, false, visco_extra(kViscoInstantaneous)},
       {"visco_fatigue_mullins_stack", stack,
        [](MaterialPoint& mp) {
          mp.advance(uniaxial(2.0), 0.0);                             // Mullins preload, no time
@@ -456,6 +477,10 @@ std::vector<BatchCase> batch_cases() {
       {"fatigue_stretch_saturating", make_fatigue(yeoh, kFatigueSaturating)},
       {"viscoelastic", make_viscoelastic(yeoh, kVisco)},
       {"viscoelastic_3_terms", make_viscoelastic(yeoh, visco3)},
+      {"viscoelastic_instantaneous", make_viscoelastic(yeoh, kViscoInstantaneous)},
+      {"viscoelastic_3_terms_instantaneous",
+       make_viscoelastic(yeoh, ViscoParams{visco3.gamma, visco3.tau_s, ViscoModuli::instantaneous})},
+      {"stack_energy_instantaneous", decorate(scaled, {kMullins, kFatigueInStack, kViscoInstantaneous})},
       {"fatigue_mullins", make_fatigue(make_mullins(yeoh, kMullins), kFatigueInStack)},
       {"viscoelastic_mullins", make_viscoelastic(make_mullins(yeoh, kMullins), kVisco)},
       {"stack_energy", stack()},

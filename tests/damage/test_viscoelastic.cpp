@@ -11,6 +11,7 @@
 #include "damage/effects.h"
 #include "damage/material_point.h"
 #include "materials/hyperelastic.h"
+#include "materials/scaled.h"
 
 namespace pneufem {
 namespace {
@@ -118,18 +119,97 @@ TEST(Viscoelastic, SmallStrainCreepConvergesAtSecondOrder) {
   EXPECT_LT(err.back(), 1e-4 * exact);
 }
 
+// Abaqus's g_i with its default MODULI=INSTANTANEOUS: the base (mu = 2 C10) is the instantaneous
+// modulus G_0 and G_inf = (1 - sum g) G_0. With MODULI=LONG TERM the base is G_inf and G_0 = G_inf / (1 - sum g).
+// (initial_shear_modulus is the instantaneous one, which stable-step estimates need.)
 TEST(Viscoelastic, AbaqusPronyConversionAndInstantaneousModulus) {
   const ViscoParams p = prony_from_abaqus({0.3, 0.2}, {1.0, 10.0});
   // gamma_i = g_i / (1 - sum g) = g_i / 0.5
   ASSERT_EQ(p.gamma.size(), 2u);
   EXPECT_DOUBLE_EQ(p.gamma[0], 0.6);
   EXPECT_DOUBLE_EQ(p.gamma[1], 0.4);
+  EXPECT_EQ(p.moduli, ViscoModuli::instantaneous);
   const MaterialPtr m = make_viscoelastic(ecoflex(), p);
-  // Abaqus: G_0 = G_inf / (1 - sum g) = 2 mu_inf; we report the instantaneous modulus.
-  EXPECT_DOUBLE_EQ(m->initial_shear_modulus(), 2.0 * mu_inf);
+  const auto& v = dynamic_cast<const Viscoelastic&>(*m);
+  EXPECT_DOUBLE_EQ(m->initial_shear_modulus(), mu_inf);       // G_0: the base
+  EXPECT_DOUBLE_EQ(v.long_term_shear_modulus(), 0.5 * mu_inf);  // (1 - sum g) G_0
   EXPECT_DOUBLE_EQ(m->initial_bulk_modulus(), K);
   EXPECT_EQ(m->name(), "viscoelastic(yeoh)");
   EXPECT_EQ(m->state_size(), 6 * 3);
+  const MaterialPtr lt = make_viscoelastic(ecoflex(), prony_from_abaqus({0.3, 0.2}, {1.0, 10.0}, ViscoModuli::long_term));
+  EXPECT_DOUBLE_EQ(lt->initial_shear_modulus(), 2.0 * mu_inf);  // G_0 = G_inf / (1 - sum g)
+  EXPECT_DOUBLE_EQ(dynamic_cast<const Viscoelastic&>(*lt).long_term_shear_modulus(), mu_inf);
+  EXPECT_STREQ(to_string(ViscoModuli::instantaneous), "instantaneous");
+  EXPECT_STREQ(to_string(ViscoModuli::long_term), "long_term");
+}
+
+// Step strain in both moduli conventions, uniaxial at finite strain (lambda = 1.5, J = 1.03). From
+// damage/viscoelastic.h, with S0 constant after the step the branches decay exactly,
+// Q_i = a_i S0 exp(-t/tau_i), so P_iso(t) = (beta + sum a_i exp(-t/tau_i)) P0_iso, i.e. with
+// g_i = gamma_i / (1 + sum gamma) (Abaqus's relative moduli; sum gamma = 0.75 here, so sum g = 3/7):
+//   instantaneous: P_iso(t) / P0_iso = 1 - sum g_i (1 - exp(-t/tau_i)):  1 at t = 0+, 1 - sum g = 4/7 at t -> inf;
+//   long_term:     P_iso(t) / P0_iso = 1 + sum gamma_i exp(-t/tau_i):    1 + sum gamma = 1/(1 - sum g) = 7/4 at
+//                  t = 0+, 1 at t -> inf.
+// At every time the long-term material is 1 + sum gamma times the instantaneous one (same Prony terms,
+// base constants read as G_inf instead of G_0). The volumetric part is the base's in both (k_i = 0).
+// Tolerance: only the rounding of a few operations on O(|P0|) numbers (1e-12 relative, ~5000 eps);
+// the instantaneous ratio at t = 0+ is 1 exactly by construction (b = 1 - sum a_i (1 - k_i), k_i = 1).
+TEST(Viscoelastic, StepStrainRelaxesFromAndToTheRightModulusInBothConventions) {
+  const std::vector<double> gam{0.5, 0.25}, tau{0.3, 3.0};
+  const double sum_gamma = 0.75, sum_g = sum_gamma / (1.0 + sum_gamma);
+  const Mat3 F = std::cbrt(1.03) * Mat3(Vec3(1.5, 1.0 / std::sqrt(1.5), 1.0 / std::sqrt(1.5)).asDiagonal());
+  const PointResponse r0 = base_response(F);
+  const double scale = r0.P_iso.norm();
+  MaterialPoint inst(make_viscoelastic(ecoflex(), {gam, tau, ViscoModuli::instantaneous}));
+  MaterialPoint lt(make_viscoelastic(ecoflex(), {gam, tau, ViscoModuli::long_term}));
+  double t = 0.0;
+  for (double dt : {0.0, 0.05, 0.25, 1.0, 4.0, 20.0, 100.0}) {
+    t += dt;
+    const PointResponse ri = inst.advance(F, dt), rl = lt.advance(F, dt);
+    double relax_inst = 1.0, relax_lt = 1.0;
+    for (std::size_t i = 0; i < gam.size(); ++i) {
+      const double gi = gam[i] / (1.0 + sum_gamma);
+      relax_inst -= gi * (1.0 - std::exp(-t / tau[i]));
+      relax_lt += gam[i] * std::exp(-t / tau[i]);
+    }
+    EXPECT_LE((ri.P_iso - relax_inst * r0.P_iso).norm(), 1e-12 * scale) << "t = " << t;
+    EXPECT_LE((rl.P_iso - relax_lt * r0.P_iso).norm(), 1e-12 * scale) << "t = " << t;
+    EXPECT_LE((rl.P_iso - (1.0 + sum_gamma) * ri.P_iso).norm(), 1e-12 * scale) << "t = " << t;
+    EXPECT_EQ(ri.P_vol, r0.P_vol);
+    EXPECT_EQ(rl.P_vol, r0.P_vol);
+    if (t == 0.0) {
+      EXPECT_EQ(ri.P_iso, r0.P_iso);  // the given constants are the instantaneous response, exactly
+    }
+  }
+  // t = 125 s = 42 tau_2: exp(-42) ~ 6e-19, fully relaxed.
+  const PointResponse ri = inst.advance(F, 0.0), rl = lt.advance(F, 0.0);
+  EXPECT_LE((ri.P_iso - (1.0 - sum_g) * r0.P_iso).norm(), 1e-12 * scale);
+  EXPECT_LE((rl.P_iso - r0.P_iso).norm(), 1e-12 * scale);
+  EXPECT_LE(inst.fields().viscous_strain, 1e-12);  // relaxed: exp(-42) ~ 6e-19 of a strain ~0.5
+}
+
+// The instantaneous convention is the long-term one on the base scaled by beta = 1 - sum g: the same
+// physical material, whatever the history. Ramp, hold, unload and reload with uneven steps; stress,
+// tangent and viscous strain agree to rounding (1e-12 of the stress and tangent scales: a few hundred
+// operations on O(1) factors), but not bit for bit (b is evaluated in another order).
+TEST(Viscoelastic, InstantaneousIsLongTermOnTheScaledBaseForAnyHistory) {
+  const std::vector<double> gam{0.8, 0.1, 0.3}, tau{0.2, 2.0, 15.0};
+  const double beta = 1.0 / (1.0 + 0.8 + 0.1 + 0.3);
+  MaterialPoint inst(make_viscoelastic(ecoflex(), {gam, tau, ViscoModuli::instantaneous}));
+  MaterialPoint lt(make_viscoelastic(scale_material(ecoflex(), beta), {gam, tau, ViscoModuli::long_term}));
+  EXPECT_NEAR(inst.material().initial_shear_modulus(), lt.material().initial_shear_modulus(), 1e-12 * mu_inf);
+  const double dts[] = {0.0, 0.1, 0.1, 0.4, 1.3, 0.05, 2.0, 7.0, 0.3, 0.3};
+  for (int n = 0; n < 10; ++n) {
+    const double lambda = 1.0 + 0.6 * std::sin(0.5 * n);  // 1 -> 1.6 -> 0.93 -> ...
+    const Mat3 F = Eigen::AngleAxisd(0.2 * n, Vec3(1.0, 2.0, 0.5).normalized()).toRotationMatrix() *
+                   Mat3(Vec3(lambda, 1.0 / std::sqrt(lambda), 1.0 / std::sqrt(lambda)).asDiagonal()) * simple_shear(0.1 * n);
+    const PointResponse ri = inst.advance(F, dts[n], true), rl = lt.advance(F, dts[n], true);
+    const double P_scale = std::max(ri.P_iso.norm(), 1e-3 * mu_inf), A_scale = ri.A_iso.norm();
+    EXPECT_LE((ri.P_iso - rl.P_iso).norm(), 1e-12 * P_scale) << "step " << n;
+    EXPECT_LE((ri.A_iso - rl.A_iso).norm(), 1e-12 * A_scale) << "step " << n;
+    EXPECT_NEAR(ri.psi_iso, rl.psi_iso, 1e-12 * std::abs(rl.psi_iso) + 1e-12 * mu_inf) << "step " << n;
+    EXPECT_NEAR(inst.fields().viscous_strain, lt.fields().viscous_strain, 1e-12 * (1.0 + lt.fields().viscous_strain));
+  }
 }
 
 TEST(Viscoelastic, RejectsBadParameters) {

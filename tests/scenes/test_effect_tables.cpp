@@ -120,6 +120,40 @@ TEST(EffectTables, ChoicesAndKeysComeFromTheRegistry) {
   EXPECT_NE(error_of([&] { make_material(typo, "silicone"); }).find("allowed: beta, enabled, m_MPa, r"), std::string::npos);
 }
 
+// materials.NAME.viscoelastic.moduli (issue 35): whether the hyperelastic constants are the
+// instantaneous response (the default, as Abaqus) or the long-term one; declared once, in the registry.
+TEST(EffectTables, ViscoelasticModuliDefaultToInstantaneousAsAbaqus) {
+  const MaterialEffect& fx = builtin_effect("viscoelastic");
+  ASSERT_EQ(fx.choices.size(), 1u);
+  EXPECT_EQ(fx.choices[0].name, "moduli");
+  EXPECT_EQ(fx.choices[0].values, (std::vector<std::string>{"instantaneous", "long_term"}));
+  EXPECT_EQ(Scene::load("").string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+  auto moduli_of = [](const std::vector<std::string>& sets) {
+    std::vector<std::string> all{"materials.silicone.viscoelastic.enabled=true"};
+    all.insert(all.end(), sets.begin(), sets.end());
+    const MaterialPtr m = make_material(Scene::load("", all), "silicone");
+    const auto* v = dynamic_cast<const Viscoelastic*>(m.get());
+    EXPECT_NE(v, nullptr);
+    return v ? v->moduli() : ViscoModuli::long_term;
+  };
+  EXPECT_EQ(moduli_of({}), ViscoModuli::instantaneous);
+  EXPECT_EQ(moduli_of({"materials.silicone.viscoelastic.moduli=long_term"}), ViscoModuli::long_term);
+  EXPECT_EQ(moduli_of({"materials.silicone.viscoelastic.moduli=\"instantaneous\""}), ViscoModuli::instantaneous);
+  // A user's own material table without the key takes the registry's default too.
+  const Scene rubber = Scene::load("", {"materials.rubber={model=\"neo_hookean\", C10_MPa=0.02, K_over_mu=100.0, density_kg_m3=1000.0}",
+                                        "materials.rubber.viscoelastic.enabled=true"});
+  EXPECT_EQ(dynamic_cast<const Viscoelastic&>(*make_material(rubber, "rubber")).moduli(), ViscoModuli::instantaneous);
+  try {
+    make_material(Scene::load("", {"materials.silicone.viscoelastic.enabled=true", "materials.silicone.viscoelastic.moduli=relaxed"}),
+                  "silicone");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'materials.silicone.viscoelastic.moduli': must be \"instantaneous\" or \"long_term\""),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(EffectTables, RegistryParameterLookupNamesTheValidOnes) {
   try {
     builtin_effect("mullins").param("q");

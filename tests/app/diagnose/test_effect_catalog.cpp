@@ -1,13 +1,18 @@
 // The candidate-effect catalog (app/diagnose/effect_catalog.h): bounds are sane, every candidate's overrides
-// build on the default scene and land on the right keys, registered material effects appear.
+// build on the default scene and land on the right keys, registered material effects appear, and the
+// creep candidate in both moduli conventions names the one a recording shows (one diagnosis, ~1 min).
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <functional>
 
 #include <gtest/gtest.h>
 
+#include "app/diagnose/command.h"
 #include "app/diagnose/effect_catalog.h"
 #include "core/errors.h"
 #include "damage/registry.h"
+#include "damage/viscoelastic.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -39,7 +44,8 @@ void register_test_effect_once() {
 
 TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   const auto& all = candidate_effects();
-  const std::vector<std::string> names = {"stiffness", "viscoelastic", "mullins", "fatigue", "pressure_lag", "gravity"};
+  const std::vector<std::string> names = {"stiffness", "viscoelastic", "viscoelastic_instantaneous", "mullins",
+                                          "fatigue",   "pressure_lag", "gravity"};
   ASSERT_GE(all.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   for (const CandidateEffect& c : all) {
@@ -59,7 +65,9 @@ TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   EXPECT_FALSE(candidate_effect("stiffness").history);
   const std::string e = error_of([] { candidate_effect("creep"); });
   EXPECT_NE(e.find("unknown candidate effect 'creep'"), std::string::npos) << e;
-  EXPECT_NE(e.find("stiffness, viscoelastic, mullins, fatigue, pressure_lag, gravity"), std::string::npos) << e;
+  EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, mullins, fatigue, pressure_lag, gravity"),
+            std::string::npos)
+      << e;
 }
 
 TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRightKeys) {
@@ -84,7 +92,13 @@ TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRight
   EXPECT_TRUE(s.boolean("materials.silicone.viscoelastic.enabled"));
   EXPECT_EQ(s.numbers("materials.silicone.viscoelastic.gamma"), std::vector<double>{0.5});
   EXPECT_EQ(s.numbers("materials.silicone.viscoelastic.tau_s"), std::vector<double>{4.0});
+  EXPECT_EQ(s.string("materials.silicone.viscoelastic.moduli"), "long_term");  // the convention it always had
   EXPECT_FALSE(s.has("materials.fabric.viscoelastic"));
+  s = with("viscoelastic_instantaneous", {0.5, 4.0});
+  EXPECT_TRUE(s.boolean("materials.silicone.viscoelastic.enabled"));
+  EXPECT_EQ(s.numbers("materials.silicone.viscoelastic.gamma"), std::vector<double>{0.5});
+  EXPECT_EQ(s.numbers("materials.silicone.viscoelastic.tau_s"), std::vector<double>{4.0});
+  EXPECT_EQ(s.string("materials.silicone.viscoelastic.moduli"), "instantaneous");
   s = with("mullins", {3.0, 0.01});
   EXPECT_TRUE(s.boolean("materials.silicone.mullins.enabled"));
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.mullins.r"), 3.0);
@@ -134,7 +148,7 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
   register_test_effect_once();
   int checked = 0;
   for (const CandidateEffect& c : candidate_effects()) {
-    const MaterialEffect* fx = find_material_effect(c.name);
+    const MaterialEffect* fx = find_material_effect(c.name == "viscoelastic_instantaneous" ? "viscoelastic" : c.name);
     if (!fx) continue;
     EXPECT_EQ(c.history, fx->history) << c.name;
     for (const CandidateParameter& p : c.params) {
@@ -146,13 +160,107 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
       ++checked;
     }
   }
-  EXPECT_GE(checked, 2 + 2 + 2 + 1);  // viscoelastic, mullins, fatigue, the test effect
+  EXPECT_GE(checked, 2 + 2 + 2 + 2 + 1);  // viscoelastic in both conventions, mullins, fatigue, the test effect
   // Calibration start and synth truth are the catalog's own, and not defaults: Mullins starts at
   // r = 5 (near the middle of log [1.1, 20]) and hides r = 3, while a scene's default is 8.
   const CandidateEffect& m = candidate_effect("mullins");
   EXPECT_EQ(m.params[0].initial, 5.0);
   EXPECT_EQ(m.params[0].truth, 3.0);
   EXPECT_EQ(builtin_effect("mullins").param("r").default_value, 8.0);
+}
+
+// The creep candidate in both moduli conventions (issue 35): the same Prony constants and ranges,
+// each fixing `moduli`, so the diagnosis names the convention that fits. They describe the same
+// creep from opposite ends (elastic constants = long-term vs instantaneous response), so one is
+// not added on top of the other: a candidate refuses to switch the convention of a table already
+// enabled (an effect selected before, or the scene's own), naming what to do instead.
+TEST(EffectCatalog, CreepIsTriedInBothModuliConventions) {
+  const CandidateEffect& lt = candidate_effect("viscoelastic");
+  const CandidateEffect& inst = candidate_effect("viscoelastic_instantaneous");
+  EXPECT_TRUE(lt.history);
+  EXPECT_TRUE(inst.history);
+  ASSERT_EQ(inst.params.size(), lt.params.size());
+  for (std::size_t i = 0; i < lt.params.size(); ++i) {
+    EXPECT_EQ(inst.params[i].name, lt.params[i].name);
+    EXPECT_EQ(inst.params[i].lo, lt.params[i].lo);
+    EXPECT_EQ(inst.params[i].hi, lt.params[i].hi);
+    EXPECT_EQ(inst.params[i].truth, lt.params[i].truth);
+  }
+  EXPECT_NE(lt.description.find("long-term"), std::string::npos) << lt.description;
+  EXPECT_NE(inst.description.find("instantaneous"), std::string::npos) << inst.description;
+  EXPECT_NE(inst.signature.find("creeps above it"), std::string::npos) << inst.signature;
+
+  const Scene base = Scene::load("", kTiny);
+  // Built, the two are the same Prony term on the two readings of the constants.
+  auto moduli_of = [&](const CandidateEffect& c) {
+    const auto bm = build_model(base.with(c.sets(base, {0.5, 4.0})));
+    for (const Part& p : bm->model.parts)
+      if (const auto* v = dynamic_cast<const Viscoelastic*>(p.material.get())) return v->moduli();
+    ADD_FAILURE() << c.name << ": no viscoelastic part";
+    return ViscoModuli::long_term;
+  };
+  EXPECT_EQ(moduli_of(lt), ViscoModuli::long_term);
+  EXPECT_EQ(moduli_of(inst), ViscoModuli::instantaneous);
+
+  // On top of the other convention: refused, naming the table and the way out.
+  const Scene with_lt = base.with(lt.sets(base, {0.5, 4.0}));
+  const std::string e = error_of([&] { inst.sets(with_lt, {0.3, 2.0}); });
+  EXPECT_NE(e.find("candidate 'viscoelastic_instantaneous': materials.silicone.viscoelastic is already enabled with "
+                   "moduli = \"long_term\"; this candidate would switch it to \"instantaneous\""),
+            std::string::npos)
+      << e;
+  EXPECT_NE(error_of([&] { lt.sets(base.with(inst.sets(base, {0.5, 4.0})), {0.3, 2.0}); }).find("already enabled"),
+            std::string::npos);
+  // The same convention again (a re-fit of a scene's own creep) replaces its constants, as before.
+  const Scene refit = with_lt.with(lt.sets(with_lt, {0.3, 2.0}));
+  EXPECT_EQ(refit.numbers("materials.silicone.viscoelastic.gamma"), std::vector<double>{0.3});
+  // A scene whose creep is switched off is free for either.
+  const Scene off = with_lt.with({"materials.silicone.viscoelastic.enabled=false"});
+  EXPECT_EQ(off.with(inst.sets(off, {0.3, 2.0})).string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+}
+
+// End to end: a recording whose creep goes beyond the elastic model (tests/data/hidden/
+// viscoelastic_instantaneous.csv: synth with gamma 0.5, tau 4 s in the instantaneous convention on
+// the hidden-effect datasets' actuator, scripts/make_hidden_datasets.sh) is diagnosed as
+// viscoelastic_instantaneous; the long-term candidate, whose creep can only approach the elastic
+// model from the stiff side, explains nothing (its constants go to their lower bounds). Its
+// long-term twin, tests/data/hidden/viscoelastic.csv, is HiddenEffect.Viscoelastic
+// (test_command.cpp), with every candidate. Measured (2026-11-27): NRMSE 0.2040 -> 0.0264 at a noise
+// floor of 0.0053, gamma 0.495, tau 4.64 s; stiffness 0.0996 (scale 0.82), long-term creep 0.2040
+// (at its lower bounds). The remainder is the reduced model's own error for creep under the
+// overshooting inlet, as for the twin (0.023 there; ~1 % of the angle range), which is 5x this
+// recording's floor: its creep enlarges the angle range the floor is relative to. Hence the bound on
+// the error is relative to the baseline: below 0.2x (measured 0.13x; issue 35 asks <= 0.4x). gamma and
+// tau trade off over 4 s holds: within 50 % and 30 % of the truth, as for the twin.
+TEST(CreepConventions, ARecordingThatCreepsBeyondTheElasticModelIsInstantaneousCreep) {
+  const std::vector<std::string> scene = {"geometry.chambers=5", "mesh.h_mm=6.0", "load.max_kPa=30.0",
+                                          "load.step_kPa=10.0",  "load.hold_s=4.0", "load.trials=3"};
+  DiagnoseOptions o;
+  o.data_path = std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/viscoelastic_instantaneous.csv";
+  o.out_dir = (std::filesystem::temp_directory_path() / "pneufem_diag_creep_conventions").string();
+  std::filesystem::remove_all(o.out_dir);
+  o.max_effects = 1;
+  o.candidates = {"stiffness", "viscoelastic", "viscoelastic_instantaneous"};
+  o.cache_dir = (std::filesystem::temp_directory_path() / "pneufem_diagnose_cache").string();  // as test_command's
+  const DiagnosisResult r = run_diagnosis(Scene::load("", scene), o);
+  for (const CandidateResult& c : r.candidates) {
+    std::printf("%s NRMSE %.4f%s", c.effect.c_str(), c.nrmse, c.significant ? " (sig)" : "");
+    for (std::size_t i = 0; i < c.params.size(); ++i) std::printf(" %s=%.4g", c.param_names[i].c_str(), c.params[i]);
+    std::printf("; ");
+  }
+  std::printf("\nbaseline %.4f, floor %.4f, final %.4f\n", r.baseline_nrmse, r.noise_floor_nrmse, r.final_nrmse);
+  EXPECT_EQ(r.missing_effect, "viscoelastic_instantaneous");
+  EXPECT_LT(r.final_nrmse, 0.2 * r.baseline_nrmse);
+  const CandidateEffect& truth = candidate_effect("viscoelastic_instantaneous");
+  for (const CandidateResult& c : r.candidates) {
+    if (c.effect == "viscoelastic") {
+      EXPECT_FALSE(c.significant) << c.why;
+    }
+    if (c.effect != "viscoelastic_instantaneous") continue;
+    ASSERT_EQ(c.params.size(), 2u);
+    EXPECT_NEAR(c.params[0], truth.params[0].truth, 0.5 * truth.params[0].truth);
+    EXPECT_NEAR(c.params[1], truth.params[1].truth, 0.3 * truth.params[1].truth);
+  }
 }
 
 }  // namespace
