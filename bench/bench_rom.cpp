@@ -94,8 +94,9 @@ std::vector<double> nrmse_per_trial(const LoadHistory& load, const Record& a, co
 
 int main(int argc, char** argv) {
   std::string scene_path, work = "rom_work";
-  std::vector<std::string> sets, model_sets;
+  std::vector<std::string> sets, model_sets, snap_sets;
   bool fem = false;
+  int snap_trials = 0;
   int threads = 0;
   RomBasisOptions ro;
   ro.verbose = true;
@@ -105,6 +106,8 @@ int main(int argc, char** argv) {
     if (a == "--set") sets.push_back(next());
     else if (a == "--model-set") model_sets.push_back(next());  // the run's model only, not the reference
     else if (a == "--work") work = next();
+    else if (a == "--snap-trials") snap_trials = std::stoi(next());  // FEM snapshots of the first N trials enrich the basis
+    else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
@@ -160,8 +163,18 @@ int main(int argc, char** argv) {
                   since(t0));
     }
   }
+  std::vector<Eigen::VectorXd> snapshots;
+  if (snap_trials > 0) {
+    const Scene snap_scene = scene.with(snap_sets).with({"load.trials=" + std::to_string(snap_trials)});
+    auto sm = build_model(snap_scene);
+    const auto t0 = Clock::now();
+    Assembler A(sm->model);
+    QuasiStaticRun q(A, sm->solver.quasi_static);
+    q.run(sm->load, [&](const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>&) { snapshots.push_back(u); });
+    std::printf("snapshots: %zu FEM reports of %d trial(s) in %.1f s\n", snapshots.size(), snap_trials, since(t0));
+  }
   const auto tb = Clock::now();
-  const ReducedBasis basis = build_reduced_basis(ref->model, trace, ro);
+  const ReducedBasis basis = build_reduced_basis(ref->model, trace, ro, snapshots);
   std::printf("basis: %d modes, %zu sampled elements of %d soft (%d clusters), POD energy left %.2e, ECSW worst %.2e, %.1f s; path to %.2f deg\n",
               basis.num_modes(), basis.elements.size(), basis.info.soft_elements, basis.info.clusters, basis.info.pod_energy_left,
               basis.info.ecsw_worst_residual, since(tb), basis.theta.back());

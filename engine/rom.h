@@ -18,7 +18,11 @@
 // Every history effect of damage/ acts on the isochoric stress, locally (Mullins, fatigue, Prony
 // terms, region scales), so a local softening is the generic first-order deformation change; no
 // effect's constants enter the basis (the same basis serves any constants and any registered effect).
-// More modes can be added from snapshots (an FEM state, an indicator's correction).
+// More modes can be added from snapshots (an FEM state, an indicator's correction): they come first,
+// by size. One FEM trial of a 3-chamber actuator with fatigue (at other constants) cut the error of
+// three trials' drift 7x (tests/engine/test_rom.cpp); on the 15-chamber story near its limit point
+// they fixed trial 1 but not the later trials, and worsened Mullins' reloading
+// (bench/results/rom_h2_story/snapshots.md), so the product does not use them yet.
 //
 // Equations: a Petrov-Galerkin projection of the equilibrium R(u) = f_int(u) - p dV/du - f_g = 0. The
 // q rows are Galerkin (tested with Phi). The theta row is tested with the bending angle's influence
@@ -84,7 +88,7 @@ namespace pneufem {
 struct RomBasisOptions {
   int clusters = 48;              ///< spatial clusters of the soft elements (softening patterns, ECSW blocks)
   int mode_samples = 6;           ///< path samples at which the softening responses are computed
-  int max_modes = 16;             ///< correction modes kept
+  int max_modes = 16;             ///< softening modes kept (snapshots, when given, add up to as many more)
   double pod_tolerance = 1e-4;    ///< relative energy of the responses the kept modes may leave out
   double ecsw_tolerance = 1e-2;   ///< relative residual of each cluster's hyper-reduced training force
   int training_fields = 3;        ///< random cluster-wise softening fields per mode sample (ECSW training)
@@ -146,7 +150,9 @@ double mesh_fingerprint(const Mesh& mesh);
 /// path (engine/path_model.h). Throws InputError for a reference with history or a trace that does
 /// not fit it, PhysicsError when no sample's tangent could be factorised.
 /// `snapshots` (optional): displacements of states the basis should contain (e.g. FEM states of a run
-/// with history effects); their departures from the path at equal angle join the softening responses.
+/// with history effects). Their departures from the path at equal angle come first: their POD by
+/// size (up to max_modes modes, to pod_tolerance of their energy), then the softening responses'
+/// POD in what those modes leave out; the snapshots also join the ECSW training states.
 ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& options,
                                  const std::vector<Eigen::VectorXd>& snapshots = {});
 

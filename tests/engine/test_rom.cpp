@@ -128,6 +128,7 @@ Scene small_scene(std::vector<std::string> extra) {
 /// The elastic reference, its path and basis: built once for the whole file (~10 s).
 struct Offline {
   std::unique_ptr<BuiltModel> ref;
+  ElasticPathTrace trace;
   ReducedBasis basis;
 };
 const Offline& offline() {
@@ -138,7 +139,8 @@ const Offline& offline() {
     po.p_top_Pa = 1.8 * 45e3;
     po.dp_Pa = 45e3 / 40.0;
     po.newton = out->ref->solver.quasi_static.newton;
-    out->basis = build_reduced_basis(out->ref->model, trace_elastic_path(out->ref->model, po), RomBasisOptions{});
+    out->trace = trace_elastic_path(out->ref->model, po);
+    out->basis = build_reduced_basis(out->ref->model, out->trace, RomBasisOptions{});
     return out;
   }();
   return *o;
@@ -257,6 +259,51 @@ TEST(ReducedModel, FollowsTheFemForEachEffectAlone) {
   expect_follows_fem({"load.trials=1", "materials.silicone.mullins.enabled=false", "materials.silicone.fatigue.enabled=false"}, 0.5, 0.5, 0.0);
   expect_follows_fem({"load.trials=2", "materials.silicone.viscoelastic.enabled=false", "materials.silicone.fatigue.enabled=false"}, 0.5, 0.5, 0.25);
   expect_follows_fem({"load.trials=2", "materials.silicone.viscoelastic.enabled=false", "materials.silicone.mullins.enabled=false"}, 0.5, 0.5, 0.25);
+}
+
+// ---- Enrichment from FEM snapshots of a damaged trial.
+
+/// The largest |ROM - FEM| over the reports of `fem` and `rom` (same reports).
+double largest_difference(const Record& fem, const Record& rom) {
+  EXPECT_EQ(fem.angle.size(), rom.angle.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < std::min(fem.angle.size(), rom.angle.size()); ++i)
+    worst = std::max(worst, std::abs(fem.angle[i] - rom.angle[i]));
+  return worst;
+}
+
+// Fatigue alone over three trials with the paper's 16 s holds (the drift is then ~0.7 deg at
+// 45 kPa). In the FEM a damaged point stretches more, which damages it faster; the softening
+// responses of the basis hold that local feedback only to first order, so the reduced model's
+// drift falls behind (measured 0.108 deg at trial 3's top, 8 % of the drift). A basis that also
+// takes the reports of ONE FEM trial, run with other fatigue constants (lambda_th 1.7 instead of
+// 1.6: the snapshots do not contain the answer), follows it within 0.015 deg (measured). Bounds:
+// 0.04 deg (the measured error with a margin for other compilers and thread counts; still 2.7x
+// below the plain basis's error) and at most half the plain basis's error.
+TEST(ReducedModel, SnapshotsOfOneDamagedTrialCarryTheFatigueFeedback) {
+  const std::vector<std::string> fatigue = {"load.hold_s=16.0", "load.mark_s=2.5", "load.trials=3",
+                                            "materials.silicone.mullins.enabled=false",
+                                            "materials.silicone.viscoelastic.enabled=false"};
+  const auto bm = build_model(small_scene(fatigue));
+  std::vector<std::string> other = fatigue;
+  other.push_back("materials.silicone.fatigue.lambda_th=1.7");
+  other.push_back("load.trials=1");
+  const auto snap_bm = build_model(small_scene(other));
+  std::vector<Eigen::VectorXd> snapshots;
+  {
+    Assembler A(snap_bm->model);
+    QuasiStaticRun run(A, snap_bm->solver.quasi_static);
+    run.run(snap_bm->load, [&](const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>&) { snapshots.push_back(u); });
+  }
+  ASSERT_GE(snapshots.size(), 10u);
+  const ReducedBasis enriched = build_reduced_basis(offline().ref->model, offline().trace, RomBasisOptions{}, snapshots);
+  EXPECT_GT(enriched.num_modes(), offline().basis.num_modes()) << "the snapshots add modes of their own";
+  const Record fem = fem_run(*bm);
+  const double plain = largest_difference(fem, rom_run(*bm, offline().basis));
+  const double with_snapshots = largest_difference(fem, rom_run(*bm, enriched));
+  EXPECT_GT(fem.angle.back() - fem.angle[fem.angle.size() / 3 - 1], 0.3) << "fatigue drifts the top angle (not a vacuous test)";
+  EXPECT_LE(with_snapshots, 0.04);
+  EXPECT_LE(with_snapshots, 0.5 * plain) << "plain basis " << plain << " deg";
 }
 
 // ---- An effect the reduced model has never heard of: registered only through damage/registry.h.
