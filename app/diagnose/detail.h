@@ -101,6 +101,7 @@ TradeOff trade_off(const CandidateEffect& c, const std::function<double(const st
 struct Signature {
   std::vector<double> trial_rmse;     ///< per trial
   double growth = 1.0;                ///< rmse of the last trial / first
+  double noise_deg = 0.0;             ///< angle tracking noise per frame (mean over the trials)
   double creep_top_deg = 0.0;         ///< mean (measured - model) spread at the top third of the levels
   double creep_low_deg = 0.0;         ///< ... at the other levels
   double creep_first_deg = 0.0, creep_last_deg = 0.0;  ///< mean spread difference, first / last trial
@@ -112,7 +113,10 @@ struct Signature {
 
 Signature signature_of(const Comparison& c);
 
-/// The sentence about the residual feature that `effect` explains.
+/// The sentence about the residual feature that `effect` explains. Every word of direction in it
+/// (grows / falls / stays flat, more / less / as modelled, ...) is read off the numbers it quotes:
+/// a difference within the angle tracking noise (s.noise_deg, and at least half the last digit
+/// printed, so "+0.00" is never a trend) is called flat, and a correlation below 0.5 in size weak.
 std::string evidence(const std::string& effect, const Signature& s);
 
 // ---- full FEM (fem.cpp)
