@@ -65,7 +65,8 @@ struct Calibration {
 /// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
 /// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
 /// (several) from the best grid point, until the trust region is 1e-4 of the calibration scale,
-/// a step gains less than 1e-4 in log RSS, or `budget` runs are spent. Two constants that trade
+/// a step gains less than 1e-4 in log RSS (for BOBYQA confirmed by a restart from the best point,
+/// which gains no more either), or `budget` runs are spent. Two constants that trade
 /// off leave a narrow valley that BOBYQA walks down in small steps: the default budget (60,
 /// DiagnoseOptions) is sized for that walk (Calibrate.WalksDownALogSpaceValleyWithinTheDefaultBudget).
 /// The optimiser sees log(rss), which has the same minimiser: near a limit point the RSS of
