@@ -70,7 +70,8 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   c->cmd->add_option("--cache", c->options.cache_dir,
                      "Keep the elastic FEM work that depends only on the actuator (the reduced model's elastic path, "
                      "the scene mesh's sweep, static curves with gravity) in this directory and reuse it in later runs "
-                     "on the same actuator and peak pressure: identical results (the default scene: 527 s, re-run 50 s)");
+                     "on the same actuator and protocol (keyed by the protocol's peak pressure, not a recording's noisy "
+                     "one): identical results (the default scene: 527 s, re-run 50 s)");
   c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
   c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));

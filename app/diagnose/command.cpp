@@ -226,15 +226,15 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   const PathModelEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
                          opt.cache_dir);
   if (opt.progress) {
-    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s; path %s%s%s)\n",
-                 rom.path().path_pressure_Pa().back() * 1e-3, rom.path().num_points(),
+    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa (for a peak of %.1f kPa), %d material points (%.1f s; path %s%s%s)\n",
+                 rom.path().path_pressure_Pa().back() * 1e-3, rom.reference_peak_Pa() * 1e-3, rom.path().num_points(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), rom.path_source().c_str(),
                  rom.fine_source().empty() ? "" : ", scene mesh's sweep ", rom.fine_source().c_str());
     if (!rom.fine_curve().empty())
       std::fprintf(stderr,
                    "diagnose: calibration mesh %ld dof, scene mesh %ld dof: angle at %.1f kPa %.3f vs %.3f deg "
                    "(the calibration mesh is driven at %.2f kPa there)\n",
-                   rom.dofs(), rom.fine_dofs(), rom.inlet_max_Pa() * 1e-3, rom.coarse_curve().back(), rom.fine_curve().back(),
+                   rom.dofs(), rom.fine_dofs(), rom.reference_peak_Pa() * 1e-3, rom.coarse_curve().back(), rom.fine_curve().back(),
                    rom.pressure_map_Pa().back() * 1e-3);
   }
   long rom_runs = 0;

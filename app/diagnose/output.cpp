@@ -86,7 +86,9 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
                                   " material points, elastic path to " +
                                   fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add("reference_peak_kPa", rom.reference_peak_Pa() * 1e-3);
   method.add_str("elastic_path_source", rom.path_source());
+  method.add("static_curves_from_cache", rom.curves_from_cache()).add("static_curves_computed", rom.curves_computed());
   if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
   if (opt.calibration_h_mm > 0.0) {
     // The calibration mesh and its correction, so a reader can judge its size against the effects'.
@@ -94,7 +96,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
     const std::vector<double>& f = rom.fine_curve();
     const std::vector<double>& c = rom.coarse_curve();
     std::vector<double> p;
-    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.inlet_max_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
+    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.reference_peak_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
     cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
     std::vector<double> m;
     for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
