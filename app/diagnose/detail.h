@@ -8,7 +8,8 @@
 //   evidence.cpp            the residual's signature and the plain-words reason per candidate;
 //   fem.cpp                 the full-FEM stages: space-mapping refinement (--refine), FEM
 //                           calibration (--fem-calibrate) and verification (--verify);
-//   output.cpp              diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv, history.
+//   output.cpp              diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv, history;
+//   report.cpp              report.md, the diagnosis for a person.
 // Beside them: effect_catalog (the candidates; `pneufem synth` hides the same ones),
 // elastic_curve (static angle curves and the interpolation nodes of the catalog's constants) and
 // cli (the command line).
@@ -142,9 +143,17 @@ void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& r
 
 // ---- outputs (output.cpp)
 
-/// Writes diagnosis.json, fitted.toml, diagnosis.csv and calibration.csv to opt.out_dir and
-/// appends the baseline and the fitted model to its history.jsonl.
-void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEvaluator& rom, const ChosenEffects& chosen,
-                     const DiagnoseOptions& opt, const DiagnosisResult& out);
+/// Writes diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv and report.md to opt.out_dir
+/// (each atomically) and appends the baseline and the model after each round to its history.jsonl.
+void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
+                     const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out);
+
+// ---- report (report.cpp)
+
+/// report.md: the recording and the scene, the error per trial of the baseline beside the final
+/// model's (and after each round), every round's candidates with their tests, the chosen effect
+/// and its constants, and the reasons in words (the candidates' `why`). Only formats `out`.
+std::string diagnosis_report(const Scene& scene, const Recording& rec, const PathModelEvaluator& rom,
+                             const DiagnoseOptions& opt, const DiagnosisResult& out);
 
 }  // namespace pneufem::diagnose_detail
