@@ -42,7 +42,9 @@ namespace {
 std::string history_line(const HistoryEntry& e) {
   return "{\"time_utc\": " + json::quote(e.time_utc) + ", \"label\": " + json::quote(e.label) +
          ", \"scene_hash\": " + json::quote(e.scene_hash) + ", \"nrmse\": " + json::num(e.nrmse) +
-         ", \"trial_nrmse\": " + json::array(e.trial_nrmse) + ", \"source\": " + json::quote(e.source) + "}";
+         ", \"trial_nrmse\": " + json::array(e.trial_nrmse) +
+         (e.trial_rmse_deg.empty() ? std::string() : ", \"trial_rmse_deg\": " + json::array(e.trial_rmse_deg)) +
+         ", \"source\": " + json::quote(e.source) + "}";
 }
 
 /// A number of a history line: JSON has no NaN, so json::num wrote a non-finite value as null.
@@ -98,6 +100,12 @@ std::vector<HistoryEntry> read_history(const std::string& dir) {
         double x = 0.0;
         if (!read_number(v, x)) break;
         e.trial_nrmse.push_back(x);
+      }
+    if (const auto trials = j.find("trial_rmse_deg"); trials != j.end() && trials->is_array())
+      for (const nlohmann::json& v : *trials) {
+        double x = 0.0;
+        if (!read_number(v, x)) break;
+        e.trial_rmse_deg.push_back(x);
       }
     out.push_back(e);
   }

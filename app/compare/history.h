@@ -1,6 +1,6 @@
 #pragma once
 // The study history of a compare/diagnose output directory: history.jsonl, one JSON line per run
-// ({"time_utc", "label", "scene_hash", "nrmse", "trial_nrmse", "source"}), which the report plots
+// ({"time_utc", "label", "scene_hash", "nrmse", "trial_nrmse", ["trial_rmse_deg",] "source"}), which the report plots
 // as the error of each model variant in order. `pneufem compare` and `pneufem diagnose` append to it.
 #include <string>
 #include <vector>
@@ -16,6 +16,7 @@ struct HistoryEntry {
   std::string scene_hash; ///< scene_hash() of the resolved scene
   double nrmse = 0.0;     ///< pooled
   std::vector<double> trial_nrmse;
+  std::vector<double> trial_rmse_deg;  ///< per trial, deg; written only when given (diagnose gives it)
   std::string source = "compare";  ///< which command wrote it ("compare", "diagnose", ...)
 };
 

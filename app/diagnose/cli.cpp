@@ -14,13 +14,13 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       "diagnose",
       "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, mullins, "
       "fatigue, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
-      "them by the error they remove with an information criterion, and writes diagnosis.json and fitted.toml");
+      "them by the error they remove with an information criterion, and writes diagnosis.json, fitted.toml and report.md");
   c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
       ->check(CLI::ExistingFile);
   c->cmd->add_option("--data", c->options.data_path, "Measurements: canonical CSV trial,time_s,pressure_kPa,angle_deg (without pressure_kPa the scene's [load] drives the model)")
       ->required()
       ->check(CLI::ExistingFile);
-  c->cmd->add_option("--out", c->options.out_dir, "Output directory (diagnosis.json, fitted.toml, diagnosis.csv, history.jsonl)")
+  c->cmd->add_option("--out", c->options.out_dir, "Output directory (diagnosis.json, fitted.toml, report.md, diagnosis.csv, calibration.csv, history.jsonl)")
       ->required();
   c->cmd->add_option("--set", c->sets, "Override a scene key, e.g. --set mesh.h_mm=4 (repeatable)");
   c->cmd->add_option("--candidates", c->candidates, "Comma-separated candidate effects to try (default: all)");
@@ -70,7 +70,8 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   c->cmd->add_option("--cache", c->options.cache_dir,
                      "Keep the elastic FEM work that depends only on the actuator (the reduced model's elastic path, "
                      "the scene mesh's sweep, static curves with gravity) in this directory and reuse it in later runs "
-                     "on the same actuator and peak pressure: identical results (the default scene: 527 s, re-run 50 s)");
+                     "on the same actuator and protocol (keyed by the protocol's peak pressure, not a recording's noisy "
+                     "one): identical results (the default scene: 527 s, re-run 50 s)");
   c->cmd->add_flag("--progress", c->progress, "Report each calibration on stderr (default: only when stderr is a terminal)");
   c->cmd->add_option("--threads", c->options.threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(1, 1024));
@@ -108,7 +109,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   if (!r.missing_history_effect.empty() && r.missing_history_effect != r.missing_effect)
     std::printf("missing history effect: %s (after %s, which takes the larger, static part of the misfit)\n",
                 r.missing_history_effect.c_str(), r.missing_effect.c_str());
-  std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json and fitted.toml\n",
+  std::printf("missing effect: %s; selected: %zu; final NRMSE %.4f; %.1f s. Wrote %s/diagnosis.json, fitted.toml and report.md\n",
               r.missing_effect.empty() ? "none" : r.missing_effect.c_str(), r.selected.size(), r.final_nrmse, r.wall_s,
               c.options.out_dir.c_str());
   if (c.options.cache_dir.empty() && r.elastic_wall_s > 20.0)

@@ -125,6 +125,19 @@ std::string refit_text(const ChosenEffects& chosen, const std::vector<double>& v
   return out;
 }
 
+/// The model of `effects` (scene overrides `sets`) as compared in `c`, for history.jsonl and report.md.
+ModelAfterRound model_after_round(const std::vector<std::string>& effects, const std::vector<std::string>& sets, const Comparison& c) {
+  ModelAfterRound m;
+  m.effects = effects;
+  m.sets = sets;
+  m.nrmse = c.nrmse;
+  for (const TrialComparison& t : c.trials) {
+    m.nrmse_per_trial.push_back(t.nrmse);
+    m.rmse_deg_per_trial.push_back(t.rmse_deg);
+  }
+  return m;
+}
+
 /// How much of the final error is static (fit_static_discrepancy), in numbers and words.
 void describe_static_remainder(const Comparison& final_cmp, const StaticFit& st, const DiagnoseOptions& opt, DiagnosisResult& out) {
   const double floor = out.noise_floor_nrmse;
@@ -226,15 +239,15 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   const PathModelEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
                          opt.cache_dir);
   if (opt.progress) {
-    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa, %d material points (%.1f s; path %s%s%s)\n",
-                 rom.path().path_pressure_Pa().back() * 1e-3, rom.path().num_points(),
+    std::fprintf(stderr, "diagnose: elastic path traced to %.1f kPa (for a peak of %.1f kPa), %d material points (%.1f s; path %s%s%s)\n",
+                 rom.path().path_pressure_Pa().back() * 1e-3, rom.reference_peak_Pa() * 1e-3, rom.path().num_points(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), rom.path_source().c_str(),
                  rom.fine_source().empty() ? "" : ", scene mesh's sweep ", rom.fine_source().c_str());
     if (!rom.fine_curve().empty())
       std::fprintf(stderr,
                    "diagnose: calibration mesh %ld dof, scene mesh %ld dof: angle at %.1f kPa %.3f vs %.3f deg "
                    "(the calibration mesh is driven at %.2f kPa there)\n",
-                   rom.dofs(), rom.fine_dofs(), rom.inlet_max_Pa() * 1e-3, rom.coarse_curve().back(), rom.fine_curve().back(),
+                   rom.dofs(), rom.fine_dofs(), rom.reference_peak_Pa() * 1e-3, rom.coarse_curve().back(), rom.fine_curve().back(),
                    rom.pressure_map_Pa().back() * 1e-3);
   }
   long rom_runs = 0;
@@ -251,7 +264,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
     if (w.find("runs opposite to the model's") != std::string::npos || w.find("probably in radians") != std::string::npos)
       throw InputError(opt.data_path + ": " + w + ". diagnose stops here: no physical effect explains that");
   out.baseline_nrmse = base.nrmse;
-  for (const TrialComparison& t : base.trials) out.baseline_nrmse_per_trial.push_back(t.nrmse);
+  for (const TrialComparison& t : base.trials) {
+    out.baseline_nrmse_per_trial.push_back(t.nrmse);
+    out.baseline_rmse_deg_per_trial.push_back(t.rmse_deg);
+  }
   out.noise_floor_nrmse = base.noise_floor_nrmse;
   const Signature sig = signature_of(base);
 
@@ -572,8 +588,13 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
     current = metrics(cal_scene.with(selected_sets));
     current_rss = current.rss_deg2;
     current_static = fit_static_discrepancy(current.frames);
+    out.after_round.push_back(model_after_round(out.selected, selected_sets, current));
   }
   out.final_nrmse = current.nrmse;
+  for (const TrialComparison& t : current.trials) {
+    out.final_nrmse_per_trial.push_back(t.nrmse);
+    out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
+  }
   describe_static_remainder(current, current_static, opt, out);
 
   std::vector<Series> fitted_fem;  // the FEM traces of the refined constants, when a refinement ran them
@@ -589,7 +610,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   if (opt.verify || opt.refine > 0 || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  write_diagnosis(scene, fitted, rom, chosen, opt, out);
+  if (opt.progress && !opt.cache_dir.empty())
+    std::fprintf(stderr, "diagnose: cache %s: elastic path %s; static FEM curves: %d from the cache, %d computed\n",
+                 opt.cache_dir.c_str(), rom.path_source().c_str(), rom.curves_from_cache(), rom.curves_computed());
+  write_diagnosis(scene, fitted, rec, rom, chosen, opt, out);
   return out;
 }
 

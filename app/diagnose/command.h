@@ -43,8 +43,10 @@
 // Outputs in out_dir: diagnosis.json (schema in the README), fitted.toml (the scene plus the
 // selected effects; `pneufem compare fitted.toml --data FILE` shows the drop), diagnosis.csv
 // (one row per candidate and round), calibration.csv (every reduced-model evaluation of every
-// calibration: parameters, RSS or the error that made it fail), and one line in history.jsonl per
-// model variant.
+// calibration: parameters, RSS or the error that made it fail), one line in history.jsonl per
+// model variant (the baseline and the model after each round, with the NRMSE and RMSE per trial)
+// and report.md (the diagnosis for a person: recording, scene, the error per trial before and
+// after, every round's candidates, tests and choice, and the evidence in words).
 #include <string>
 #include <vector>
 
@@ -136,9 +138,20 @@ struct CandidateResult {
   std::vector<double> refit_selected;
 };
 
+/// The reduced model after a round's selection (the effects selected so far, with the constants
+/// they had then): one line of history.jsonl and one column of report.md each.
+struct ModelAfterRound {
+  std::vector<std::string> effects;     ///< selected so far, in order
+  std::vector<std::string> sets;        ///< the scene overrides that add them
+  double nrmse = 0.0;                   ///< pooled
+  std::vector<double> nrmse_per_trial;
+  std::vector<double> rmse_deg_per_trial;
+};
+
 struct DiagnosisResult {
   double baseline_nrmse = 0.0;
   std::vector<double> baseline_nrmse_per_trial;
+  std::vector<double> baseline_rmse_deg_per_trial;
   double noise_floor_nrmse = 0.0;
   std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
   std::vector<std::string> selected;
@@ -149,6 +162,9 @@ struct DiagnosisResult {
   std::string missing_history_effect;
   std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
+  std::vector<double> final_nrmse_per_trial;      ///< ... per trial (the baseline's when none is selected)
+  std::vector<double> final_rmse_deg_per_trial;
+  std::vector<ModelAfterRound> after_round;       ///< one per selected effect, in order; the last is the final model
   /// The final residual after a static correction (fit_static_discrepancy), and the share of the
   /// final error above the noise floor that it removes (in squared NRMSE; 0 when at the floor):
   /// near 1, what is left is a misfit of the elastic response, not a missing history effect.

@@ -8,7 +8,8 @@
 //   evidence.cpp            the residual's signature and the plain-words reason per candidate;
 //   fem.cpp                 the full-FEM stages: space-mapping refinement (--refine), FEM
 //                           calibration (--fem-calibrate) and verification (--verify);
-//   output.cpp              diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv, history.
+//   output.cpp              diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv, history;
+//   report.cpp              report.md, the diagnosis for a person.
 // Beside them: effect_catalog (the candidates; `pneufem synth` hides the same ones),
 // elastic_curve (static angle curves and the interpolation nodes of the catalog's constants) and
 // cli (the command line).
@@ -65,7 +66,8 @@ struct Calibration {
 /// Minimises rss(values) over the candidate's box: a coarse grid (5 points per parameter for
 /// one parameter, 3 per parameter above), then golden-section search (one parameter) or BOBYQA
 /// (several) from the best grid point, until the trust region is 1e-4 of the calibration scale,
-/// a step gains less than 1e-4 in log RSS, or `budget` runs are spent. Two constants that trade
+/// a step gains less than 1e-4 in log RSS (for BOBYQA confirmed by a restart from the best point,
+/// which gains no more either), or `budget` runs are spent. Two constants that trade
 /// off leave a narrow valley that BOBYQA walks down in small steps: the default budget (60,
 /// DiagnoseOptions) is sized for that walk (Calibrate.WalksDownALogSpaceValleyWithinTheDefaultBudget).
 /// The optimiser sees log(rss), which has the same minimiser: near a limit point the RSS of
@@ -101,6 +103,7 @@ TradeOff trade_off(const CandidateEffect& c, const std::function<double(const st
 struct Signature {
   std::vector<double> trial_rmse;     ///< per trial
   double growth = 1.0;                ///< rmse of the last trial / first
+  double noise_deg = 0.0;             ///< angle tracking noise per frame (mean over the trials)
   double creep_top_deg = 0.0;         ///< mean (measured - model) spread at the top third of the levels
   double creep_low_deg = 0.0;         ///< ... at the other levels
   double creep_first_deg = 0.0, creep_last_deg = 0.0;  ///< mean spread difference, first / last trial
@@ -112,7 +115,10 @@ struct Signature {
 
 Signature signature_of(const Comparison& c);
 
-/// The sentence about the residual feature that `effect` explains.
+/// The sentence about the residual feature that `effect` explains. Every word of direction in it
+/// (grows / falls / stays flat, more / less / as modelled, ...) is read off the numbers it quotes:
+/// a difference within the angle tracking noise (s.noise_deg, and at least half the last digit
+/// printed, so "+0.00" is never a trend) is called flat, and a correlation below 0.5 in size weak.
 std::string evidence(const std::string& effect, const Signature& s);
 
 // ---- full FEM (fem.cpp)
@@ -137,9 +143,17 @@ void verify_with_fem(const Scene& scene, const Scene& fitted, const Recording& r
 
 // ---- outputs (output.cpp)
 
-/// Writes diagnosis.json, fitted.toml, diagnosis.csv and calibration.csv to opt.out_dir and
-/// appends the baseline and the fitted model to its history.jsonl.
-void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEvaluator& rom, const ChosenEffects& chosen,
-                     const DiagnoseOptions& opt, const DiagnosisResult& out);
+/// Writes diagnosis.json, fitted.toml, diagnosis.csv, calibration.csv and report.md to opt.out_dir
+/// (each atomically) and appends the baseline and the model after each round to its history.jsonl.
+void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
+                     const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out);
+
+// ---- report (report.cpp)
+
+/// report.md: the recording and the scene, the error per trial of the baseline beside the final
+/// model's (and after each round), every round's candidates with their tests, the chosen effect
+/// and its constants, and the reasons in words (the candidates' `why`). Only formats `out`.
+std::string diagnosis_report(const Scene& scene, const Recording& rec, const PathModelEvaluator& rom,
+                             const DiagnoseOptions& opt, const DiagnosisResult& out);
 
 }  // namespace pneufem::diagnose_detail

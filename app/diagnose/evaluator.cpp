@@ -36,6 +36,17 @@ bool has_history(const Model& m) {
 
 }  // namespace
 
+double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa) {
+  constexpr double kProtocolHeadroom = 1.1;  // overshoot and sensor noise above the commanded peak
+  constexpr double kProtocolLowest = 0.8;    // a recording peaking lower follows a protocol of its own
+  if (scene_peak_Pa > 0.0 && recorded_peak_Pa >= kProtocolLowest * scene_peak_Pa &&
+      recorded_peak_Pa <= kProtocolHeadroom * scene_peak_Pa)
+    return kProtocolHeadroom * scene_peak_Pa;
+  const double p = std::max(recorded_peak_Pa, 1e3);
+  const double step = 0.5 * std::pow(10.0, std::floor(std::log10(p)));  // 5 kPa for 10-100 kPa
+  return step * std::ceil(p / step);
+}
+
 PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
                            int rom_points, const Scene* mesh_scene, const std::string& cache_dir)
     : cache_dir_(cache_dir), rec_(rec), frames_(frames) {
@@ -48,11 +59,17 @@ PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, 
   d.max_report_gap_s = 0.5;  // creep and damage inside holds: 0.5 s states, linear in between
   inlet_ = measured_load(rec, d, base.number("load.rest_s"), true, offset_);
   rest_s_ = base.number("load.rest_s");
+  double inlet_max_Pa = 0.0, scene_peak_Pa = 0.0;
   for (const TrialLoad& tr : inlet_.trials)
-    for (double p : tr.pressure_Pa) inlet_max_Pa_ = std::max(inlet_max_Pa_, p);
+    for (double p : tr.pressure_Pa) inlet_max_Pa = std::max(inlet_max_Pa, p);
+  for (const TrialLoad& tr : ref_->load.trials)
+    for (double p : tr.pressure_Pa) scene_peak_Pa = std::max(scene_peak_Pa, p);
+  // Not the measured peak itself: the cache entries below are keyed by this pressure, and it must
+  // be the same for every recording of one protocol (elastic_reference_peak_Pa).
+  reference_peak_Pa_ = elastic_reference_peak_Pa(scene_peak_Pa, std::max(p_max_Pa_, inlet_max_Pa));
   PathModelOptions po;
-  po.p_top_Pa = 1.8 * p_max_Pa_;  // softened models reach angles the elastic one reaches only above p_max
-  po.dp_Pa = p_max_Pa_ / 40.0;
+  po.p_top_Pa = 1.8 * reference_peak_Pa_;  // softened models reach angles the elastic one reaches only above the peak
+  po.dp_Pa = reference_peak_Pa_ / 40.0;
   po.max_points = rom_points;
   po.max_dt_s = 0.5;
   po.newton = ref_->solver.quasi_static.newton;
@@ -100,18 +117,18 @@ PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, 
                            const Scene fine_scene = elastic_reference_scene(*mesh_scene);
                            const std::unique_ptr<BuiltModel> fine = build_model(fine_scene);
                            fine_dofs_ = fine->model.num_dofs();
-                           fine_curve_ = stored_curve(fine_scene, *fine, inlet_max_Pa_, kMeshCurvePoints, &fine_source_);
+                           fine_curve_ = stored_curve(fine_scene, *fine, reference_peak_Pa_, kMeshCurvePoints, &fine_source_);
                          } catch (const PhysicsError& e) {
                            fine_error = e.what();
                          }
                        });
   if (!fine_error.empty())
     throw PhysicsError("diagnose: the static sweep of the scene's own mesh (for the calibration mesh's pressure map) to " +
-                       fmt_kPa(inlet_max_Pa_) + " failed: " + fine_error);
+                       fmt_kPa(reference_peak_Pa_) + " failed: " + fine_error);
   const std::vector<double>& th = path_->path_angle_deg();
   const std::vector<double>& pc = path_->path_pressure_Pa();
   for (std::size_t i = 0; i < fine_curve_.size(); ++i) {
-    const double p = inlet_max_Pa_ * static_cast<double>(i) / kMeshCurvePoints;
+    const double p = reference_peak_Pa_ * static_cast<double>(i) / kMeshCurvePoints;
     if (fine_curve_[i] > th.back() + 1e-9)
       throw PhysicsError("diagnose: the calibration mesh's elastic path ends at " + fmt_kPa(pc.back()) + " (" +
                          std::to_string(th.back()) + " deg, a limit point) before the angle the scene's mesh reaches at " +
@@ -165,9 +182,9 @@ std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& varia
     // tests/app/test_path_model.cpp); gravity loads a different deformation mode, which the
     // 1-dof reduced model cannot represent, so then the sweep is the full static FEM (fewer
     // points, quadratic interpolation; cached by scene without the lag).
-    // Curves span the inlet's peak pressure, which a lagged chamber pressure never exceeds, so
-    // every lag shares one curve per scene (the cache key leaves the lag out).
-    const double hi = chamber(inlet_max_Pa_);
+    // Curves span the reference peak, above the inlet's peak pressure, which a lagged chamber
+    // pressure never exceeds, so every lag shares one curve per scene (the cache key leaves the lag out).
+    const double hi = chamber(reference_peak_Pa_);
     const bool fem = bm->model.gravity_m_s2.norm() > 0.0;
     const int n = fem ? kFemCurvePoints : 120;
     std::vector<double> th;
@@ -226,7 +243,7 @@ std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& varia
     // diagnosis on the 5-chamber test actuator); five sweeps serve every angle, within ~1e-4 deg
     // of the direct sweep (RigAngleInterpolation.MatchesDirectFemSweepsBetweenNodes).
     const Scene el = elastic_reference_scene(variant);
-    const double hi = chamber(inlet_max_Pa_);  // pl holds mapped pressures
+    const double hi = chamber(reference_peak_Pa_);  // pl holds mapped pressures
     const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
     std::vector<double> off(c0.size(), 0.0);
     const double rig_deg = variant.has("gravity.rig_angle_deg") ? variant.number("gravity.rig_angle_deg") : -1.0;
@@ -294,7 +311,9 @@ std::vector<double> PathModelEvaluator::elastic_curve(const Scene& variant, cons
   std::unique_ptr<BuiltModel> own;
   if (!bm_in) own = build_model(variant);
   const BuiltModel& bm = bm_in ? *bm_in : *own;
-  const std::vector<double> th = stored_curve(variant, bm, hi, n);
+  std::string source;
+  const std::vector<double> th = stored_curve(variant, bm, hi, n, &source);
+  ++(source.starts_with("cache ") ? curves_from_cache_ : curves_computed_);
   std::lock_guard<std::mutex> lock(cache_mu_);
   curves_[key] = th;
   return th;

@@ -4,6 +4,7 @@
 // the model angle at its frames. Separate from the diagnosis itself because the calibration and
 // the selection only ever see angles per frame; how they are made (path model, static FEM sweeps,
 // the calibration mesh's pressure map) is this class's business. Internal to app/diagnose*.cpp.
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -18,6 +19,23 @@
 #include "scenes/scene.h"
 
 namespace pneufem::diagnose_detail {
+
+/// The peak pressure (Pa) diagnose's elastic FEM work is done for, and so the pressure its cache
+/// entries are keyed by: the reduced model's path is traced to 1.8 x it (softened models reach
+/// angles the elastic one reaches only above the peak), the static curves and the calibration
+/// mesh's pressure map span [0, it]. It must cover every recorded pressure AND be the same for
+/// every recording of one protocol, whose measured peaks differ by the controller's overshoot and
+/// the sensor noise (keyed by the exact measured peak, a second recording of the same protocol
+/// never found the first one's entries; issue 28). So:
+///  * a recording whose peak lies within [0.8, 1.1] x the scene's commanded peak follows the
+///    scene's protocol: 1.1 x the commanded peak (10 % headroom: synth's controller overshoots a
+///    10 kPa step by ~7 %, 0.7 kPa, and the sensor noise is ~0.1 kPa), the same for all of them;
+///  * any other recording (its own protocol, not the scene's): its peak rounded UP to a grid of
+///    half its leading power of ten (5 kPa for peaks of 10-100 kPa), so noisy peaks share a key
+///    unless they straddle a grid line. Why not always the grid: a protocol peak on a grid line
+///    (45 kPa -> 50 kPa) would put half of its noisy recordings on either side of it.
+/// `scene_peak_Pa` <= 0 (no protocol in the scene) means the second rule.
+double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa);
 
 /// Reduced-model replay of a recording for any variant of the base scene (same mesh).
 ///
@@ -47,14 +65,20 @@ class PathModelEvaluator {
   const std::string& path_source() const { return path_source_; }
   const std::string& fine_source() const { return fine_source_; }
 
+  /// The peak pressure of the elastic work (elastic_reference_peak_Pa above; >= every recorded pressure).
+  double reference_peak_Pa() const { return reference_peak_Pa_; }
+
+  /// Static FEM curves (gravity's sweeps) of this run read from the cache directory / computed.
+  int curves_from_cache() const { return curves_from_cache_; }
+  int curves_computed() const { return curves_computed_; }
+
   /// The calibration mesh's pressure map (empty without one): static angles (deg) of the scene's
-  /// mesh and of the calibration mesh at p = inlet_max_Pa() i / n, and phi(p) there (Pa).
+  /// mesh and of the calibration mesh at p = reference_peak_Pa() i / n, and phi(p) there (Pa).
   const std::vector<double>& fine_curve() const { return fine_curve_; }
   const std::vector<double>& coarse_curve() const { return coarse_curve_; }
   const std::vector<double>& pressure_map_Pa() const { return map_Pa_; }
   long fine_dofs() const { return fine_dofs_; }
   long dofs() const { return ref_->model.num_dofs(); }
-  double inlet_max_Pa() const { return inlet_max_Pa_; }
 
   const PathModel& path() const { return *path_; }
 
@@ -81,8 +105,8 @@ class PathModelEvaluator {
 
   /// The pressure that drives the reduced model: p itself, or phi(p) with a calibration mesh
   /// (interpolated between the sweep's points; identity above the sweep's top is never needed:
-  /// the sweep spans the inlet's peak).
-  double chamber(double p) const { return map_Pa_.empty() ? p : curve_at(map_Pa_, inlet_max_Pa_, p); }
+  /// the sweep spans the reference peak, above every inlet pressure).
+  double chamber(double p) const { return map_Pa_.empty() ? p : curve_at(map_Pa_, reference_peak_Pa_, p); }
 
   static std::string fmt_kPa(double p_Pa);
 
@@ -105,6 +129,7 @@ class PathModelEvaluator {
   std::string cache_dir_, path_source_ = "computed", fine_source_;
   mutable std::mutex cache_mu_;
   mutable std::map<std::string, std::vector<double>> curves_;
+  mutable std::atomic<int> curves_from_cache_{0}, curves_computed_{0};
   const Recording& rec_;
   const std::vector<ComparedFrame>& frames_;
   std::unique_ptr<BuiltModel> ref_;
@@ -113,7 +138,7 @@ class PathModelEvaluator {
   long fine_dofs_ = 0;
   LoadHistory inlet_;
   std::vector<double> offset_;
-  double rest_s_ = 0.0, p_max_Pa_ = 0.0, inlet_max_Pa_ = 0.0;
+  double rest_s_ = 0.0, p_max_Pa_ = 0.0, reference_peak_Pa_ = 0.0;
 };
 
 }  // namespace pneufem::diagnose_detail

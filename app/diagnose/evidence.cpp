@@ -23,6 +23,7 @@ Signature signature_of(const Comparison& c) {
   for (std::size_t k = 0; k < c.trials.size(); ++k) {
     const TrialComparison& t = c.trials[k];
     s.trial_rmse.push_back(t.rmse_deg);
+    s.noise_deg += t.noise_deg / static_cast<double>(c.trials.size());
     double cr = 0.0, mr = 0.0;
     int ncr = 0, nmr = 0;
     for (const StepComparison& st : t.steps) {
@@ -73,27 +74,136 @@ Signature signature_of(const Comparison& c) {
   return s;
 }
 
+namespace {
+
+/// Which way a quoted difference goes. A difference within `flat_within` is no trend.
+enum class Trend { up, down, flat };
+Trend trend_of(double difference, double flat_within) {
+  if (difference > flat_within) return Trend::up;
+  if (difference < -flat_within) return Trend::down;
+  return Trend::flat;
+}
+
+/// The largest difference (deg) called flat: the angle tracking noise per frame — a difference a
+/// reader could not see on a plot of the angle — and at least half the last digit the sentences
+/// print (%.2f), so a difference printed as +0.00 is never called a trend.
+double flat_deg(const Signature& s) { return std::max(s.noise_deg, 0.005); }
+
+/// "(angle noise 0.05 deg)", the number a "flat" is judged by.
+std::string noise_text(const Signature& s) { return "angle noise " + fmt("%.2f", s.noise_deg) + " deg"; }
+
+/// Growth of the error over the trials (rms of trial 1 and of the last trial).
+std::string growth_sentence(const Signature& s) {
+  if (s.trial_rmse.empty()) return "no trial to compare";
+  const double first = s.trial_rmse.front(), last = s.trial_rmse.back();
+  if (s.trial_rmse.size() < 2) return "one trial: no growth over the trials to see (rms " + fmt("%.2f", first) + " deg)";
+  const std::string nums = "rms " + fmt("%.2f", first) + " -> " + fmt("%.2f", last) + " deg";
+  switch (trend_of(last - first, flat_deg(s))) {
+    case Trend::up: return "the error grows from trial 1 to the last trial (" + nums + ")";
+    case Trend::down: return "the error falls from trial 1 to the last trial (" + nums + ")";
+    case Trend::flat: break;
+  }
+  return "the error stays flat from trial 1 to the last trial, within the angle noise (" + nums + ", " + noise_text(s) + ")";
+}
+
+/// Creep in the top holds: measured minus modelled rise of the angle over a hold.
+std::string top_creep_sentence(const Signature& s) {
+  const std::string nums = fmt("%+.2f", s.creep_top_deg) + " deg over a hold against the model, vs " +
+                           fmt("%+.2f", s.creep_low_deg) + " at the lower steps";
+  switch (trend_of(s.creep_top_deg, flat_deg(s))) {
+    case Trend::up: return "during the top holds the measured angle keeps rising beyond the model (" + nums + ")";
+    case Trend::down: return "during the top holds the measured angle rises less than the model (" + nums + ")";
+    case Trend::flat: break;
+  }
+  return "during the top holds the measured angle rises as the model does, within the angle noise (" + nums + ", " +
+         noise_text(s) + ")";
+}
+
+/// "more than" / "less than" / "as much as" (within the angle noise, which the sentence then
+/// quotes) the model, for a measured-minus-model creep.
+std::string creep_comparison(double measured_minus_model, const Signature& s) {
+  switch (trend_of(measured_minus_model, flat_deg(s))) {
+    case Trend::up: return "more than";
+    case Trend::down: return "less than";
+    case Trend::flat: break;
+  }
+  return "as much as";
+}
+
+/// Creep inside the holds of trial 1 and of the last trial, measured minus modelled.
+std::string hold_creep_sentence(const Signature& s) {
+  const std::string first = creep_comparison(s.creep_first_deg, s), last = creep_comparison(s.creep_last_deg, s);
+  const std::string a = fmt("%+.2f", s.creep_first_deg) + " deg", b = fmt("%+.2f", s.creep_last_deg) + " deg";
+  if (s.trial_rmse.size() < 2)
+    return "inside the holds the measured angle creeps " + first + " the model (" + a + " over a hold" +
+           (first.starts_with("as much") ? ", " + noise_text(s) : "") + ")";
+  if (first == last)
+    return "inside the holds the measured angle creeps " + first + " the model (" + a + " over a hold in trial 1, " + b +
+           " in the last trial" + (first.starts_with("as much") ? ", " + noise_text(s) : "") + ")";
+  return "inside the holds the measured angle creeps " + first + " the model in trial 1 (" + a + " over a hold) and " + last +
+         " it in the last trial (" + b + "; " + noise_text(s) + ")";
+}
+
+/// Trial 1 against the later trials (mean residual model - measured).
+std::string first_trial_sentence(const Signature& s) {
+  if (s.trial_rmse.size() < 2) return "one trial: no later trial to compare trial 1 with";
+  const std::string nums = "mean residual (model - measured) of trial 1 " + fmt("%+.2f", s.first_vs_rest) + " deg relative to them";
+  switch (trend_of(s.first_vs_rest, flat_deg(s))) {
+    case Trend::up:
+      return "the later trials bend further than modelled, relative to trial 1 (" + nums +
+             "), the signature of softening set by the first peak load";
+    case Trend::down:
+      return "trial 1 bends further than modelled, relative to the later trials (" + nums +
+             "), the opposite of softening set by the first peak load";
+    case Trend::flat: break;
+  }
+  return "trial 1 and the later trials have the same mean residual within the angle noise (" + nums + ", " + noise_text(s) +
+         "): no sign of softening set by the first peak load";
+}
+
+/// Correlation of the error at the marks with the measured angle there.
+std::string proportional_sentence(const Signature& s) {
+  // |r| >= 0.5: the angle accounts for at least a quarter of the error's variance across the marks.
+  constexpr double kStrongCorrelation = 0.5;
+  const std::string nums = "correlation of the error at the marks (model - measured) with the angle " + fmt("%+.2f", s.proportional);
+  if (s.proportional >= kStrongCorrelation) return "the error rises with the angle (" + nums + ")";
+  if (s.proportional <= -kStrongCorrelation) return "the error falls with the angle (" + nums + ")";
+  return "the error barely follows the angle (" + nums + ", below 0.5 in size)";
+}
+
+/// Error right after the pressure steps against the error after the mark.
+std::string step_lag_sentence(const Signature& s) {
+  const std::string nums = "mean residual " + fmt("%+.2f", s.early_deg) + " deg in the first 0.5 s vs " + fmt("%+.2f", s.late_deg) +
+                           " deg after the mark";
+  switch (trend_of(std::abs(s.early_deg) - std::abs(s.late_deg), flat_deg(s))) {
+    case Trend::up: return "the error concentrates right after each pressure step (" + nums + ")";
+    case Trend::down: return "the error is smaller right after the pressure steps than after the mark (" + nums + ")";
+    case Trend::flat: break;
+  }
+  return "the error is no larger right after the pressure steps than after the mark, within the angle noise (" + nums + ", " +
+         noise_text(s) + ")";
+}
+
+/// Offset of the model at rest (steps at zero pressure).
+std::string rest_sentence(const Signature& s) {
+  const std::string nums = "mean residual " + fmt("%+.2f", s.rest_deg) + " deg at 0 kPa";
+  switch (trend_of(s.rest_deg, flat_deg(s))) {
+    case Trend::up: return "at rest the model's angle lies above the measured one (" + nums + ")";
+    case Trend::down: return "at rest the model's angle lies below the measured one (" + nums + ")";
+    case Trend::flat: break;
+  }
+  return "at rest the model matches the measured angle within the angle noise (" + nums + ", " + noise_text(s) + ")";
+}
+
+}  // namespace
+
 std::string evidence(const std::string& effect, const Signature& s) {
-  const std::string growth = "the error grows from trial 1 to the last trial (rms " + fmt("%.2f", s.trial_rmse.front()) +
-                             " -> " + fmt("%.2f", s.trial_rmse.back()) + " deg)";
-  const std::string creep = "the measured angle keeps rising during the top holds (" + fmt("%+.2f", s.creep_top_deg) +
-                            " deg more than modelled over a hold, vs " + fmt("%+.2f", s.creep_low_deg) + " at the lower steps)";
-  if (effect == "fatigue") return growth + ", and " + creep;
-  if (effect == "viscoelastic")
-    return "inside the holds the measured angle creeps more than the model (" + fmt("%+.2f", s.creep_first_deg) +
-           " deg in trial 1, " + fmt("%+.2f", s.creep_last_deg) + " deg in the last trial)";
-  if (effect == "mullins")
-    return "trial 1 differs from the later trials (mean residual " + fmt("%+.2f", s.first_vs_rest) +
-           " deg relative to them), the signature of softening set by the first peak load";
-  if (effect == "stiffness")
-    return "the error scales with the angle (correlation of the step error with the angle " + fmt("%+.2f", s.proportional) +
-           ") with little time structure";
-  if (effect == "pressure_lag")
-    return "the error concentrates right after each pressure step (mean residual " + fmt("%+.2f", s.early_deg) +
-           " deg in the first 0.5 s vs " + fmt("%+.2f", s.late_deg) + " deg after the mark)";
-  if (effect == "gravity")
-    return "the model misses an angle at rest and low pressure (mean residual " + fmt("%+.2f", s.rest_deg) +
-           " deg at 0 kPa)";
+  if (effect == "fatigue") return growth_sentence(s) + ", and " + top_creep_sentence(s);
+  if (effect == "viscoelastic") return hold_creep_sentence(s);
+  if (effect == "mullins") return first_trial_sentence(s);
+  if (effect == "stiffness") return proportional_sentence(s);
+  if (effect == "pressure_lag") return step_lag_sentence(s);
+  if (effect == "gravity") return rest_sentence(s);
   return "its calibrated constants reshape the residual";
 }
 

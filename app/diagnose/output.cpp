@@ -1,6 +1,7 @@
 // The files a diagnosis writes (app/diagnose/detail.h; schema of diagnosis.json in the README):
 // diagnosis.json, fitted.toml, diagnosis.csv (one row per candidate and round), calibration.csv
-// (every evaluation of every calibration) and the history lines. Apart from the diagnosis because
+// (every evaluation of every calibration), report.md (its text is report.cpp's) and the history
+// lines (the baseline and the model after each round, per trial). Apart from the diagnosis because
 // it only formats a finished DiagnosisResult; nothing here changes a number.
 #include <algorithm>
 #include <cstdio>
@@ -18,8 +19,8 @@ namespace fs = std::filesystem;
 
 namespace pneufem::diagnose_detail {
 
-void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEvaluator& rom, const ChosenEffects& chosen,
-                     const DiagnoseOptions& opt, const DiagnosisResult& out) {
+void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
+                     const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out) {
   fs::create_directories(opt.out_dir);
   json::Object root;
   root.add_str("version", version_string());
@@ -27,6 +28,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
   root.add_str("data", opt.data_path);
   json::Object b;
   b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
+  b.add("rmse_deg_per_trial", json::array(out.baseline_rmse_deg_per_trial));
   if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
   root.add("baseline", b.str(2));
   std::string cs = "[";
@@ -77,6 +79,8 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
   }
   root.add("noise_floor_nrmse", out.noise_floor_nrmse);
   root.add("final_nrmse", out.final_nrmse);
+  root.add("final_nrmse_per_trial", json::array(out.final_nrmse_per_trial));
+  root.add("final_rmse_deg_per_trial", json::array(out.final_rmse_deg_per_trial));
   if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
   json::Object sr;
   sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
@@ -86,7 +90,9 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
   method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
                                   " material points, elastic path to " +
                                   fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add("reference_peak_kPa", rom.reference_peak_Pa() * 1e-3);
   method.add_str("elastic_path_source", rom.path_source());
+  method.add("static_curves_from_cache", rom.curves_from_cache()).add("static_curves_computed", rom.curves_computed());
   if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
   if (opt.calibration_h_mm > 0.0) {
     // The calibration mesh and its correction, so a reader can judge its size against the effects'.
@@ -94,7 +100,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
     const std::vector<double>& f = rom.fine_curve();
     const std::vector<double>& c = rom.coarse_curve();
     std::vector<double> p;
-    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.inlet_max_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
+    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.reference_peak_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
     cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
     std::vector<double> m;
     for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
@@ -131,6 +137,10 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
             (std::isfinite(c.trace[i].rss_deg2) ? json::num(c.trace[i].rss_deg2) : std::string("inf")) + ",\"" + e + "\"\n";
     }
   write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
+  write_file_atomic((fs::path(opt.out_dir) / "report.md").string(), diagnosis_report(scene, rec, rom, opt, out));
+  // History: the baseline, then the model after each round (the last is fitted.toml's, whose hash
+  // it carries: with --refine its constants are the refined ones, its errors the reduced model's
+  // before the refinement), each with the error per trial, so the fall shows trial by trial.
   HistoryEntry h;
   h.time_utc = utc_now();
   h.source = "diagnose";
@@ -138,13 +148,17 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const PathModelEva
   h.scene_hash = scene_hash(scene);
   h.nrmse = out.baseline_nrmse;
   h.trial_nrmse = out.baseline_nrmse_per_trial;
+  h.trial_rmse_deg = out.baseline_rmse_deg_per_trial;
   append_history(opt.out_dir, h);
-  if (!out.selected.empty()) {
-    h.label = "diagnose + " + out.selected.front() + (out.selected.size() > 1 ? " + " + out.selected[1] : "") +
-              " (reduced model)";
-    h.scene_hash = scene_hash(fitted);
-    h.nrmse = out.final_nrmse;
-    h.trial_nrmse.clear();
+  for (std::size_t i = 0; i < out.after_round.size(); ++i) {
+    const ModelAfterRound& m = out.after_round[i];
+    h.label = "diagnose";
+    for (const std::string& e : m.effects) h.label += " + " + e;
+    h.label += " (reduced model)";
+    h.scene_hash = i + 1 == out.after_round.size() ? scene_hash(fitted) : scene_hash(scene.with(m.sets));
+    h.nrmse = m.nrmse;
+    h.trial_nrmse = m.nrmse_per_trial;
+    h.trial_rmse_deg = m.rmse_deg_per_trial;
     append_history(opt.out_dir, h);
   }
 }

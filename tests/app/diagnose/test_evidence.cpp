@@ -1,0 +1,112 @@
+// The plain-words reasons of diagnose (app/diagnose/evidence.cpp, evidence()): every word of direction
+// must be read off the numbers the sentence quotes. Before 2026-11-27 the sentences were fixed
+// text with the numbers filled in, and a user's ten-trial recording got "the error grows from trial
+// 1 to the last trial (rms 0.55 -> 0.53 deg)" (issue 28). Here each sentence is fed signatures of
+// both signs and of a size within the noise, and must say which.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "app/diagnose/detail.h"
+
+namespace pneufem::diagnose_detail {
+namespace {
+
+bool says(const std::string& sentence, const std::string& what) { return sentence.find(what) != std::string::npos; }
+
+/// Three trials with the given first and last rms; no angle noise (noise-free data: any difference
+/// printed as non-zero is a trend) unless `noise_deg` is given.
+Signature trials(double first_rms, double last_rms, double noise_deg = 0.0) {
+  Signature s;
+  s.trial_rmse = {first_rms, 0.5 * (first_rms + last_rms), last_rms};
+  s.growth = last_rms / first_rms;
+  s.noise_deg = noise_deg;
+  return s;
+}
+
+TEST(Evidence, GrowthOverTheTrialsFollowsTheSignOfTheChange) {
+  // The user's numbers: a falling error is not "grows".
+  const std::string falls = evidence("fatigue", trials(0.55, 0.53));
+  EXPECT_FALSE(says(falls, "grows")) << falls;
+  EXPECT_TRUE(says(falls, "the error falls from trial 1 to the last trial (rms 0.55 -> 0.53 deg)")) << falls;
+  const std::string grows = evidence("fatigue", trials(0.30, 0.90));
+  EXPECT_TRUE(says(grows, "the error grows from trial 1 to the last trial (rms 0.30 -> 0.90 deg)")) << grows;
+  // 0.02 deg of change under 0.05 deg of tracking noise (synth's default) is no trend either way.
+  const std::string flat = evidence("fatigue", trials(0.55, 0.53, 0.05));
+  EXPECT_TRUE(says(flat, "stays flat")) << flat;
+  EXPECT_TRUE(says(flat, "angle noise 0.05 deg")) << flat;
+  EXPECT_FALSE(says(flat, "grows") || says(flat, "falls")) << flat;
+  // A difference that prints as 0.00 is flat even without noise (half the last digit printed).
+  EXPECT_TRUE(says(evidence("fatigue", trials(0.551, 0.549)), "stays flat"));
+  Signature one;
+  one.trial_rmse = {0.4};
+  EXPECT_TRUE(says(evidence("fatigue", one), "one trial")) << evidence("fatigue", one);
+}
+
+TEST(Evidence, CreepInTheTopHoldsRisesOnlyWhenTheMeasuredRiseExceedsTheModels) {
+  Signature s = trials(0.3, 0.9);
+  s.creep_top_deg = 0.42, s.creep_low_deg = 0.10;
+  const std::string up = evidence("fatigue", s);
+  EXPECT_TRUE(says(up, "keeps rising beyond the model (+0.42 deg over a hold against the model, vs +0.10")) << up;
+  s.creep_top_deg = -0.42;
+  const std::string down = evidence("fatigue", s);
+  EXPECT_FALSE(says(down, "keeps rising")) << down;
+  EXPECT_TRUE(says(down, "rises less than the model (-0.42 deg")) << down;
+  s.creep_top_deg = 0.03, s.noise_deg = 0.05;
+  EXPECT_TRUE(says(evidence("fatigue", s), "rises as the model does, within the angle noise")) << evidence("fatigue", s);
+}
+
+TEST(Evidence, CreepInsideTheHoldsSaysMoreOrLessPerTrial) {
+  Signature s = trials(0.3, 0.3);
+  s.creep_first_deg = 0.31, s.creep_last_deg = 0.28;
+  EXPECT_TRUE(says(evidence("viscoelastic", s), "creeps more than the model (+0.31 deg over a hold in trial 1, +0.28 deg"))
+      << evidence("viscoelastic", s);
+  s.creep_first_deg = -0.31, s.creep_last_deg = -0.28;
+  EXPECT_TRUE(says(evidence("viscoelastic", s), "creeps less than the model (-0.31 deg")) << evidence("viscoelastic", s);
+  s.creep_first_deg = 0.31, s.creep_last_deg = -0.28;
+  const std::string mixed = evidence("viscoelastic", s);
+  EXPECT_TRUE(says(mixed, "more than the model in trial 1 (+0.31 deg over a hold) and less than it in the last trial (-0.28 deg"))
+      << mixed;
+}
+
+TEST(Evidence, FirstTrialAgainstTheLaterOnesNamesSofteningOnlyForItsSign) {
+  Signature s = trials(0.3, 0.3);
+  s.first_vs_rest = 0.25;  // residual model - measured higher in trial 1: the later trials bend further
+  const std::string soft = evidence("mullins", s);
+  EXPECT_TRUE(says(soft, "the later trials bend further than modelled")) << soft;
+  EXPECT_TRUE(says(soft, "the signature of softening")) << soft;
+  s.first_vs_rest = -0.25;
+  const std::string opposite = evidence("mullins", s);
+  EXPECT_TRUE(says(opposite, "the opposite of softening")) << opposite;
+  EXPECT_FALSE(says(opposite, "the signature of softening")) << opposite;
+  s.first_vs_rest = 0.01, s.noise_deg = 0.05;
+  EXPECT_TRUE(says(evidence("mullins", s), "no sign of softening")) << evidence("mullins", s);
+}
+
+TEST(Evidence, LagOffsetAndProportionalErrorFollowTheirNumbers) {
+  Signature s = trials(0.3, 0.3);
+  s.early_deg = 0.8, s.late_deg = 0.1;
+  EXPECT_TRUE(says(evidence("pressure_lag", s), "concentrates right after each pressure step")) << evidence("pressure_lag", s);
+  s.early_deg = -0.1, s.late_deg = 0.8;  // larger after the mark, whatever the signs
+  EXPECT_TRUE(says(evidence("pressure_lag", s), "smaller right after the pressure steps")) << evidence("pressure_lag", s);
+  s.early_deg = 0.12, s.late_deg = -0.10, s.noise_deg = 0.05;
+  EXPECT_TRUE(says(evidence("pressure_lag", s), "no larger right after the pressure steps")) << evidence("pressure_lag", s);
+
+  s.noise_deg = 0.0;
+  s.rest_deg = 0.6;
+  EXPECT_TRUE(says(evidence("gravity", s), "lies above the measured one (mean residual +0.60 deg at 0 kPa)")) << evidence("gravity", s);
+  s.rest_deg = -0.6;
+  EXPECT_TRUE(says(evidence("gravity", s), "lies below the measured one (mean residual -0.60 deg")) << evidence("gravity", s);
+  s.rest_deg = 0.002;
+  EXPECT_TRUE(says(evidence("gravity", s), "matches the measured angle")) << evidence("gravity", s);
+
+  s.proportional = 0.83;
+  EXPECT_TRUE(says(evidence("stiffness", s), "the error rises with the angle (correlation")) << evidence("stiffness", s);
+  s.proportional = -0.83;
+  EXPECT_TRUE(says(evidence("stiffness", s), "the error falls with the angle")) << evidence("stiffness", s);
+  s.proportional = 0.2;
+  EXPECT_TRUE(says(evidence("stiffness", s), "barely follows the angle")) << evidence("stiffness", s);
+}
+
+}  // namespace
+}  // namespace pneufem::diagnose_detail
