@@ -24,7 +24,9 @@ class Scene {
   static const std::string& default_text();
 
   /// Typed access to a dotted key of the resolved scene. Throws InputError naming the key and
-  /// where it was set when it is missing or has the wrong type.
+  /// where it was set when it is missing or has the wrong type. Every number read (number,
+  /// numbers, vec3) must be finite, every integer a TOML integer that fits an int, and a key with a
+  /// declared range (scenes/key_limits.h) must lie in it: the error gives the value and the range.
   double number(const std::string& key) const;
   int integer(const std::string& key) const;
   bool boolean(const std::string& key) const;
@@ -63,6 +65,10 @@ class Scene {
   Scene with(const std::vector<std::string>& overrides) const;
 
  private:
+  /// `v`, read from `key` (`entry` names a list's element in the message), if it is finite and in
+  /// the key's declared range; else a failure with the value and the range.
+  double checked(const std::string& key, double v, const std::string& entry) const;
+
   struct Impl;
   std::shared_ptr<const Impl> impl_;
   std::string path_;
