@@ -301,8 +301,11 @@ void assign_parts(const Scene& s, Model& model, bool membrane_fabric) {
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
     }
     if (membrane_fabric && els->empty()) continue;  // FABRIC is empty: the fabric is the membrane
-    const double density = s.number("materials." + mat + ".density_kg_m3");
-    model.parts.push_back(Part{elset, make_material(s, mat), density});
+    // The material first: it names what is wrong with its table (an unknown model, a missing
+    // constant) before the density is read from it.
+    MaterialPtr material = make_material(s, mat);
+    const double density = positive(s, "materials." + mat + ".density_kg_m3");
+    model.parts.push_back(Part{elset, std::move(material), density});
     const int part = static_cast<int>(model.parts.size()) - 1;
     // Elements of a region with a stiffness scale != 1 get their own part "ELSET@region" (same
     // material, scaled); each part's material sets its own state layout, so assembly is unchanged.
