@@ -227,7 +227,7 @@ std::string Scene::origin(const std::string& key) const {
 }
 
 void Scene::fail(const std::string& key, const std::string& what) const {
-  throw InputError(origin(key) + ": key '" + key + "': " + what);
+  throw SceneKeyError(origin(key) + ": key '" + key + "': " + what);
 }
 
 double Scene::checked(const std::string& key, double v, const std::string& entry) const {

@@ -12,7 +12,16 @@
 
 #include <Eigen/Core>
 
+#include "core/errors.h"
+
 namespace pneufem {
+
+/// An InputError that already names its scene key and where the key was set (Scene::fail): code
+/// that adds context to the errors of a law or an effect passes it on unchanged.
+class SceneKeyError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 class Scene {
  public:
@@ -43,7 +52,7 @@ class Scene {
   int array_size(const std::string& key) const;
   /// Where a key was set: "scene.toml:12", "--set", or "default scene".
   std::string origin(const std::string& key) const;
-  /// InputError prefixed with the key's origin.
+  /// SceneKeyError (an InputError) prefixed with the key's origin.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
 
   /// Resolves a path given in the scene relative to the scene file's directory.
