@@ -587,6 +587,9 @@ LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, d
       const int trial = std::stoi(f[ct]);
       const double t = std::stod(f[cs], &used);
       const double p = std::stod(f[cp]);
+      if (!std::isfinite(t) || !std::isfinite(p))  // stod reads "inf" and "nan"
+        throw InputError(path + ":" + std::to_string(lineno) + ": time_s and pressure_kPa must be finite numbers, got '" +
+                         line + "'");
       auto& [ts, ps] = data[trial];
       if (!ts.empty() && t <= ts.back())
         throw InputError(path + ":" + std::to_string(lineno) + ": time_s must increase within a trial");

@@ -89,6 +89,17 @@ TEST(KeyLimits, AProtocolOfTooManyReportsIsRefusedWithTheCount) {
               AllOf(HasSubstr("--set load.output_every_s"), HasSubstr("reports")));
 }
 
+// A pressure file is a scene's input too. Old: "nan" and "inf" were read as times and pressures (a
+// nan time passed the check that times increase).
+TEST(KeyLimits, APressureFileOfInfOrNanIsAnError) {
+  const std::filesystem::path csv = std::filesystem::temp_directory_path() / "pneufem_key_limits_nan.csv";
+  for (const char* row : {"1,nan,5", "1,3,inf"}) {
+    std::ofstream(csv) << "trial,time_s,pressure_kPa\n1,0,0\n" << row << "\n";
+    EXPECT_THAT(error_of([&] { pressure_history_from_csv(csv.string(), 0.25, 0.0); }),
+                AllOf(HasSubstr(csv.string() + ":3:"), HasSubstr("finite"))) << row;
+  }
+}
+
 // Old: K_over_mu = 1e12 built a model whose tangent had lost every digit; 1e-3 a foam no elastomer is.
 TEST(KeyLimits, AnAbsurdBulkRatioIsAnError) {
   for (const char* v : {"1e12", "0.001"}) {
