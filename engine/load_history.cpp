@@ -5,6 +5,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/number_text.h"
 #include "materials/errors.h"
 
 namespace pneufem {
@@ -20,18 +21,35 @@ double TrialLoad::pressure(double t) const {
   return (1.0 - w) * pressure_Pa[i - 1] + w * pressure_Pa[i];
 }
 
+StaircaseSize staircase_size(double p_max, double dp, double hold_s, int trials, double output_every_s) {
+  StaircaseSize z;
+  z.levels = std::floor(p_max / dp + 1e-9) + 1.0;  // 1e-9: 45/5 is 9 even when the division rounds below
+  const double extra = output_every_s > 0.0 ? std::ceil(hold_s / output_every_s) : 0.0;
+  z.reports = static_cast<double>(trials) * z.levels * (2.0 + extra);  // the mark, the end, the extras
+  return z;
+}
+
 LoadHistory staircase(double p_max, double dp, double hold_s, double ramp_s, int trials, double mark_s,
                       double rest_s, double output_every_s) {
   auto bad = [](const std::string& key, const std::string& what) {
     throw InputError("load." + key + ": " + what);
   };
-  if (!(dp > 0)) bad("step_kPa", "must be > 0");
-  if (!(p_max >= 0)) bad("max_kPa", "must be >= 0");
-  if (!(hold_s > 0)) bad("hold_s", "must be > 0");
+  if (!(std::isfinite(dp) && dp > 0)) bad("step_kPa", "must be > 0");
+  if (!(std::isfinite(p_max) && p_max >= 0)) bad("max_kPa", "must be >= 0");
+  if (!(std::isfinite(hold_s) && hold_s > 0)) bad("hold_s", "must be > 0");
   if (!(ramp_s >= 0 && ramp_s < hold_s)) bad("ramp_s", "must be >= 0 and shorter than hold_s");
   if (trials < 1) bad("trials", "must be >= 1");
   if (!(mark_s >= ramp_s && mark_s <= hold_s)) bad("mark_s", "must lie within the hold, after the ramp");
-  const int nlev = static_cast<int>(std::floor(p_max / dp + 1e-9)) + 1;
+  if (!(std::isfinite(rest_s) && rest_s >= 0)) bad("rest_s", "must be >= 0");
+  if (!(std::isfinite(output_every_s) && output_every_s >= 0)) bad("output_every_s", "must be >= 0 (0 = off)");
+  const StaircaseSize size = staircase_size(p_max, dp, hold_s, trials, output_every_s);
+  if (!(size.levels <= kMaxStaircaseLevels))
+    bad("step_kPa", "gives " + short_num(size.levels) + " levels up to max_kPa; the limit is " +
+                        short_num(kMaxStaircaseLevels) + "; use a larger step");
+  if (!(size.reports <= kMaxReports))
+    bad("output_every_s", "the protocol would make " + short_num(size.reports) + " reports; the limit is " +
+                              short_num(kMaxReports) + "; report less often or run fewer trials");
+  const int nlev = static_cast<int>(size.levels);  // <= kMaxStaircaseLevels: the cast is exact
   TrialLoad tl;
   double prev = 0.0;
   tl.time_s.push_back(0.0);

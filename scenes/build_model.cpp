@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 #include "materials/hyperelastic.h"
 #include "materials/scaled.h"
 #include "scenes/angle_frame.h"
@@ -300,8 +301,11 @@ void assign_parts(const Scene& s, Model& model, bool membrane_fabric) {
       s.fail(key + ".elset", "element set '" + elset + "' not found in the mesh; available: " + avail);
     }
     if (membrane_fabric && els->empty()) continue;  // FABRIC is empty: the fabric is the membrane
-    const double density = s.number("materials." + mat + ".density_kg_m3");
-    model.parts.push_back(Part{elset, make_material(s, mat), density});
+    // The material first: it names what is wrong with its table (an unknown model, a missing
+    // constant) before the density is read from it.
+    MaterialPtr material = make_material(s, mat);
+    const double density = positive(s, "materials." + mat + ".density_kg_m3");
+    model.parts.push_back(Part{elset, std::move(material), density});
     const int part = static_cast<int>(model.parts.size()) - 1;
     // Elements of a region with a stiffness scale != 1 get their own part "ELSET@region" (same
     // material, scaled); each part's material sets its own state layout, so assembly is unchanged.
@@ -447,14 +451,33 @@ LoadHistory inlet_load(const Scene& s) {
   LoadHistory load;
   const std::string protocol = s.string("load.protocol");
   if (protocol == "staircase") {
-    load = staircase(s.number("load.max_kPa") * kkPa, s.number("load.step_kPa") * kkPa, s.number("load.hold_s"),
-                     s.number("load.ramp_s"), s.integer("load.trials"), s.number("load.mark_s"), s.number("load.rest_s"),
-                     s.number("load.output_every_s"));
+    const double p_max = s.number("load.max_kPa") * kkPa, dp = s.number("load.step_kPa") * kkPa;
+    const double hold_s = s.number("load.hold_s"), every_s = s.number("load.output_every_s");
+    const int trials = s.integer("load.trials");
+    // The size first, so that the key and where it was set are named (staircase() checks it too).
+    const StaircaseSize size = staircase_size(p_max, dp, hold_s, trials, every_s);
+    if (size.levels > kMaxStaircaseLevels)
+      s.fail("load.step_kPa", "gives " + short_num(size.levels) + " pressure levels up to load.max_kPa = " +
+                                  short_num(p_max / kkPa) + " kPa; the limit is " + short_num(kMaxStaircaseLevels) +
+                                  " (each level is a solve); use a larger step");
+    if (size.reports > kMaxReports)
+      s.fail(every_s > 0.0 ? "load.output_every_s" : "load.trials",
+             "the protocol would make " + short_num(size.reports) + " reports (" + std::to_string(trials) + " trial(s) x " +
+                 short_num(size.levels) + " levels x " + short_num(size.reports / (trials * size.levels)) +
+                 " per level); the limit is " + short_num(kMaxReports) +
+                 "; report less often (load.output_every_s) or run fewer trials");
+    load = staircase(p_max, dp, hold_s, s.number("load.ramp_s"), trials, s.number("load.mark_s"),
+                     s.number("load.rest_s"), every_s);
   } else if (protocol == "csv") {
     const std::string csv = s.string("load.csv");
     if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
-    load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
-    if (s.number("load.rest_s") > 0) load.rest_between_trials_s = s.number("load.rest_s");
+    try {
+      load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+    } catch (const InputError& e) {
+      if (std::string(e.what()).find("load.output_every_s") == std::string::npos) throw;
+      s.fail("load.output_every_s", e.what());
+    }
+    load.rest_between_trials_s = s.number("load.rest_s");
   } else {
     s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
   }
@@ -564,6 +587,9 @@ LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, d
       const int trial = std::stoi(f[ct]);
       const double t = std::stod(f[cs], &used);
       const double p = std::stod(f[cp]);
+      if (!std::isfinite(t) || !std::isfinite(p))  // stod reads "inf" and "nan"
+        throw InputError(path + ":" + std::to_string(lineno) + ": time_s and pressure_kPa must be finite numbers, got '" +
+                         line + "'");
       auto& [ts, ps] = data[trial];
       if (!ts.empty() && t <= ts.back())
         throw InputError(path + ":" + std::to_string(lineno) + ": time_s must increase within a trial");
@@ -577,6 +603,7 @@ LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, d
   }
   if (data.empty()) throw InputError(path + ": no pressure samples found");
   LoadHistory h;
+  double reports = 0.0;  // the extra reports of output_every_s so far, against kMaxReports
   for (auto& [trial, tp] : data) {
     auto& [ts, ps] = tp;
     const std::vector<char> keep = rdp_keep(ts, ps, tol_kPa);
@@ -588,8 +615,13 @@ LoadHistory pressure_history_from_csv(const std::string& path, double tol_kPa, d
         tl.pressure_Pa.push_back(ps[i] * kkPa);
       }
     tl.output_s = tl.time_s;
-    if (output_every_s > 0)
+    if (output_every_s > 0) {
+      reports += std::ceil(tl.duration() / output_every_s);
+      if (!(reports <= kMaxReports))
+        throw InputError("load.output_every_s = " + short_num(output_every_s) + " s would make more than " +
+                         short_num(kMaxReports) + " reports over the trials of " + path + " (the limit); report less often");
       for (double t = output_every_s; t < tl.duration(); t += output_every_s) tl.output_s.push_back(t);
+    }
     std::sort(tl.output_s.begin(), tl.output_s.end());
     h.trials.push_back(std::move(tl));
   }

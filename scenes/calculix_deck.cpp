@@ -26,6 +26,10 @@ void write_nset(std::ostringstream& os, const std::string& name, const std::vect
 void write_material(std::ostringstream& os, const Scene& s, const std::string& name, const std::string& ccx_name) {
   const std::string T = "materials." + name;
   const std::string model = s.string(T + ".model");
+  // The model first: an unknown one is named as such, not as a constant it lacks.
+  if (model != "linear_elastic" && model != "yeoh" && model != "neo_hookean" && model != "mooney_rivlin" && model != "ogden")
+    s.fail(T + ".model", "\"" + model + "\" cannot be exported to CalculiX (linear_elastic, yeoh, neo_hookean, "
+                         "mooney_rivlin or ogden can)");
   os << "*MATERIAL, NAME=" << ccx_name << "\n";
   if (model == "linear_elastic") {
     os << "*ELASTIC\n" << g(s.number(T + ".E_MPa")) << ", " << g(s.number(T + ".nu")) << "\n";

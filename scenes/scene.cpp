@@ -1,6 +1,9 @@
 #include "scenes/scene.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -10,8 +13,10 @@
 #include <toml++/toml.h>
 
 #include "core/errors.h"
+#include "core/number_text.h"
 #include "scenes/default_scene_text.h"
 #include "scenes/effect_tables.h"
+#include "scenes/key_limits.h"
 
 namespace pneufem {
 
@@ -222,21 +227,42 @@ std::string Scene::origin(const std::string& key) const {
 }
 
 void Scene::fail(const std::string& key, const std::string& what) const {
-  throw InputError(origin(key) + ": key '" + key + "': " + what);
+  throw SceneKeyError(origin(key) + ": key '" + key + "': " + what);
+}
+
+double Scene::checked(const std::string& key, double v, const std::string& entry) const {
+  if (!std::isfinite(v)) fail(key, "got " + short_num(v) + entry + "; a value must be a finite number");
+  const KeyLimit* limit = find_key_limit(key);
+  if (limit && !limit->contains(v))
+    fail(key, "got " + short_num(v) + entry + "; allowed: " + limit->range_text() + " (" + limit->why + ")");
+  return v;
 }
 
 double Scene::number(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
   if (!n) fail(key, "missing");
-  if (auto v = n->value<double>(); v && (n->is_floating_point() || n->is_integer())) return *v;
-  fail(key, "expected a number");
+  const std::optional<double> v = n->value<double>();
+  if (!v || !(n->is_floating_point() || n->is_integer())) fail(key, "expected a number");
+  return checked(key, *v, "");
 }
 
 int Scene::integer(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
   if (!n) fail(key, "missing");
-  if (!n->is_integer()) fail(key, "expected an integer");
-  return static_cast<int>(*n->value<std::int64_t>());
+  if (!n->is_integer()) {
+    const std::optional<double> v = n->value<double>();
+    fail(key, "expected an integer (no decimal point or exponent)" + (v ? ", got " + short_num(*v) : std::string()));
+  }
+  const std::int64_t v = *n->value<std::int64_t>();
+  const KeyLimit* limit = find_key_limit(key);
+  // Without a declared range an integer key must still fit the int it is read into (a wider value
+  // would wrap: 4294967299 read as 3).
+  const double lo = limit ? limit->lo : std::numeric_limits<int>::min();
+  const double hi = limit ? limit->hi : std::numeric_limits<int>::max();
+  if (static_cast<double>(v) < lo || static_cast<double>(v) > hi)
+    fail(key, "got " + std::to_string(v) + "; allowed: integers " + (limit ? limit->range_text() : "that fit in 32 bits") +
+                  (limit ? " (" + limit->why + ")" : std::string()));
+  return static_cast<int>(v);
 }
 
 bool Scene::boolean(const std::string& key) const {
@@ -262,7 +288,7 @@ std::vector<double> Scene::numbers(const std::string& key) const {
   for (auto&& e : *a) {
     auto v = e.value<double>();
     if (!v || !(e.is_floating_point() || e.is_integer())) fail(key, "expected an array of numbers");
-    out.push_back(*v);
+    out.push_back(checked(key, *v, " (entry " + std::to_string(out.size() + 1) + ")"));
   }
   return out;
 }

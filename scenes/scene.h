@@ -12,7 +12,16 @@
 
 #include <Eigen/Core>
 
+#include "core/errors.h"
+
 namespace pneufem {
+
+/// An InputError that already names its scene key and where the key was set (Scene::fail): code
+/// that adds context to the errors of a law or an effect passes it on unchanged.
+class SceneKeyError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 class Scene {
  public:
@@ -24,7 +33,9 @@ class Scene {
   static const std::string& default_text();
 
   /// Typed access to a dotted key of the resolved scene. Throws InputError naming the key and
-  /// where it was set when it is missing or has the wrong type.
+  /// where it was set when it is missing or has the wrong type. Every number read (number,
+  /// numbers, vec3) must be finite, every integer a TOML integer that fits an int, and a key with a
+  /// declared range (scenes/key_limits.h) must lie in it: the error gives the value and the range.
   double number(const std::string& key) const;
   int integer(const std::string& key) const;
   bool boolean(const std::string& key) const;
@@ -41,7 +52,7 @@ class Scene {
   int array_size(const std::string& key) const;
   /// Where a key was set: "scene.toml:12", "--set", or "default scene".
   std::string origin(const std::string& key) const;
-  /// InputError prefixed with the key's origin.
+  /// SceneKeyError (an InputError) prefixed with the key's origin.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
 
   /// Resolves a path given in the scene relative to the scene file's directory.
@@ -63,6 +74,10 @@ class Scene {
   Scene with(const std::vector<std::string>& overrides) const;
 
  private:
+  /// `v`, read from `key` (`entry` names a list's element in the message), if it is finite and in
+  /// the key's declared range; else a failure with the value and the range.
+  double checked(const std::string& key, double v, const std::string& entry) const;
+
   struct Impl;
   std::shared_ptr<const Impl> impl_;
   std::string path_;

@@ -160,8 +160,10 @@ MaterialPtr make_base_material(const Scene& s, const std::string& name) {
       }
       return std::make_shared<Ogden>(mu, alpha, bulk_from_ratio(mu0, Kr));
     }
+  } catch (const SceneKeyError&) {
+    throw;  // names its key already
   } catch (const InputError& e) {
-    s.fail(T, e.what());
+    s.fail(T, e.what());  // the law's error, with the table it came from
   }
   s.fail(T + ".model", "unknown material model \"" + model +
                            "\"; use yeoh, neo_hookean, mooney_rivlin, ogden or linear_elastic");
@@ -197,6 +199,8 @@ MaterialPtr make_material(const Scene& s, const std::string& name, double region
   MaterialPtr m = make_base_material(s, name);
   try {
     m = scale_material(std::move(m), material_scale(s, name) * region_scale);
+  } catch (const SceneKeyError&) {
+    throw;
   } catch (const InputError& err) {
     s.fail(T + ".stiffness_scale", err.what());
   }

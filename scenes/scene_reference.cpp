@@ -6,8 +6,10 @@
 
 #include "core/json_writer.h"
 #include "damage/registry.h"
+#include "engine/load_history.h"
 #include "scenes/default_scene_text.h"
 #include "scenes/effect_tables.h"
+#include "scenes/key_limits.h"
 
 namespace pneufem {
 
@@ -68,6 +70,10 @@ class Writer {
     open_rows("| key | default | unit | calibration range | meaning |\n|---|---|---|---|---|\n");
     out_ << "| `" << key << "` | `" << cell(value) << "` | " << unit << " | " << range << " | " << cell(meaning);
   }
+  void limit_row(const std::string& pattern, const std::string& range, const std::string& why) {
+    open_rows("| key | allowed | why |\n|---|---|---|\n");
+    out_ << "| `" << pattern << "` | " << cell(range) << " | " << cell(why);
+  }
   /// An indented comment line: continues the last row's meaning, or the table's description.
   void continue_text(const std::string& more) {
     if (row_open_)
@@ -125,6 +131,20 @@ void effect_sections(Writer& w, const std::string& material_table) {
   w.close_rows();
 }
 
+/// The ranges of scenes/key_limits.h, which every read of a numeric key checks.
+void limits_section(Writer& w) {
+  w.prose("## Allowed ranges");
+  w.prose("Every number of a scene must be finite (no inf or nan) and every integer key a TOML integer (no "
+          "decimal point or exponent) that fits 32 bits. The keys below must also lie in their range; a value "
+          "outside is an error naming the key, where it was set, the value and the range (declared once, in "
+          "scenes/key_limits.cpp). Checks that relate keys come on top: load.ramp_s < load.hold_s, at most " +
+          json::num(kMaxStaircaseLevels) + " pressure levels and " + json::num(kMaxReports) +
+          " reports per run (engine/load_history.h), the mesher's cell limit, and each law's and effect's own "
+          "physics (C10 > 0, Mullins r > 1, ...).");
+  for (const KeyLimit& l : key_limits()) w.limit_row(l.pattern, l.range_text(), l.why);
+  w.close_rows();
+}
+
 }  // namespace
 
 std::string unit_of_key(const std::string& key) {
@@ -169,6 +189,7 @@ std::string scene_reference_markdown() {
     }
   }
   flush_paragraph();
+  limits_section(w);
   return "# Scene reference\n\n"
          "Every key of a pneufem scene with its default, its unit and what it means. A scene file holds only the "
          "keys it changes; `--set key=value` overrides any of them; units are part of the key names and pneufem "

@@ -31,7 +31,8 @@ std::unique_ptr<SimulateCommand> add_simulate_command(CLI::App& app) {
       ->check(CLI::Range(1, 1024));
   sim->add_option("--resume", c->resume_dir,
                   "Continue a killed run in this directory from its checkpoint (uses its scene.toml; the final "
-                  "results equal an uninterrupted run)");
+                  "results equal an uninterrupted run). A checkpoint of another scene, mesh, protocol or build, "
+                  "or a damaged one, is refused; a fresh simulate into the directory removes it");
   sim->add_option("--checkpoint-every", c->checkpoint_every_s, "Wall-clock seconds between checkpoints (0 = after every segment)")
       ->check(CLI::NonNegativeNumber);
   sim->add_option("--abort-after-checkpoints", c->abort_after_checkpoints, "Testing aid: exit abruptly after N checkpoints")

@@ -11,6 +11,7 @@
 #include <tbb/info.h>
 
 #include "analysis/paper_metrics.h"
+#include "app/simulate/checkpoint_file.h"
 #include "app/simulate/ideal_cache.h"
 #include "app/simulate/reduced.h"
 #include "core/atomic_file.h"
@@ -154,6 +155,17 @@ AppCheckpoint read_app_section(std::istream& is) {
   return a;
 }
 
+/// For --resume DIR: DIR must hold a run with a checkpoint; else an InputError saying why there is
+/// nothing to resume and what to do.
+void require_checkpoint(const fs::path& dir, const std::string& name) {
+  if (fs::exists(dir / "checkpoint.bin")) return;
+  if (!fs::exists(dir / "scene.toml"))
+    throw InputError("--resume " + name + ": not a run directory (no scene.toml and no checkpoint.bin); give the --out "
+                     "directory of the run to continue");
+  throw InputError("--resume " + name + ": nothing to resume: no checkpoint.bin (the run stopped or ended before its "
+                   "first checkpoint); run it again: pneufem simulate " + name + "/scene.toml --out " + name);
+}
+
 /// Quasi-static run of a scene with no outputs (the ideal model of the metrics).
 std::vector<StateRecord> records_of(const Scene& scene) {
   std::unique_ptr<BuiltModel> bm = build_model(scene);
@@ -216,9 +228,8 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
   const fs::path dir(opt.out_dir);
+  if (opt.resume) require_checkpoint(dir, opt.out_dir);
   const Scene scene = opt.resume ? Scene::load((dir / "scene.toml").string()) : scene_arg;
-  if (opt.resume && !fs::exists(dir / "checkpoint.bin"))
-    throw InputError("--resume " + opt.out_dir + ": no checkpoint.bin there (was the run started with this directory?)");
   fs::create_directories(dir);
   if (!fs::is_directory(dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
 
@@ -226,7 +237,21 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   std::unique_ptr<BuiltModel> bm = build_model(scene);
   const Assembler asmb(bm->model);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
-  if (!opt.resume) write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
+  if (!opt.resume) {
+    // A fresh run starts over: an earlier run's checkpoint goes before this run's scene.toml
+    // replaces that run's, so no later --resume can pair them.
+    if (fs::exists(dir / "checkpoint.bin")) {
+      fs::remove(dir / "checkpoint.bin");
+      const std::string note = "removed checkpoint.bin of an earlier run in " + opt.out_dir +
+                               " (a fresh run starts over; simulate --resume DIR continues a killed run)";
+      std::fprintf(stderr, "note: %s\n", note.c_str());
+      bm->warnings.push_back(note);
+    }
+    write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
+  }
+  const RunIdentity identity = run_identity(scene, bm->model, bm->load);
+  const std::string resume_body =  // checked now, before any work
+      opt.resume ? read_checkpoint_body(dir / "checkpoint.bin", identity, opt.out_dir) : std::string();
 
   const bool reduced = bm->solver.mode == SolverSettings::Mode::QuasiStatic && bm->solver.model == SolverSettings::Model::Reduced;
   if (reduced && opt.resume) throw InputError("--resume: reduced-model runs have no checkpoints; start the run again");
@@ -285,7 +310,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   AppCheckpoint app;
   std::unique_ptr<QuasiStaticCheckpoint> resume_from;
   if (opt.resume) {
-    std::ifstream in(dir / "checkpoint.bin", std::ios::binary);
+    std::istringstream in(resume_body, std::ios::binary);
     resume_from = std::make_unique<QuasiStaticCheckpoint>(
         QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
     app = read_app_section(in);
@@ -319,7 +344,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
     std::ostringstream os(std::ios::binary);
     c.write(os);
     write_app_section(os, app);
-    write_file_atomic((dir / "checkpoint.bin").string(), os.str());
+    write_file_atomic((dir / "checkpoint.bin").string(), checkpoint_file_text(identity, os.str()));
     write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
     last_ckpt = std::chrono::steady_clock::now();
     if (opt.abort_after_checkpoints >= 0 && ++checkpoints >= opt.abort_after_checkpoints) std::_Exit(137);

@@ -9,7 +9,9 @@
 //   summary.json      version, status, resolved scene, mesh and solver statistics, timings
 //   scene.toml        the fully resolved scene (re-runnable as is; --resume reads it)
 //   results.pvd + vtu/state_NNNN.vtu   fields for ParaView
-//   checkpoint.bin    the full state at the last checkpoint (quasi-static runs of the full FEM)
+//   checkpoint.bin    the full state at the last checkpoint (quasi-static runs of the full FEM),
+//                     with the hashes of the run it belongs to and a checksum
+//                     (app/simulate/checkpoint_file.h); a fresh run removes an earlier one
 //   reduced_check.csv solver.model = "reduced": each report's estimated angle error (the full
 //                     residual of the reconstructed state, weighted by the angle's adjoint)
 // Every file is written atomically (temporary file + rename).
@@ -46,7 +48,8 @@ struct RunResult {
 
 /// Runs the scene and writes the run directory. Physics failures are recorded in summary.json
 /// (status) and rethrown after the outputs so far are safely on disk. With options.resume the
-/// scene argument is ignored and out_dir/scene.toml is used.
+/// scene argument is ignored and out_dir/scene.toml is used; a missing, damaged or foreign
+/// checkpoint (another scene, mesh, protocol or build) is an InputError before any work.
 RunResult run_simulation(const Scene& scene, const RunOptions& options);
 
 }  // namespace pneufem

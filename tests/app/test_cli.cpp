@@ -114,6 +114,50 @@ TEST(Cli, KilledRunResumesToTheUninterruptedResult) {
   }
 }
 
+// Issue 30 item 1: a resume never mixes two runs. Before, a changed scene killed before its first
+// checkpoint resumed from the old run's checkpoint and exited 0 with a mixed result; a flipped bit
+// resumed silently; a directory without a checkpoint said only "no checkpoint.bin there".
+TEST(Cli, ResumeNeverMixesRuns) {
+  const fs::path a = fresh_dir("mix_a"), b = fresh_dir("mix_b");
+  const std::string kill = " --checkpoint-every 0 --abort-after-checkpoints 1";
+  ASSERT_EQ(run("simulate --out " + a.string() + " " + kTiny + kill).code, 137);
+  ASSERT_EQ(run("simulate --out " + b.string() + " " + kTiny + " --set load.hold_s=12.0" + kill).code, 137);
+  const std::string checkpoint = slurp(a / "checkpoint.bin"), scene = slurp(a / "scene.toml");
+  auto write = [](const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; };
+
+  // A flipped bit anywhere (here: in the middle of the state) is an error, not a silent resume.
+  std::string flipped = checkpoint;
+  flipped[flipped.size() / 2] ^= 0x10;
+  write(a / "checkpoint.bin", flipped);
+  Result r = run("simulate --resume " + a.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("damaged (its checksum does not match"), std::string::npos) << r.out;
+  write(a / "checkpoint.bin", checkpoint);
+
+  // Another run's scene.toml beside the checkpoint (what a changed scene killed before its first
+  // checkpoint left behind before a fresh run removed old checkpoints): refused, naming the scene.
+  write(a / "scene.toml", slurp(b / "scene.toml"));
+  r = run("simulate --resume " + a.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("belongs to another run: its scene differs"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run it again: pneufem simulate " + a.string() + "/scene.toml"), std::string::npos) << r.out;
+  write(a / "scene.toml", scene);
+  r = run("simulate --resume " + a.string());  // its own scene: resumes
+  EXPECT_EQ(r.code, 0) << r.out;
+
+  // A fresh run into a directory with an old checkpoint removes it, with a note; its own run here
+  // ends before any checkpoint, so there is then nothing to resume.
+  write(b / "checkpoint.bin", checkpoint);
+  r = run("simulate --out " + b.string() + " " + kTiny + " --checkpoint-every 1e6");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("note: removed checkpoint.bin of an earlier run"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(b / "checkpoint.bin"));
+  r = run("simulate --resume " + b.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("nothing to resume"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run it again"), std::string::npos) << r.out;
+}
+
 // diagnose --cache on the command line: the second run reads the elastic path the first stored and
 // writes the same diagnosis; a cache directory that cannot be made is bad input (exit 2, nothing
 // written). (The cache itself: tests/app/simulate/test_result_cache.cpp, DiagnoseCache in

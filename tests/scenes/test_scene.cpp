@@ -158,6 +158,15 @@ TEST(SceneErrors, UnknownMaterialKeyAndModel) {
   EXPECT_NE(error_of([&] { make_material(s2, "silicone"); }).find("unknown material model"), std::string::npos);
 }
 
+// Issue 30 item 5: a part's unknown material model is named as such; it used to be reported as a
+// missing density (the part read the density before building the material, and a table whose model
+// changes starts empty).
+TEST(SceneErrors, UnknownMaterialModelOfAPartIsNotReportedAsAMissingDensity) {
+  const std::string msg = error_of([] { build_model(Scene::load("", {"materials.silicone.model=\"gent\"", "mesh.h_mm=8.0"})); });
+  EXPECT_NE(msg.find("unknown material model \"gent\""), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("density"), std::string::npos) << msg;
+}
+
 TEST(SceneErrors, MissingSetInPartsIsReported) {
   const Scene s = Scene::load("", {"parts=[{elset=\"SILICONE\", material=\"silicone\"}, {elset=\"CLOTH\", material=\"fabric\"}]",
                                    "mesh.h_mm=4.0"});
