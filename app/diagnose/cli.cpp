@@ -98,6 +98,10 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
     std::string bound;
     for (const std::string& n : k.at_bound) bound += (bound.empty() ? "  (at the edge of its range: " : ", ") + n;
     if (!bound.empty()) bound += ")";
+    if (!k.error.empty()) {  // a candidate that could not be calibrated has no numbers to show
+      std::printf("  round %d %-14s not calibrated: %s\n", k.round, k.effect.c_str(), k.error.c_str());
+      continue;
+    }
     std::printf("  round %d %-14s NRMSE %.4f  dAIC %10.1f  beyond static %.4f  %s%s\n", k.round, k.effect.c_str(), k.nrmse,
                 k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
   }

@@ -2,7 +2,8 @@
 // Expensive elastic results shared between runs through a cache directory.
 //
 // `pneufem diagnose` starts every run with static FEM work that depends only on the actuator and
-// the recording's peak pressure, not on the candidates or the rest of the recording: the elastic
+// the protocol's peak pressure (app/diagnose: elastic_reference_peak_Pa, so recordings of one
+// protocol with their own noise share it), not on the candidates or the rest of the recording: the elastic
 // path of the reduced model (a Newton trace of the calibration mesh) and, with a calibration mesh,
 // one static sweep of the scene's own mesh — 305 s of the default scene's 527 s — plus the static
 // curves of the gravity candidate (BENCHMARKS.md section 8, session 24). With `--cache DIR` the

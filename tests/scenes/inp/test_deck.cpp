@@ -561,7 +561,7 @@ TEST_F(InpFiles, TheAngleFrameComesFromTheMeshUnlessSetAndIsCheckedWhenSet) {
   EXPECT_NEAR((g_at("90.0") - Eigen::Vector3d(0.0, 0.0, -9.81)).norm(), 0.0, 1e-12);
   EXPECT_EQ(build_model(scene({}))->model.gravity_m_s2, Eigen::Vector3d::Zero());  // -1: off
   for (const auto& [sets, hint] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"gravity.rig_angle_deg=200.0"}, "must lie in [0, 180] deg"},
+           {{"gravity.rig_angle_deg=200.0"}, "allowed: >= -360 and <= 180"},  // the scene's checked read (scenes/key_limits.cpp)
            {{"gravity.rig_angle_deg=10.0", "gravity.g_m_s2=[0.0, 0.0, -9.81]"}, "both give gravity"}}) {
     try {
       build_model(scene(sets));
