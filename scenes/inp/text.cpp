@@ -25,10 +25,11 @@ namespace fs = std::filesystem;
 // inclusions, so the count of inclusions is bounded as well as the depth and the bytes.
 constexpr int kMaxIncludeDepth = 32;       // deeper nesting than any real deck; cycles are caught before it
 constexpr int kMaxIncludes = 10000;        // *INCLUDE lines followed per deck: a fan-out ends in well under 1 s
-constexpr std::uintmax_t kMaxDeckBytes = std::uintmax_t{1} << 30;  // 1 GiB of text, a file counted each
-                                           // time it is included: ~5x a deck of 10^6 C3D10 elements
+// All the text read, a file counted each time it is included, all of it in memory at once: 1 GiB
+// is ~5x a deck of 10^6 C3D10 elements, far beyond what the engine solves on one machine.
+constexpr std::uintmax_t kMaxDeckBytes = std::uintmax_t{1} << 30;
 
-/// "1.5 MiB", "2.0 GiB": a size in a message.
+/// "1.5 MiB", "1024.0 MiB": a size in a message.
 std::string mebibytes(std::uintmax_t bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
