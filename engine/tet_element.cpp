@@ -1,6 +1,7 @@
 #include "engine/tet_element.h"
 
 #include <Eigen/LU>
+#include <limits>
 #include <sstream>
 
 #include "materials/errors.h"
@@ -118,6 +119,45 @@ ElementGeometry compute_geometry(const Mesh& mesh) {
     }
   }
   return g;
+}
+
+Tet10Distortion tet10_distortion(const Mesh& mesh, int e) {
+  // The 10 nodes as (xi, eta, zeta) = (L1, L2, L3), in the C3D10 order of mesh.h.
+  static constexpr double kNodeAt[10][3] = {{0, 0, 0},     {1, 0, 0},     {0, 1, 0},   {0, 0, 1},     {.5, 0, 0},
+                                            {.5, .5, 0},   {0, .5, 0},    {0, 0, .5},  {.5, 0, .5},   {0, .5, .5}};
+  static constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+  const int* conn = mesh.element(e);
+  const double straight = 6.0 * corner_volume(mesh, e);  // det J of the straight-sided tetrahedron
+  double N[10], dN[30];
+  auto scaled_det = [&](const double* at) {
+    tet_shape(ElementType::Tet10, at[0], at[1], at[2], N, dN);
+    Eigen::Matrix3d Jm = Eigen::Matrix3d::Zero();
+    for (int a = 0; a < 10; ++a)
+      for (int i = 0; i < 3; ++i)
+        for (int d = 0; d < 3; ++d) Jm(i, d) += mesh.X[conn[a]][i] * dN[3 * a + d];
+    return Jm.determinant() / straight;
+  };
+  Tet10Distortion out;
+  out.min_scaled_jacobian = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 10; ++a) {
+    const double s = scaled_det(kNodeAt[a]);
+    if (s < out.min_scaled_jacobian) out = {s, a, 4, 0.0};
+  }
+  for (const QuadPoint& q : kTet10Rule) {
+    const double at[3] = {q.xi, q.eta, q.zeta};
+    const double s = scaled_det(at);
+    if (s < out.min_scaled_jacobian) out = {s, -1, 4, 0.0};
+  }
+  for (int k = 0; k < 6; ++k) {
+    const Eigen::Vector3d& xi = mesh.X[conn[kEdge[k][0]]];
+    const Eigen::Vector3d& xj = mesh.X[conn[kEdge[k][1]]];
+    const double offset = (mesh.X[conn[4 + k]] - 0.5 * (xi + xj)).norm() / (xj - xi).norm();
+    if (offset > out.mid_node_offset) {
+      out.mid_node_offset = offset;
+      out.farthest_mid_node = 4 + k;
+    }
+  }
+  return out;
 }
 
 }  // namespace pneufem

@@ -53,4 +53,19 @@ struct ElementGeometry {
 /// Throws InputError naming the element (external id) when a Jacobian is not positive.
 ElementGeometry compute_geometry(const Mesh& mesh);
 
+/// How far a quadratic tetrahedron's mid-nodes bend it away from the straight-sided tetrahedron on
+/// its corners, which a mesh read from a deck must bound (scenes/inp/reader.cpp).
+struct Tet10Distortion {
+  /// Smallest Jacobian determinant over the 10 nodes and the 4 integration points, relative to
+  /// the straight-sided tetrahedron's: 1 with every mid-node at its edge midpoint, 0 or less where
+  /// the element folds over itself (a mid-node a quarter of its edge off the midpoint, along it).
+  double min_scaled_jacobian = 1.0;
+  int at_node = -1;            ///< local node (0-based) of that minimum; -1 at an integration point
+  int farthest_mid_node = 4;   ///< local mid-node (4..9) farthest from its edge's midpoint
+  double mid_node_offset = 0;  ///< that distance divided by the edge's length
+};
+
+/// The distortion of Tet10 element e, whose corner tetrahedron must have a positive volume.
+Tet10Distortion tet10_distortion(const Mesh& mesh, int e);
+
 }  // namespace pneufem

@@ -12,6 +12,7 @@
 #include "app/compare/report.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/output_dir.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 
@@ -231,6 +232,7 @@ std::vector<RegionSensitivity> region_sensitivities(const Scene& scene, const Re
 CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   if (opt.out_dir.empty()) throw InputError("--out DIR is required");
+  check_output_dir(opt.out_dir, "--out");  // before anything is read or run: a bad --out fails now
   if (opt.data_path.empty()) throw InputError("--data FILE is required (canonical CSV trial,time_s,pressure_kPa,angle_deg)");
   Recording rec = opt.dlc_map_path.empty() ? read_measurements_csv(opt.data_path)
                                            : merge_deeplabcut(read_measurements_csv(opt.data_path), opt.dlc_map_path);
@@ -245,6 +247,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   const fs::path staging = dir.string() + ".vtu.tmp";
   std::error_code ec;
   fs::remove_all(staging, ec);
+  prepare_output_dir(opt.out_dir, "--out");  // the inputs are good: DIR exists before the model runs
   DriveOptions dopt;
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
@@ -269,8 +272,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
     throw;
   }
 
-  fs::create_directories(dir);
-  if (!fs::is_directory(dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
+  prepare_output_dir(opt.out_dir, "--out");  // again: it may have gone while the model ran
   // Move the worst-state VTUs into DIR/vtu (replacing an older set).
   fs::remove_all(dir / "vtu", ec);
   if (!r.drive.worst.empty()) {

@@ -26,6 +26,7 @@
 #include "app/diagnose/evaluator.h"
 #include "app/simulate/drive.h"
 #include "core/errors.h"
+#include "core/output_dir.h"
 #include "scenes/build_model.h"
 
 namespace pneufem {
@@ -195,12 +196,13 @@ double resolve_calibration_h(const Scene& scene, double requested_mm, std::vecto
 DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in) {
   const auto t0 = std::chrono::steady_clock::now();
   DiagnoseOptions opt = opt_in;
+  if (opt.out_dir.empty()) throw InputError("diagnose: --out DIR is required");
+  check_output_dir(opt.out_dir, "--out");  // before anything is read or fitted: a bad --out fails now
   {
     std::vector<std::string> notes;
     opt.calibration_h_mm = resolve_calibration_h(scene, opt_in.calibration_h_mm, notes);
     for (const std::string& n : notes) std::fprintf(stderr, "note: %s\n", n.c_str());
   }
-  if (opt.out_dir.empty()) throw InputError("diagnose: --out DIR is required");
   if (opt.max_effects < 1) throw InputError("diagnose: --max-effects must be >= 1");
   std::vector<const CandidateEffect*> cands;
   if (opt.candidates.empty())
@@ -233,6 +235,7 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
                        "comes from a deck (" + scene.string("mesh.file") + "): coarsen the deck itself, or omit --calibration-h");
     cal_scene = scene.with({"mesh.h_mm=" + fmt("%.17g", opt.calibration_h_mm)});
   }
+  prepare_output_dir(opt.out_dir, "--out");  // the inputs are good: DIR exists before the hours of fitting
   if (opt.progress)
     std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
                  opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");

@@ -16,6 +16,7 @@
 #include "app/simulate/reduced.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/output_dir.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "damage/registry.h"
@@ -230,8 +231,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const fs::path dir(opt.out_dir);
   if (opt.resume) require_checkpoint(dir, opt.out_dir);
   const Scene scene = opt.resume ? Scene::load((dir / "scene.toml").string()) : scene_arg;
-  fs::create_directories(dir);
-  if (!fs::is_directory(dir)) throw InputError("--out " + opt.out_dir + ": cannot create the directory");
+  prepare_output_dir(opt.out_dir, "--out");  // before the model is built: a bad --out fails now
 
   const auto t_build = std::chrono::steady_clock::now();
   std::unique_ptr<BuiltModel> bm = build_model(scene);

@@ -27,6 +27,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/output_dir.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "scenes/scene.h"
@@ -521,6 +522,7 @@ SweepResult run_sweep(const SweepOptions& o) {
     throw InputError("--threads-per-job " + std::to_string(o.threads_per_job) + ": must be at least 1");
   if (o.lhs < 0) throw InputError("--lhs " + std::to_string(o.lhs) + ": the number of samples must be at least 1");
   if (o.out_dir.empty() && !o.dry_run) throw InputError("--out DIR is required");
+  if (!o.dry_run) check_output_dir(o.out_dir, "--out");  // before anything is read or run: a bad --out fails now
 
   // The parameters, checked against the scene: existing numeric keys, each once.
   const Scene base = Scene::load(o.scene_path, o.sets);
@@ -582,8 +584,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   if (o.exe.empty()) throw std::logic_error("run_sweep: SweepOptions::exe (the pneufem binary) is not set");
 
   const fs::path out(o.out_dir);
-  fs::create_directories(out / "points");
-  if (!fs::is_directory(out)) throw InputError("--out " + o.out_dir + ": cannot create the directory");
+  prepare_output_dir((out / "points").string(), "--out");
   const DirLock lock(out);
   const std::string scene_abs = o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string();
 

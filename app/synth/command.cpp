@@ -14,6 +14,7 @@
 #include "app/diagnose/effect_catalog.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/output_dir.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "engine/assembly.h"
@@ -198,6 +199,7 @@ std::vector<std::string> parse_hidden(const std::string& spec) {
 SynthResult run_synth(const SynthOptions& o) {
   const auto wall0 = std::chrono::steady_clock::now();
   check(!o.out_csv.empty(), "--out", "give the output file, e.g. --out data.csv");
+  check_output_file(o.out_csv, "--out");  // before the model runs: a bad --out fails now
   check(o.pressure_rate_Hz > 0 && std::isfinite(o.pressure_rate_Hz), "--pressure-rate", "must be > 0 Hz");
   check(o.angle_rate_Hz > 0 && std::isfinite(o.angle_rate_Hz), "--angle-rate", "must be > 0 Hz");
   check(o.controller_hz > 0 && std::isfinite(o.controller_hz), "--controller-hz", "must be > 0 Hz");
@@ -334,7 +336,7 @@ SynthResult run_synth(const SynthOptions& o) {
 
   // Outputs.
   const fs::path out(o.out_csv);
-  if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  prepare_output_file(o.out_csv, "--out");  // its directory, checked before the model ran, is made now
   const fs::path stem = out.parent_path() / out.stem();
   res.data.source = out.string();
   res.truth.source = stem.string() + ".truth.csv";

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "engine/tet_element.h"
 #include "scenes/inp/reader.h"
 
 namespace pneufem {
@@ -21,6 +23,51 @@ bool constraint_keyword(const std::string& name) {
       "TIE", "COUPLING", "KINEMATIC COUPLING", "DISTRIBUTING COUPLING", "MPC", "EQUATION", "RIGID BODY",
       "CONTACT PAIR", "CONTACT", "CONTACT INCLUSIONS", "EMBEDDED ELEMENT", "SHELL TO SOLID COUPLING"};
   return constraints.count(name) != 0;
+}
+
+// A C3D10 whose Jacobian falls below this fraction of its straight-sided tetrahedron's anywhere
+// (nodes, integration points) is refused: at 0 it folds over itself (a mid-node a quarter of its
+// edge off the midpoint, along the edge) and near 0 its stiffness and stresses are meaningless.
+// 0.1 is Gmsh's own floor for curved elements (Mesh.HighOrderThresholdMin), so Gmsh's curved
+// meshes pass; straight-sided elements have 1.
+constexpr double kMinScaledJacobian = 0.1;
+
+/// "0.62": a ratio in a message.
+std::string ratio_text(double r) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", r);
+  return buf;
+}
+
+/// InputError naming the most distorted C3D10 of `mesh` (read from `deck`) and how many there are,
+/// when any falls below kMinScaledJacobian. Elements whose corners are inverted are left to the
+/// warning about them (and to the element kernels' own check).
+void refuse_distorted_tet10(const Mesh& mesh, const std::string& deck) {
+  if (mesh.type != ElementType::Tet10) return;
+  int distorted = 0;
+  int worst = -1;
+  Tet10Distortion worst_d;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    if (!(corner_volume(mesh, e) > 0.0)) continue;
+    const Tet10Distortion d = tet10_distortion(mesh, e);
+    if (!(d.min_scaled_jacobian >= kMinScaledJacobian)) {
+      ++distorted;
+      if (worst < 0 || d.min_scaled_jacobian < worst_d.min_scaled_jacobian) worst = e, worst_d = d;
+    }
+  }
+  if (distorted == 0) return;
+  static constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+  const int* n = mesh.element(worst);
+  const int k = worst_d.farthest_mid_node;
+  const std::string where = worst_d.at_node >= 0 ? "at its node " + mesh.node_name(n[worst_d.at_node])
+                                                 : "at an integration point";
+  throw InputError(deck + ": " + mesh.element_label(worst) + " is a C3D10 too distorted to compute: its Jacobian falls to " +
+                   ratio_text(worst_d.min_scaled_jacobian) + " of its straight-sided tetrahedron's " + where +
+                   " (at least " + ratio_text(kMinScaledJacobian) + " is needed), its mid-node " + mesh.node_name(n[k]) +
+                   " lying " + ratio_text(worst_d.mid_node_offset) + " edge lengths off the midpoint of edge " +
+                   mesh.node_name(n[kEdge[k - 4][0]]) + "-" + mesh.node_name(n[kEdge[k - 4][1]]) + "; " +
+                   std::to_string(distorted) +
+                   " element(s) are so. Move the mid-nodes to the edge midpoints (or curve the edges less) or remesh");
 }
 
 }  // namespace
@@ -381,6 +428,7 @@ void DeckReader::finish() {
     deck_.warnings.push_back(lines_.file_name(0) + ": " + std::to_string(inverted) +
                              " element(s) have zero or negative volume (first: element " +
                              mesh.element_name(first_inverted) + "); check the node order");
+  refuse_distorted_tet10(mesh, lines_.file_name(0));
   mesh.ensure_ids();
 }
 

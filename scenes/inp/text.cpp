@@ -6,6 +6,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -17,7 +19,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kMaxIncludeDepth = 32;
+// The limits that keep a deck's *INCLUDE graph finite and its text in memory (the lines are views
+// into the whole files, kept until the deck has been read). A deck split by Abaqus/CAE or by hand
+// nests a few files and includes tens; a file including the next twice, 24 deep, would mean 2^24
+// inclusions, so the count of inclusions is bounded as well as the depth and the bytes.
+constexpr int kMaxIncludeDepth = 32;       // deeper nesting than any real deck; cycles are caught before it
+constexpr int kMaxIncludes = 10000;        // *INCLUDE lines followed per deck: a fan-out ends in well under 1 s
+// All the text read, a file counted each time it is included, all of it in memory at once: 1 GiB
+// is ~5x a deck of 10^6 C3D10 elements, far beyond what the engine solves on one machine.
+constexpr std::uintmax_t kMaxDeckBytes = std::uintmax_t{1} << 30;
+
+/// "1.5 MiB", "1024.0 MiB": a size in a message.
+std::string mebibytes(std::uintmax_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return buf;
+}
 
 }  // namespace
 
@@ -120,6 +137,21 @@ std::string LineSource::where(const Loc& loc) const {
   return file_names_[static_cast<std::size_t>(loc.file)] + ":" + std::to_string(loc.line);
 }
 
+std::string LineSource::include_chain(const std::string& next_file) const {
+  // The files after the deck are named from the deck's directory, as its INPUT= lines name them.
+  const fs::path top_dir = fs::path(file_names_.front()).parent_path();
+  auto short_name = [&](const std::string& file) {
+    const fs::path rel = fs::path(file).lexically_relative(top_dir);
+    return rel.empty() || top_dir.empty() ? file : rel.string();
+  };
+  std::string chain;
+  for (const Frame& fr : stack_) {
+    const std::string& file = file_names_[static_cast<std::size_t>(fr.file)];
+    chain += (chain.empty() ? file : short_name(file)) + ":" + std::to_string(fr.line) + " -> ";
+  }
+  return chain + short_name(next_file);
+}
+
 void LineSource::push_file(const std::string& path, const std::optional<Loc>& from) {
   std::ifstream in;
   std::error_code ec;
@@ -129,10 +161,18 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
     throw InputError(where(*from) + ": cannot open include file '" + path +
                      "'; check INPUT= (a relative path is taken from the directory of the including file)");
   }
-  std::string text;
   in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
+  const std::streamoff size = std::max<std::streamoff>(in.tellg(), 0);
   in.seekg(0, std::ios::beg);
+  bytes_read_ += static_cast<std::uintmax_t>(size);
+  if (bytes_read_ > kMaxDeckBytes) {
+    const std::string what = "the deck's text reaches " + mebibytes(bytes_read_) + " with " + path +
+                             ", over the limit of " + mebibytes(kMaxDeckBytes) + " (a file counts each time it is included)";
+    if (!from) throw InputError(path + ": " + what + "; split the model or coarsen the mesh");
+    throw InputError(where(*from) + ": " + what + "; include chain " + include_chain(path) +
+                     "; include each file once");
+  }
+  std::string text;
   if (size > 0) {
     text.resize(static_cast<std::size_t>(size));
     in.read(text.data(), size);
@@ -141,6 +181,8 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
   if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte-order mark
   buffers_.push_back(std::move(text));
   file_names_.push_back(path);
+  const std::string id = fs::weakly_canonical(path, ec).string();
+  file_ids_.push_back(ec || id.empty() ? path : id);
   stack_.push_back(Frame{static_cast<int>(file_names_.size()) - 1, 0, 0});
 }
 
@@ -176,11 +218,23 @@ void LineSource::include(std::string_view text, const Loc& loc) {
     throw InputError(where(loc) + ": " + what + "; " + todo);
   };
   if (input.empty()) fail("*INCLUDE without INPUT=<file>", "add INPUT=<path of the file to include>");
-  if (static_cast<int>(stack_.size()) >= kMaxIncludeDepth)
-    fail("*INCLUDE nested deeper than " + std::to_string(kMaxIncludeDepth) + " files",
-         "check for a file that includes itself");
   fs::path p(input);
   if (p.is_relative()) p = fs::path(file_names_[static_cast<std::size_t>(loc.file)]).parent_path() / p;
+  const std::string path = p.string();
+  std::error_code ec;
+  std::string id = fs::weakly_canonical(p, ec).string();
+  if (ec || id.empty()) id = path;
+  for (const Frame& fr : stack_)
+    if (file_ids_[static_cast<std::size_t>(fr.file)] == id)
+      fail("*INCLUDE of " + path + " closes a cycle, a file including itself: " + include_chain(path),
+           "remove the *INCLUDE that closes the cycle");
+  if (static_cast<int>(stack_.size()) >= kMaxIncludeDepth)
+    fail("*INCLUDE nested deeper than " + std::to_string(kMaxIncludeDepth) + " files: " + include_chain(path),
+         "include the files from fewer levels");
+  if (++includes_ > kMaxIncludes)
+    fail("more than " + std::to_string(kMaxIncludes) + " *INCLUDE lines followed in one deck (here " +
+             include_chain(path) + ")",
+         "include each file once; a file that includes another several times multiplies at every level");
   push_file(p.string(), loc);
 }
 

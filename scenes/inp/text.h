@@ -2,6 +2,7 @@
 // The text layer of the deck reader (scenes/inp/deck.h): a deck's lines with *INCLUDE resolved, and the
 // fields, numbers and keyword lines on them. Nothing here knows what a keyword means; the reader
 // (scenes/inp/reader.h) does. Internal to scenes/inp/.
+#include <cstdint>
 #include <deque>
 #include <map>
 #include <optional>
@@ -74,11 +75,16 @@ class LineSource {
   };
   void push_file(const std::string& path, const std::optional<Loc>& from);
   void include(std::string_view text, const Loc& loc);
+  /// "main.inp:2 -> a.inp:5 -> <next_file>": the *INCLUDE lines open now, for messages.
+  std::string include_chain(const std::string& next_file) const;
 
   std::deque<std::string> buffers_;  // whole files; kept until the end (lines are views into them)
   std::vector<std::string> file_names_;
+  std::vector<std::string> file_ids_;  // canonical paths, to find a file that includes itself
   std::vector<Frame> stack_;
   int last_line_of_top_ = 0;
+  int includes_ = 0;              // *INCLUDE lines followed so far (bounded: kMaxIncludes)
+  std::uintmax_t bytes_read_ = 0;  // text read so far, includes counted each time (kMaxDeckBytes)
 };
 
 }  // namespace pneufem::inp

@@ -1,10 +1,13 @@
 // The CLI as a product: a tiny scene runs end to end and writes every output; bad input gives a
 // clear message and exit code 2 without leaving partial files; --help is helpful.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -181,6 +184,47 @@ TEST(Cli, DiagnoseReadsItsCacheOnTheSecondRun) {
   EXPECT_NE(b.out.find("path cache " + cache), std::string::npos) << b.out;
   EXPECT_EQ(slurp(d / "a" / "diagnosis.csv"), slurp(d / "b" / "diagnosis.csv"));
   EXPECT_EQ(slurp(d / "a" / "fitted.toml"), slurp(d / "b" / "fitted.toml"));
+}
+
+// compare, diagnose, synth, sweep (and simulate) check --out before computing (issue 30, item 3):
+// an --out that is a regular file, or lies under one, fails at once with exit code 2 and names
+// the path and the cause. Each command is given a run that would take tens of seconds, so an
+// answer within seconds, without a progress line, shows nothing was computed first.
+TEST(Cli, UnwritableOutFailsBeforeAnyWork) {
+  const fs::path d = fresh_dir("bad_out");
+  fs::create_directories(d);
+  const fs::path file = d / "a_file.csv";
+  std::ofstream(file) << "not a directory\n";
+  const std::string data = std::string(PNEUFEM_TEST_DATA_DIR) + "/hidden/stiffness.csv";
+  const std::string scene = " --set geometry.chambers=5 --set mesh.h_mm=6.0 --set load.max_kPa=30.0 --set load.step_kPa=10.0"
+                            " --set load.hold_s=4.0 --set load.trials=3";
+  struct Case {
+    std::string command;  // everything but --out
+    bool out_is_file;     // synth writes a file: --out a_file.csv is valid there
+  };
+  const Case cases[] = {
+      {"compare --data " + data + scene + " --threads 2", false},
+      {"diagnose --data " + data + scene + " --threads 2 --candidates stiffness --max-effects 1 --progress", false},
+      {"synth --hidden stiffness" + scene + " --threads 2", true},
+      {"sweep --param load.max_kPa=10:30:3 --jobs 1 --threads-per-job 2" + scene, false},
+      {"simulate" + scene + " --threads 2", false},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::pair<std::string, std::string>> outs = {{(file / "sub").string(), "is a file, not a directory"}};
+    if (!c.out_is_file) outs.push_back({file.string(), "is a file, not a directory"});
+    else outs.push_back({(file / "sub" / "data.csv").string(), "is a file, not a directory"});
+    for (const auto& [out, cause] : outs) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const Result r = run(c.command + " --out " + out);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      EXPECT_EQ(r.code, 2) << c.command << "\n" << r.out;
+      EXPECT_NE(r.out.find("--out " + out + ": "), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find(cause), std::string::npos) << r.out;
+      EXPECT_EQ(r.out.find("tracing the elastic path"), std::string::npos) << r.out;  // diagnose's first progress line
+      EXPECT_LT(seconds, 10.0) << c.command;
+    }
+  }
+  EXPECT_EQ(slurp(file), "not a directory\n");
 }
 
 TEST(Cli, MeshExportsARunnableCalculixDeck) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -736,6 +737,63 @@ TEST_F(InpFiles, ErrorInAnIncludedFileNamesThatFileAndLine) {
   write("sub/nodes.inp", "** nodes\n1, 0, 0, 0\n1, 1, 1, 1\n");
   const std::string msg = error_of("*NODE\n*INCLUDE, INPUT=sub/nodes.inp\n", "main.inp");
   EXPECT_NE(msg.find("sub/nodes.inp:3: node 1 is defined twice"), std::string::npos) << msg;
+}
+
+// *INCLUDE is bounded (issue 30, item 4): a fan-out of files each including the next twice, 24
+// deep (2^24 inclusions, which hung the reader), ends at the count of inclusions with the chain of
+// files; a cycle is named as such before the depth limit.
+TEST_F(InpFiles, IncludeFanOutEndsAtTheLimitWithTheChain) {
+  constexpr int kDepth = 24;
+  auto file = [](int i) {
+    std::ostringstream name;
+    name << 'f' << i << ".inp";
+    return name.str();
+  };
+  for (int i = 0; i < kDepth; ++i)
+    write(file(i), "*INCLUDE, INPUT=" + file(i + 1) + "\n*INCLUDE, INPUT=" + file(i + 1) + "\n");
+  write(file(kDepth), "** the leaf\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string msg;
+  try {
+    read_inp((dir_ / "f0.inp").string(), 1e-3);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_NE(msg.find("more than 10000 *INCLUDE lines followed in one deck"), std::string::npos) << msg;
+  // The chain: the line of each *INCLUDE open, the files after the deck named from its directory.
+  EXPECT_NE(msg.find((dir_ / "f0.inp").string() + ":1 -> f1.inp:1 -> f2.inp:1 -> "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("include each file once"), std::string::npos) << msg;
+}
+
+TEST_F(InpFiles, IncludeCycleIsNamedWithItsChain) {
+  write("a.inp", "** a\n*INCLUDE, INPUT=sub/b.inp\n");
+  write("sub/b.inp", "*INCLUDE, INPUT=../a.inp\n");
+  const std::string msg = error_of(kNodes + "*INCLUDE, INPUT=a.inp\n", "main.inp");
+  EXPECT_NE(msg.find("sub/b.inp:1: *INCLUDE of "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("closes a cycle"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("main.inp:6 -> "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("a.inp:2 -> "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("remove the *INCLUDE that closes the cycle"), std::string::npos) << msg;
+}
+
+// A C3D10 whose mid-node lies far off its edge's midpoint folds over itself (issue 30, item 4): the
+// deck is refused with the element, the node and the distortion; a gently curved edge is read.
+TEST_F(InpFiles, DistortedTet10IsRefusedWithTheElementAndItsDistortion) {
+  auto deck = [](const std::string& node5) {
+    return "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n5, " + node5 +
+           "\n6, .5, .5, 0\n7, 0, .5, 0\n8, 0, 0, .5\n9, .5, 0, .5\n10, 0, .5, .5\n"
+           "*ELEMENT, TYPE=C3D10, ELSET=BODY\n7, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10\n";
+  };
+  EXPECT_EQ(error_of(deck("0.5, -0.08, 0")), "");  // a curved edge, 0.08 of its length off: fine
+  const std::string msg = error_of(deck("0.9, 0, 0"));  // 0.4 of the edge off, along it: folds at node 2
+  EXPECT_NE(msg.find("bad.inp: element 7"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("is a C3D10 too distorted to compute: its Jacobian falls to -0.6 of its straight-sided "
+                     "tetrahedron's at its node 2 (at least 0.1 is needed)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("its mid-node 5 lying 0.4 edge lengths off the midpoint of edge 1-2; 1 element(s)"),
+            std::string::npos) << msg;
+  EXPECT_NE(msg.find("remesh"), std::string::npos) << msg;
 }
 
 TEST_F(InpFiles, EmptyFile) {
