@@ -22,7 +22,8 @@ std::unique_ptr<CompareCommand> add_compare_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   s->add_option("--dlc-map", c->options.dlc_map_path,
                 "Angles from DeepLabCut tracks: a TOML map of body parts and one DeepLabCut CSV per trial (see "
-                "app/compare/dlc_map.h); --data then needs only the pressure")
+                "app/compare/dlc_map.h); --data then needs only the pressure of the mapped trials: its header still names "
+                "angle_deg, whose cells may be empty (a trial of --data without a map entry keeps its CSV angles)")
       ->check(CLI::ExistingFile);
   s->add_option("--out", c->options.out_dir, "Output directory (created if needed; history.jsonl there grows by one line)")
       ->required();

@@ -1,6 +1,7 @@
 #pragma once
 // `compare --dlc-map MAP.toml`: bending angles from DeepLabCut tracks (analysis/deeplabcut.h)
-// instead of the angle column of the --data CSV, which then only needs the pressure. The map
+// instead of the angle column of the --data CSV, which then only needs the pressure (its header
+// still names angle_deg; the cells may be empty). The map
 // names the body parts once and one DeepLabCut CSV per trial:
 //
 //     fixed_parts = ["clamp_left", "clamp_right"]   # >= 2, ordered (see deeplabcut.h)
