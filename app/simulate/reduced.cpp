@@ -111,11 +111,11 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
   std::size_t asked = 0, i = 0;
   auto newton_at = [&](const ReducedStep&) { return newton_reports.count(asked++) > 0; };
   replay_reduced_run(rom, run.trajectory(), [&](const ReducedStep&, const Eigen::VectorXd& u, const std::vector<double>& state,
-                                                const ReducedCheck& check) {
+                                                const ReducedCheck& estimate) {
     if (i >= records.size()) throw PhysicsError("reduced model: the replay found more reports than the run made (internal error)");
-    res.reports.push_back({records[i], check});
-    double e = std::isnan(check.angle_error_deg) ? 0.0 : std::abs(check.angle_error_deg);
-    if (!std::isnan(check.newton_angle_error_deg)) e = std::max(e, std::abs(check.newton_angle_error_deg));
+    res.reports.push_back({records[i], estimate});
+    double e = std::isnan(estimate.angle_error_deg) ? 0.0 : std::abs(estimate.angle_error_deg);
+    if (!std::isnan(estimate.newton_angle_error_deg)) e = std::max(e, std::abs(estimate.newton_angle_error_deg));
     if (e > res.worst_check_deg || res.worst_report < 0) res.worst_check_deg = e, res.worst_report = static_cast<int>(i);
     if (at_report) at_report(records[i], u, state);
     ++i;
