@@ -195,9 +195,9 @@ Eigen::VectorXd rom_detail::angle_gradient(const Model& model, const Eigen::Vect
 namespace {
 
 /// Appends to `modes` (mass-orthonormal, unit RMS) up to `count` POD modes of `shapes` after their
-/// parts along `modes` are removed. Each shape is normalised to unit mass norm before the projection,
-/// so that every shape counts alike and a shape the earlier modes already hold adds nothing. `left`
-/// is set to the relative energy of the projected shapes outside the kept modes.
+/// parts along `modes` are removed. With `normalise`, each shape is scaled to unit mass norm first,
+/// so that every shape counts alike; without, the shapes count by size. `left` is set to the relative
+/// energy of the projected shapes outside the kept modes.
 void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorXd& mass, int count, double tolerance,
                 std::vector<Eigen::VectorXd>& modes, double& left, bool normalise = true) {
   const double m_tot = mass.sum();
@@ -218,8 +218,11 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   const Eigen::VectorXd lam = eig.eigenvalues().reverse();
   const Eigen::MatrixXd vec = eig.eigenvectors().rowwise().reverse();
   const double total = std::max(lam.sum(), 1e-300);
-  // Shapes the earlier modes hold already leave only round-off: nothing to add.
-  if (lam[0] <= 1e-20 * C.trace()) return;
+  // Shapes the earlier modes hold already leave only round-off of their energy: nothing to add.
+  double before = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    before += normalise ? 1.0 : mass_dot(mass, shapes[i], shapes[i]) / m_tot;
+  if (lam.sum() <= 1e-20 * before) return;
   int r = 0;
   left = total;
   while (r < count && r < static_cast<int>(n) && lam[r] > 1e-14 * lam[0] && left > tolerance * total) left -= lam[r++];
@@ -502,13 +505,13 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
       }
     }
     // The snapshots themselves: the states a run with history visits, with the theta row's test
-    // vector of the path sample nearest in angle.
+    // vector of the path sample nearest in angle. As among the path samples above, the unloaded
+    // sample 0 gives no training state.
     for (const Eigen::VectorXd& u : snapshots) {
       const double th = bending_angle(reference, u).angle_deg;
-      std::size_t k = 0;
-      for (std::size_t j = 1; j < ns; ++j)
-        if (std::abs(B.theta[j] - th) < std::abs(B.theta[k] - th)) k = j;
-      if (k > 0) train.push_back({u, B.W.col(static_cast<Eigen::Index>(k)), 0.0});
+      int k = path_segment_index(B.theta, th);
+      if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+      if (k > 0) train.push_back({u, B.W.col(k), 0.0});
     }
     for (TrainingState& s : train) s.t_scale = std::sqrt(mass_dot(mass, s.t, s.t) / m_tot) + 1e-300;
   }

@@ -16,6 +16,7 @@
 #include "engine/quasi_static.h"
 #include "materials/hyperelastic.h"
 #include "scenes/build_model.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -73,14 +74,7 @@ void register_example_once() {
   (void)done;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 PointResponse eval(const Material& m, const Mat3& F, bool tangent = true) {
   PointResponse r;

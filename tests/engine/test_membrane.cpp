@@ -15,6 +15,7 @@
 #include "engine/membrane.h"
 #include "core/errors.h"
 #include "tests/engine/test_meshes.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -96,14 +97,7 @@ double evaluate(const Patch& p, const MembraneGeometry& g, const Eigen::VectorXd
   return W;
 }
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 TEST(PlaneStressSVK, MatchesTheClosedFormAndRejectsBadConstants) {
   const PlaneStressSVK law(kE, kNu);

@@ -24,18 +24,12 @@
 #include "engine/rom.h"
 #include "materials/tensor.h"
 #include "scenes/build_model.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 // ------------------------------------------------------------------ NNLS
 

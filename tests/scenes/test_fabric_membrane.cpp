@@ -16,6 +16,7 @@
 #include "scenes/build_model.h"
 #include "scenes/calculix_deck.h"
 #include "scenes/pneunet.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -110,14 +111,7 @@ INSTANTIATE_TEST_SUITE_P(Cases, FabricMembraneMesh,
                                            Case{ElementType::Tet10, false}),
                          case_name);
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 TEST(FabricMembraneScene, BuildsTheMembraneFromTheFabricMaterial) {
   const Scene s = Scene::load("", {"mesh.h_mm=4", "mesh.fabric_model=membrane"});

@@ -14,6 +14,7 @@
 #include "scenes/build_model.h"
 #include "scenes/key_limits.h"
 #include "scenes/scene.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -22,14 +23,7 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 std::string load_error(const std::vector<std::string>& sets) {
   return error_of([&] { inlet_load(Scene::load("", sets)); });

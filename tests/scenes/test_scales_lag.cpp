@@ -13,6 +13,7 @@
 #include "materials/scaled.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -26,14 +27,7 @@ std::vector<std::string> tiny(std::vector<std::string> more) {
   return s;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 /// Angles at every report of the scene's load.
 std::vector<double> angles(const Scene& s) {

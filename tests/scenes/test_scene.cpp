@@ -8,6 +8,7 @@
 #include "core/errors.h"
 #include "scenes/build_model.h"
 #include "scenes/scene.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -22,14 +23,7 @@ std::string write_temp(const std::string& name, const std::string& text) {
   return p.string();
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 // scenes/examples/small_actuator.toml, the tutorial's scene (docs/user_guide.md), is the scene the
 // recordings of tests/data/hidden were made with (scripts/make_hidden_datasets.sh): every --set of a

@@ -14,20 +14,14 @@
 #include "damage/registry.h"
 #include "damage/viscoelastic.h"
 #include "scenes/build_model.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
 
 const std::vector<std::string> kTiny = {"geometry.chambers=3", "mesh.h_mm=6.0"};
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 void register_test_effect_once() {
   static const bool done = [] {

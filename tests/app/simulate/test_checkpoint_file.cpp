@@ -10,6 +10,7 @@
 
 #include "app/simulate/checkpoint_file.h"
 #include "core/errors.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -17,14 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 const RunIdentity kId{"0000000000000001", "0000000000000002", "0000000000000003", "0000000000000004"};
 const std::string kBody = std::string("state\0with\0zeros\n", 17) + "and more";

@@ -13,6 +13,7 @@
 #include "app/simulate/command.h"
 #include "core/errors.h"
 #include "scenes/build_model.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -44,14 +45,7 @@ RunResult run(const fs::path& dir, std::vector<std::string> extra, const std::st
   return run_simulation(Scene::load(kStory, sets), opt);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 TEST(SimulateReduced, ReportsTheReducedRunAndReusesItsCacheBitForBit) {
   const fs::path cache = temp_dir("cache");

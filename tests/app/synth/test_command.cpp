@@ -17,6 +17,7 @@
 #include "core/json_writer.h"
 #include "scenes/build_model.h"
 #include "tests/app/cli_helpers.h"
+#include "tests/support/input_error.h"
 
 namespace pneufem {
 namespace {
@@ -38,14 +39,7 @@ fs::path dir() {
 
 using pneufem::test::slurp;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using pneufem::test::error_of;
 
 SynthOptions options(const std::string& name, std::vector<std::string> hidden) {
   SynthOptions o;
