@@ -1,0 +1,281 @@
+#include "app/fit_material/command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "app/fit_material/test_data.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/json_writer.h"
+#include "core/number_text.h"
+#include "core/output_dir.h"
+#include "core/version.h"
+#include "viz/svg_plot.h"
+
+namespace pneufem {
+
+namespace {
+
+using fit::Law;
+using fit::TestMode;
+
+std::string pct(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f %%", 100.0 * v);
+  return b;
+}
+
+std::string fixed(double v, int digits) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", digits, v);
+  return b;
+}
+
+std::string weighting_text(fit::Weighting w) {
+  return w == fit::Weighting::relative
+             ? "relative weights (each residual over its measured stress, floored at 1 % of the test's largest)"
+             : "absolute weights (stress residuals in MPa)";
+}
+
+std::string model_label(const fit::FitOptions& o) {
+  return std::string(law_name(o.law)) + (o.law == Law::ogden ? std::to_string(o.ogden_terms) : "");
+}
+
+/// The names of the moduli in the scene's keys (ogden: one list).
+std::vector<std::string> modulus_keys(Law law) {
+  switch (law) {
+    case Law::neo_hookean: return {"C10_MPa"};
+    case Law::mooney_rivlin: return {"C10_MPa", "C01_MPa"};
+    case Law::yeoh: return {"C10_MPa", "C20_MPa", "C30_MPa"};
+    case Law::ogden: return {"mu_MPa"};
+  }
+  return {};
+}
+
+std::string toml_list(const std::vector<double>& v, double scale) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + json::num(v[i] * scale);
+  return s + "]";
+}
+
+std::string stability_text(const fit::StabilityLimit& s) {
+  return std::string(fit::mode_name(s.mode)) + (s.tension ? " tension" : " compression") + " at nominal strain " +
+         short_num(s.strain);
+}
+
+// --- the steps ----------------------------------------------------------------------------------
+
+std::vector<fit::TestCurve> read_tests(const FitMaterialOptions& o, std::vector<std::string>& notes) {
+  if (o.data.empty()) throw InputError("fit-material: give at least one DATA file (uniaxial:FILE, biaxial:FILE, planar:FILE)");
+  std::vector<fit::TestCurve> tests;
+  for (const std::string& arg : o.data) {
+    const TestFileSpec spec = parse_test_spec(arg);
+    tests.push_back(read_test_csv(spec.path, spec.mode, notes, o.max_strain));
+  }
+  return tests;
+}
+
+void write_residuals(const std::string& dir, const FitMaterialResult& r) {
+  std::string s = "test,mode,file,line,stretch,nominal_strain,stress_MPa,fitted_MPa,residual_MPa,relative_residual,weight_per_MPa\n";
+  for (std::size_t t = 0; t < r.tests.size(); ++t) {
+    const fit::TestCurve& c = r.tests[t];
+    const std::vector<double> rel = fit::point_weights(c, fit::Weighting::relative);
+    for (std::size_t j = 0; j < c.points.size(); ++j) {
+      const fit::TestPoint& p = c.points[j];
+      const double Pm = r.fit.tests[t].model_P_Pa[j];
+      s += std::to_string(t + 1) + "," + fit::mode_name(c.mode) + "," + svg::csv_field(c.source) + "," +
+           std::to_string(p.line) + "," + json::num(p.stretch) + "," + json::num(p.stretch - 1.0) + "," +
+           json::num(p.P_Pa * 1e-6) + "," + json::num(Pm * 1e-6) + "," + json::num((Pm - p.P_Pa) * 1e-6) + "," +
+           json::num((Pm - p.P_Pa) * rel[j]) + "," + json::num(r.fit.tests[t].weight[j] * 1e6) + "\n";
+    }
+  }
+  write_file_atomic(dir + "/residuals.csv", s);
+}
+
+/// Top: nominal stress against nominal strain, data (markers) and the fit (line, over each test's
+/// strain range) per test. Bottom: relative residuals.
+void write_figure(const std::string& dir, const FitMaterialResult& r) {
+  svg::Figure fig(svg::kColumnWidthPx, 560, 2, 1);
+  fig.title(model_label(r.fit_options) + " fit");
+  svg::Axes& top = fig.axes(0, 0);
+  svg::Axes& bottom = fig.axes(1, 0);
+  top.title("nominal stress").xlabel("nominal strain").ylabel("nominal stress (MPa)");
+  bottom.title("relative residual").xlabel("nominal strain").ylabel("(fit - data) / data");
+  for (std::size_t t = 0; t < r.tests.size(); ++t) {
+    const fit::TestCurve& c = r.tests[t];
+    const std::string label = std::string(fit::mode_name(c.mode)) + " (test " + std::to_string(t + 1) + ")";
+    std::vector<double> x, y, res;
+    const std::vector<double> rel = fit::point_weights(c, fit::Weighting::relative);
+    double hi = 0.0;
+    for (std::size_t j = 0; j < c.points.size(); ++j) {
+      x.push_back(c.points[j].stretch - 1.0);
+      y.push_back(c.points[j].P_Pa * 1e-6);
+      res.push_back((r.fit.tests[t].model_P_Pa[j] - c.points[j].P_Pa) * rel[j]);
+      hi = std::max(hi, x.back());
+    }
+    svg::Style dots;
+    dots.color = svg::palette_color(t);
+    dots.marker = svg::Marker::Circle;
+    dots.marker_size = 2.0;
+    dots.line_width = 0.0;
+    top.scatter(x, y, label + " data", dots);
+    std::vector<double> xf, yf;
+    for (int k = 0; k <= 200; ++k) {
+      const double e = hi * k / 200.0;
+      xf.push_back(e);
+      yf.push_back(fit::nominal_stress(r.fit.constants, c.mode, 1.0 + e) * 1e-6);
+    }
+    svg::Style line;
+    line.color = svg::palette_color(t);
+    top.line(xf, yf, label + " fit", line);
+    bottom.scatter(x, res, label, dots);
+  }
+  fig.save(dir + "/fit.svg");
+}
+
+void write_json(const std::string& dir, const FitMaterialOptions& o, const FitMaterialResult& r) {
+  const fit::Constants& k = r.fit.constants;
+  json::Object constants;
+  constants.add_str("model", fit::law_name(k.law));
+  const std::vector<std::string> keys = modulus_keys(k.law);
+  if (k.law == Law::ogden) {
+    constants.add("mu_MPa", toml_list(k.c, 1e-6));
+    constants.add("alpha", json::array(k.alpha));
+  } else {
+    for (std::size_t i = 0; i < keys.size(); ++i) constants.add(keys[i], k.c[i] * 1e-6);
+    std::vector<double> se;
+    for (double v : r.fit.std_error) se.push_back(v * 1e-6);
+    constants.add("std_error_MPa", json::array(se));
+  }
+  constants.add("mu0_MPa", k.mu0() * 1e-6);
+  std::string tests = "[";
+  for (std::size_t t = 0; t < r.tests.size(); ++t) {
+    json::Object e;
+    e.add_str("mode", fit::mode_name(r.tests[t].mode)).add_str("file", r.tests[t].source);
+    e.add("points", json::num(static_cast<double>(r.tests[t].points.size())));
+    e.add("r2", r.fit.tests[t].r2).add("rms_relative_error", r.fit.tests[t].rms_relative);
+    e.add("objective", r.fit.tests[t].objective);
+    tests += (t ? ", " : "") + e.str(4);
+  }
+  tests += "]";
+  std::string limits = "[";
+  for (std::size_t i = 0; i < r.stability.limits.size(); ++i) {
+    const fit::StabilityLimit& s = r.stability.limits[i];
+    json::Object e;
+    e.add_str("mode", fit::mode_name(s.mode)).add_str("path", s.tension ? "tension" : "compression");
+    e.add("unstable_from_strain", s.strain);
+    limits += (i ? ", " : "") + e.str(6);
+  }
+  limits += "]";
+  json::Object stab;
+  stab.add("strain_range", json::array({r.stability.strain_lo, r.stability.strain_hi}));
+  stab.add("stable", r.stability.stable() ? "true" : "false").add("limits", limits);
+  std::string notes = "[";
+  for (std::size_t i = 0; i < r.notes.size(); ++i) notes += (i ? ", " : "") + json::quote(r.notes[i]);
+  notes += "]";
+  json::Object root;
+  root.add_str("version", version_string()).add_str("model", model_label(r.fit_options));
+  root.add_str("weights", o.weights).add_str("weighting", weighting_text(r.fit_options.weighting));
+  root.add("constants", constants.str(2)).add("objective", r.fit.objective);
+  root.add("evaluations", json::num(r.fit.evaluations)).add("tests", tests);
+  root.add("drucker_stability", stab.str(2)).add("notes", notes);
+  write_file_atomic(dir + "/fit.json", root.str() + "\n");
+}
+
+}  // namespace
+
+fit::FitOptions parse_model(const std::string& model, const std::string& weights) {
+  fit::FitOptions o;
+  if (weights == "relative") o.weighting = fit::Weighting::relative;
+  else if (weights == "absolute") o.weighting = fit::Weighting::absolute;
+  else throw InputError("--weights " + weights + ": use relative (the default, as Abaqus) or absolute");
+  std::string m = model;
+  m.erase(std::remove_if(m.begin(), m.end(), [](char c) { return c == '[' || c == ']' || c == '_' || c == ' '; }),
+          m.end());
+  if (model == "yeoh") o.law = Law::yeoh;
+  else if (model == "neo_hookean") o.law = Law::neo_hookean;
+  else if (model == "mooney_rivlin") o.law = Law::mooney_rivlin;
+  else if (m == "ogden") o.law = Law::ogden, o.ogden_terms = 1;
+  else if (m.size() == 6 && m.rfind("ogden", 0) == 0 && m[5] >= '1' && m[5] <= '3')
+    o.law = Law::ogden, o.ogden_terms = m[5] - '0';
+  else
+    throw InputError("--model " + model + ": use yeoh, neo_hookean, mooney_rivlin, ogden (1 term), ogden2 or ogden3");
+  return o;
+}
+
+std::string material_block(const FitMaterialOptions& o, const FitMaterialResult& r) {
+  const fit::Constants& k = r.fit.constants;
+  std::string s = "# " + model_label(r.fit_options) + " fitted by pneufem fit-material (" + version_string() + "), " +
+                  weighting_text(r.fit_options.weighting) + ".\n";
+  for (std::size_t t = 0; t < r.tests.size(); ++t)
+    s += "#   " + std::string(fit::mode_name(r.tests[t].mode)) + " " + r.tests[t].source + ": " +
+         std::to_string(r.tests[t].points.size()) + " points, R^2 " + fixed(r.fit.tests[t].r2, 4) +
+         ", rms relative error " + pct(r.fit.tests[t].rms_relative) + "\n";
+  s += "# Drucker stability, nominal strain " + short_num(r.stability.strain_lo) + " to " +
+       short_num(r.stability.strain_hi) + ": ";
+  if (r.stability.stable()) {
+    s += "stable on all six paths\n";
+  } else {
+    std::string lim;
+    for (const fit::StabilityLimit& l : r.stability.limits)
+      if (!std::isnan(l.strain)) lim += (lim.empty() ? "" : "; ") + stability_text(l);
+    s += "UNSTABLE from " + lim + "\n";
+  }
+  s += "# K_over_mu and density_kg_m3 are not fitted (incompressible tests): set them for your material.\n";
+  s += "[materials." + o.name + "]\n";
+  s += "model = \"" + std::string(fit::law_name(k.law)) + "\"\n";
+  if (k.law == Law::ogden) {
+    s += "mu_MPa = " + toml_list(k.c, 1e-6) + "\n";
+    s += "alpha = " + toml_list(k.alpha, 1.0) + "\n";
+  } else {
+    const std::vector<std::string> keys = modulus_keys(k.law);
+    for (std::size_t i = 0; i < keys.size(); ++i) s += keys[i] + " = " + json::num(k.c[i] * 1e-6) + "\n";
+  }
+  s += "K_over_mu = " + json::num(o.K_over_mu) + "\n";
+  s += "density_kg_m3 = " + json::num(o.density_kg_m3) + "\n";
+  return s;
+}
+
+void check_stability(const FitMaterialOptions& o, FitMaterialResult& r) {
+  r.stability = fit::drucker_stability(r.fit.constants, o.stability_lo, o.stability_hi);
+  for (const fit::StabilityLimit& l : r.stability.limits)
+    if (!std::isnan(l.strain))
+      r.warnings.push_back("the fit is unstable (Drucker) in " + stability_text(l) + " and beyond");
+  for (const fit::TestCurve& c : r.tests)
+    for (const fit::TestPoint& p : c.points) {
+      if (fit::drucker_stable(r.fit.constants, fit::mode_stretches(c.mode, p.stretch))) continue;
+      const std::string msg = c.source + ":" + std::to_string(p.line) + ": the fitted " +
+                              model_label(r.fit_options) + " is unstable (Drucker) at this test's own nominal strain " +
+                              short_num(p.stretch - 1.0) +
+                              ": a simulation would soften without bound there. Fit a narrower range "
+                              "(--max-strain), another law (ogden keeps mu_i > 0 and is stable), or more test "
+                              "modes together; --allow-unstable writes it anyway";
+      if (!o.allow_unstable) throw InputError(msg);
+      r.warnings.push_back(msg);
+      return;
+    }
+}
+
+FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
+  check_output_dir(o.out_dir, "--out");
+  FitMaterialResult r;
+  r.fit_options = parse_model(o.model, o.weights);
+  r.fit_options.max_evaluations = o.max_evaluations;
+  if (!(o.K_over_mu >= 1.0)) throw InputError("--K-over-mu must be >= 1 (silicone: 100-1000), got " + short_num(o.K_over_mu));
+  if (!(o.stability_lo > -1.0 && o.stability_lo <= 0.0 && o.stability_hi >= 0.0))
+    throw InputError("--stability-range: the low end must lie in (-1, 0] and the high end be >= 0");
+  r.tests = read_tests(o, r.notes);
+  r.fit = fit::fit_hyperelastic(r.tests, r.fit_options);
+  for (const std::string& n : r.fit.notes) r.notes.push_back(n);
+  check_stability(o, r);
+  r.toml = material_block(o, r);
+  prepare_output_dir(o.out_dir, "--out");
+  write_file_atomic(o.out_dir + "/material.toml", r.toml);
+  write_residuals(o.out_dir, r);
+  write_figure(o.out_dir, r);
+  write_json(o.out_dir, o, r);
+  return r;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,331 @@
+#include "app/fit_material/test_data.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include "core/errors.h"
+#include "core/number_text.h"
+
+namespace pneufem {
+
+namespace {
+
+using fit::TestMode;
+
+/// The modes by the words that name them, in arguments and file names.
+const std::vector<std::pair<std::string, TestMode>>& mode_words() {
+  static const std::vector<std::pair<std::string, TestMode>> k = {
+      {"uniaxial", TestMode::uniaxial},  {"equibiaxial", TestMode::biaxial}, {"biaxial", TestMode::biaxial},
+      {"planar", TestMode::planar},      {"pure_shear", TestMode::planar},   {"pureshear", TestMode::planar}};
+  return k;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// A column name as the reader compares it: lower case, spaces / brackets / '-' / '/' / '^' as
+/// single '_', no leading or trailing '_'.
+std::string normalise(const std::string& name) {
+  std::string s;
+  for (char c : lower(name)) {
+    const bool sep = std::isspace(static_cast<unsigned char>(c)) || c == '(' || c == ')' || c == '[' || c == ']' ||
+                     c == '-' || c == '/' || c == '^' || c == '_' || c == '"' || c == '\'';
+    if (sep) {
+      if (!s.empty() && s.back() != '_') s += '_';
+    } else {
+      s += c;
+    }
+  }
+  while (!s.empty() && s.back() == '_') s.pop_back();
+  return s;
+}
+
+/// What a header column holds.
+struct Column {
+  enum Kind { other, strain, stretch, stress, true_quantity } kind = other;
+  double scale = 1.0;  ///< to dimensionless strain or Pa
+  std::string unit;    ///< as written after the quantity ("kpa", "%", "" = none)
+  std::string name;    ///< as written in the header
+};
+
+Column classify(const std::string& raw) {
+  Column c;
+  c.name = raw;
+  std::string s = normalise(raw);
+  for (const char* p : {"true_", "cauchy_", "log_", "logarithmic_", "hencky_"})
+    if (s.rfind(p, 0) == 0) {
+      c.kind = Column::true_quantity;
+      return c;
+    }
+  for (const char* p : {"nominal_", "engineering_", "eng_"})
+    if (s.rfind(p, 0) == 0) s = s.substr(std::string(p).size());
+  const auto unit_after = [&](const std::string& word) -> std::optional<std::string> {
+    if (s == word) return std::string();
+    if (s.rfind(word + "_", 0) == 0) return s.substr(word.size() + 1);
+    return std::nullopt;
+  };
+  if (auto u = unit_after("strain")) {
+    c.kind = Column::strain;
+    c.unit = *u;
+    if (u->empty() || *u == "mm_mm" || *u == "m_m" || *u == "1") c.scale = 1.0;
+    else if (*u == "%" || *u == "percent" || *u == "pct") c.scale = 0.01;
+    else c.scale = std::numeric_limits<double>::quiet_NaN();
+    return c;
+  }
+  for (const char* w : {"stretch", "lambda", "stretch_ratio"})
+    if (auto u = unit_after(w); u && (u->empty() || *u == "1")) {
+      c.kind = Column::stretch;
+      return c;
+    }
+  if (auto u = unit_after("stress")) {
+    static const std::map<std::string, double> kUnits = {
+        {"pa", 1.0},     {"kpa", 1e3},    {"mpa", 1e6},   {"gpa", 1e9},  {"psi", 6894.757293168361},
+        {"n_mm2", 1e6},  {"n_mm_2", 1e6}, {"n_m2", 1.0},  {"n_m_2", 1.0}};
+    c.kind = Column::stress;
+    c.unit = *u;
+    const auto it = kUnits.find(*u);
+    c.scale = it == kUnits.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+  }
+  return c;
+}
+
+char delimiter_of(const std::string& line) {
+  if (line.find(';') != std::string::npos) return ';';
+  if (line.find(',') != std::string::npos) return ',';
+  return ' ';
+}
+
+std::vector<std::string> split(const std::string& line, char d) {
+  std::vector<std::string> out;
+  if (d == ' ') {  // tabs or runs of spaces
+    std::string cur;
+    for (char c : line) {
+      if (c == ' ' || c == '\t') {
+        if (!cur.empty()) out.push_back(cur);
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    if (!cur.empty()) out.push_back(cur);
+    return out;
+  }
+  std::string cur;
+  for (char c : line) {
+    if (c == d) {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  for (std::string& f : out) {  // trim
+    while (!f.empty() && std::isspace(static_cast<unsigned char>(f.back()))) f.pop_back();
+    std::size_t i = 0;
+    while (i < f.size() && std::isspace(static_cast<unsigned char>(f[i]))) ++i;
+    f = f.substr(i);
+  }
+  return out;
+}
+
+/// A whole cell as a number (decimal comma allowed with ';' and whitespace delimiters).
+std::optional<double> number(std::string cell, char d) {
+  if (d != ',') std::replace(cell.begin(), cell.end(), ',', '.');
+  if (cell.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  if (end != cell.c_str() + cell.size()) return std::nullopt;
+  return v;
+}
+
+bool all_empty(const std::vector<std::string>& cells) {
+  return std::all_of(cells.begin(), cells.end(), [](const std::string& c) { return c.empty(); });
+}
+
+/// Every non-empty cell is a number, and there is one.
+bool all_numbers(const std::vector<std::string>& cells, char d) {
+  for (const std::string& c : cells)
+    if (!c.empty() && !number(c, d)) return false;
+  return !all_empty(cells);
+}
+
+std::string where(const std::string& path, int line) { return path + ":" + std::to_string(line) + ": "; }
+
+/// The strain (or stretch) and stress columns of a header line; throws on missing units, unknown
+/// units, two columns for one quantity (mixed units).
+struct Layout {
+  int strain_col = -1, stress_col = -1;
+  Column strain, stress;
+};
+
+Layout layout_of(const std::vector<Column>& cols, const std::string& path, int line, std::vector<std::string>& notes) {
+  Layout l;
+  std::vector<std::string> skipped;
+  for (int i = 0; i < static_cast<int>(cols.size()); ++i) {
+    const Column& c = cols[i];
+    const bool is_strain = c.kind == Column::strain || c.kind == Column::stretch;
+    if (c.kind == Column::true_quantity) skipped.push_back("'" + c.name + "'");
+    if (!is_strain && c.kind != Column::stress) continue;
+    int& slot = is_strain ? l.strain_col : l.stress_col;
+    Column& kept = is_strain ? l.strain : l.stress;
+    if (slot >= 0) {
+      const bool mixed = kept.unit != c.unit || kept.kind != c.kind;
+      throw InputError(where(path, line) + "columns '" + kept.name + "' and '" + c.name + "' both give the " +
+                       (is_strain ? "strain" : "stress") +
+                       (mixed ? " in different units (mixed units)" : "") + "; keep one of them");
+    }
+    slot = i;
+    kept = c;
+  }
+  if (l.strain_col < 0 || l.stress_col < 0) return l;
+  if (std::isnan(l.strain.scale))
+    throw InputError(where(path, line) + "column '" + l.strain.name + "': unknown strain unit '" + l.strain.unit +
+                     "'; write 'strain' (nominal, dimensionless), 'strain_percent' or 'stretch'");
+  if (l.stress.unit.empty())
+    throw InputError(where(path, line) + "column '" + l.stress.name + "' has no unit; name it stress_Pa, stress_kPa, "
+                     "stress_MPa, stress_psi or stress_N_mm2 (nominal stress: force over the undeformed area)");
+  if (std::isnan(l.stress.scale))
+    throw InputError(where(path, line) + "column '" + l.stress.name + "': unknown stress unit '" + l.stress.unit +
+                     "'; use Pa, kPa, MPa, GPa, psi or N_mm2");
+  if (!skipped.empty()) {
+    std::string s;
+    for (const std::string& k : skipped) s += (s.empty() ? "" : ", ") + k;
+    notes.push_back(path + ": true-stress/strain column(s) " + s + " skipped; fitted: '" + l.strain.name + "', '" +
+                    l.stress.name + "' (nominal, as Abaqus's test data)");
+  }
+  return l;
+}
+
+}  // namespace
+
+TestFileSpec parse_test_spec(const std::string& arg) {
+  const std::size_t colon = arg.find(':');
+  if (colon != std::string::npos) {
+    const std::string word = lower(arg.substr(0, colon));
+    for (const auto& [w, m] : mode_words())
+      if (word == w) return {m, arg.substr(colon + 1)};
+  }
+  const std::string name = lower(std::filesystem::path(arg).filename().string());
+  std::optional<TestMode> found;
+  for (const auto& [w, m] : mode_words()) {
+    if (name.find(w) == std::string::npos) continue;
+    if (w == "biaxial" && name.find("equibiaxial") != std::string::npos) continue;  // counted once
+    if (found && *found != m) { found.reset(); break; }
+    found = m;
+  }
+  if (!found)
+    throw InputError(arg + ": which test is it? Write uniaxial:" + arg + ", biaxial:" + arg + " or planar:" + arg +
+                     " (nominal stress against nominal strain, as Abaqus's *UNIAXIAL / *BIAXIAL / *PLANAR TEST DATA)");
+  return {*found, arg};
+}
+
+fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector<std::string>& notes, double max_strain) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the test data file; check the path");
+  fit::TestCurve curve{mode, path, {}};
+  std::string text;
+  int line_no = 0, header_line = 0, skipped = 0, dropped = 0, negative = 0, first_negative = 0;
+  char d = ',';
+  Layout lay;
+  double prev_strain = -1.0;
+  int prev_line = 0;
+  while (std::getline(in, text)) {
+    ++line_no;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line_no == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = text.substr(3);  // UTF-8 byte-order mark
+    std::size_t first = text.find_first_not_of(" \t");
+    if (first == std::string::npos || text[first] == '#') continue;
+    if (header_line == 0) {
+      const char hd = delimiter_of(text);
+      const std::vector<std::string> cells = split(text, hd);
+      if (all_empty(cells)) continue;  // ";;;;": a spreadsheet's blank row
+      if (all_numbers(cells, hd))
+        throw InputError(where(path, line_no) + "data before any header; the first line must name the columns with "
+                         "their units, e.g. 'strain,stress_kPa' or 'stretch,stress_MPa'");
+      std::vector<Column> cols;
+      for (const std::string& c : cells) cols.push_back(classify(c));
+      lay = layout_of(cols, path, line_no, notes);
+      if (lay.strain_col < 0 || lay.stress_col < 0) {
+        if (++skipped > 200) break;
+        continue;  // a metadata line of the machine's export
+      }
+      header_line = line_no;
+      d = hd;
+      if (skipped > 0)
+        notes.push_back(path + ": " + std::to_string(skipped) + " line(s) before the header (line " +
+                        std::to_string(line_no) + ") skipped");
+      continue;
+    }
+    const std::vector<std::string> cells = split(text, d);
+    if (all_empty(cells)) continue;
+    const int need = std::max(lay.strain_col, lay.stress_col);
+    if (static_cast<int>(cells.size()) <= need)
+      throw InputError(where(path, line_no) + "has " + std::to_string(cells.size()) + " field(s); the header (line " +
+                       std::to_string(header_line) + ") puts '" + lay.stress.name + "' in field " +
+                       std::to_string(lay.stress_col + 1) + " and '" + lay.strain.name + "' in field " +
+                       std::to_string(lay.strain_col + 1));
+    const auto cell = [&](int col, const Column& c) {
+      const std::optional<double> v = number(cells[col], d);
+      if (!v || !std::isfinite(*v))
+        throw InputError(where(path, line_no) + "'" + cells[col] + "' in column '" + c.name +
+                         "' is not a number" +
+                         (cells[col].find_first_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ%") !=
+                                  std::string::npos
+                              ? " (units belong in the header, e.g. stress_kPa, not in the cells)"
+                              : "") +
+                         "; fix or remove the row");
+      return *v;
+    };
+    const double x = cell(lay.strain_col, lay.strain), P = cell(lay.stress_col, lay.stress) * lay.stress.scale;
+    const double strain = lay.strain.kind == Column::stretch ? x - 1.0 : x * lay.strain.scale;
+    if (lay.strain.kind == Column::stretch && x <= 0.0)
+      throw InputError(where(path, line_no) + "stretch " + short_num(x) + " <= 0 is impossible; the column '" +
+                       lay.strain.name + "' must hold l = 1 + nominal strain");
+    if (strain < 0.0)
+      throw InputError(where(path, line_no) + "nominal strain " + short_num(strain) +
+                       " is negative (compression, or an offset of the extensometer): fit-material fits tension "
+                       "tests only; remove the compression rows or shift the strain so the test starts at 0");
+    if (strain < prev_strain)
+      throw InputError(where(path, line_no) + "the strain falls from " + short_num(prev_strain) + " (line " +
+                       std::to_string(prev_line) + ") to " + short_num(strain) +
+                       ": not a loading curve (an unloading branch, a cycle, or unsorted rows). Keep the first "
+                       "loading up to line " + std::to_string(prev_line) +
+                       "; loading-unloading cycles (Mullins) are not fitted yet");
+    prev_strain = strain;
+    prev_line = line_no;
+    if (strain > max_strain) {
+      ++dropped;
+      continue;
+    }
+    if (strain > 0.0 && P <= 0.0) {  // a rubber in tension pulls: an offset or a slack specimen
+      if (negative++ == 0) first_negative = line_no;
+      continue;
+    }
+    curve.points.push_back({1.0 + strain, P, line_no});
+  }
+  if (header_line == 0)
+    throw InputError(path + ": no header naming a strain (or stretch) column and a stress column with its unit, e.g. "
+                     "'strain,stress_kPa'; the file's first lines are not one");
+  if (curve.points.empty())
+    throw InputError(path + ": no data rows " + (dropped ? "at or below --max-strain " + short_num(max_strain) : "") +
+                     " after the header (line " + std::to_string(header_line) + ")");
+  if (dropped)
+    notes.push_back(path + ": " + std::to_string(dropped) + " point(s) above --max-strain " + short_num(max_strain) +
+                    " left out");
+  if (negative)
+    notes.push_back(path + ":" + std::to_string(first_negative) + ": " + std::to_string(negative) +
+                    " point(s) with zero or negative stress at a positive strain, the first here (a load-cell offset or "
+                    "a slack specimen), left out: a rubber in tension pulls");
+  return curve;
+}
+
+}  // namespace pneufem

@@ -1,0 +1,42 @@
+#pragma once
+// Lab test data for `pneufem fit-material`: which test a file holds, and its nominal stress-strain
+// curve read from CSV with the units named in the header.
+//
+// A file is a table whose header names a strain and a stress column with their units:
+//   strain,stress_kPa           nominal (engineering) strain, dimensionless, and nominal stress
+//   stretch,stress_MPa          the stretch l = 1 + strain instead of the strain
+//   strain_percent,stress_psi   strain in % (also "strain_%", "Strain (%)")
+//   Engineering Strain;Engineering Stress (MPa)   a testing machine's export, units in brackets
+// Names are read case-insensitively, with spaces, brackets and '-' taken as '_' and a leading
+// "nominal_", "engineering_" or "eng_" dropped. Stress units: Pa, kPa, MPa, GPa, psi, N/mm^2 (N_mm2).
+// Columns of true (Cauchy, logarithmic) stress or strain are recognised and skipped: the fit needs
+// the nominal ones (Abaqus's test data convention). Any other column (time, force) is ignored.
+// The delimiter is the header's: ';', else ',', else tabs or spaces; with ';' or tabs a decimal
+// comma is read as a point. Lines before the header that are not data (a machine's metadata block)
+// are skipped with a note; '#' lines and blank lines are skipped anywhere.
+// Each row must be a tension point at a strain no lower than the row before (a loading curve). A row
+// with zero or negative stress at a positive strain (a load-cell offset, a slack specimen) is left
+// out with a note: under relative weights its residual would outweigh the rest of the curve.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "materials/fit/fit.h"
+
+namespace pneufem {
+
+/// A DATA argument: "uniaxial:FILE", "biaxial:FILE" (or "equibiaxial:"), "planar:FILE" (or
+/// "pure_shear:", "pureshear:"), or a FILE whose name contains exactly one of those words.
+struct TestFileSpec {
+  fit::TestMode mode;
+  std::string path;
+};
+TestFileSpec parse_test_spec(const std::string& arg);
+
+/// The curve of `path` (stresses in Pa). Points above `max_strain` are dropped (a note says how
+/// many). Notes (skipped lines, true-stress columns, rows left out) are appended to `notes`.
+/// Throws InputError "<path>:<line>: ..." with what to do.
+fit::TestCurve read_test_csv(const std::string& path, fit::TestMode mode, std::vector<std::string>& notes,
+                             double max_strain = std::numeric_limits<double>::infinity());
+
+}  // namespace pneufem
