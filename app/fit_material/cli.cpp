@@ -81,9 +81,11 @@ int run_fit_material_command(FitMaterialCommand& c) {
                 100.0 * r.fit.tests[t].rms_relative);
   std::printf("constants (MPa):");
   const fit::Constants& k = r.fit.constants;
+  static const char* kNames[3][3] = {{"C10", "", ""}, {"C10", "C01", ""}, {"C10", "C20", "C30"}};
   for (std::size_t i = 0; i < k.c.size(); ++i) {
-    std::printf(" %s%s%s", i ? ", " : "", k.law == fit::Law::ogden ? ("mu" + std::to_string(i + 1) + " ").c_str() : "",
-                short_num(k.c[i] * 1e-6).c_str());
+    const std::string name = k.law == fit::Law::ogden ? "mu" + std::to_string(i + 1)
+                                                      : kNames[static_cast<int>(k.law)][i];
+    std::printf("%s %s %s", i ? "," : "", name.c_str(), short_num(k.c[i] * 1e-6).c_str());
     if (i < r.fit.std_error.size()) std::printf(" +- %s", short_num(r.fit.std_error[i] * 1e-6).c_str());
     if (k.law == fit::Law::ogden) std::printf(" (alpha %s)", short_num(k.alpha[i]).c_str());
   }
