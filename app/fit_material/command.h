@@ -1,17 +1,17 @@
 #pragma once
-// `pneufem fit-material`: hyperelastic constants from lab tests (materials/fit/fit.h does the math),
+// `pneufem fit-material`: hyperelastic constants from lab tests (fit/fit.h does the math),
 // written as the scene's [materials.NAME] block with the evidence beside it.
 //
 // Steps, each a function below: read the test files (test_data.h) -> fit -> check Drucker stability
-// over a strain range (materials/fit/stability.h; unstable within a test's own data is an error,
+// over a strain range (fit/stability.h; unstable within a test's own data is an error,
 // elsewhere a warning, as Abaqus warns) -> write DIR/material.toml, residuals.csv, fit.svg (+ fit.csv,
 // the plotted series) and fit.json.
 #include <limits>
 #include <string>
 #include <vector>
 
-#include "materials/fit/fit.h"
-#include "materials/fit/stability.h"
+#include "fit/fit.h"
+#include "fit/stability.h"
 
 namespace pneufem {
 

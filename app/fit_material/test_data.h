@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "materials/fit/fit.h"
+#include "fit/fit.h"
 
 namespace pneufem {
 

@@ -21,7 +21,7 @@
 //   P = sum 2 mu_i/alpha_i (l^(alpha_i - 1) - l^(-c alpha_i - 1)),  c = 1/2, 2, 1 for the three modes.
 // Each law is linear in its moduli (C10, C20, ..., mu_i) at fixed exponents alpha_i; the fit uses
 // that (fit.h). The 3D laws of materials/ evaluated at F = diag(lambda) agree with (1) to round-off
-// (tests/materials/fit/test_incompressible.cpp).
+// (tests/fit/test_incompressible.cpp).
 #include <string>
 #include <vector>
 

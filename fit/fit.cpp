@@ -1,4 +1,4 @@
-#include "materials/fit/fit.h"
+#include "fit/fit.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "materials/fit/stability.h"
+#include "fit/stability.h"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-// The least-squares fit (materials/fit/fit.h) against truth: Treloar's 1944 rubber with Ogden's
+// The least-squares fit (fit/fit.h) against truth: Treloar's 1944 rubber with Ogden's
 // 1972 constants as the reference, synthetic round trips from known constants, and its errors.
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <fstream>
 #include <random>
 
-#include "materials/fit/fit.h"
-#include "materials/fit/stability.h"
+#include "fit/fit.h"
+#include "fit/stability.h"
 #include "tests/support/input_error.h"
 
 namespace pneufem::fit {

@@ -17,7 +17,7 @@
 
 #include <Eigen/Core>
 
-#include "materials/fit/incompressible.h"
+#include "fit/incompressible.h"
 
 namespace pneufem::fit {
 

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "materials/fit/incompressible.h"
+#include "fit/incompressible.h"
 
 namespace pneufem::fit {
 

@@ -1,12 +1,12 @@
-// The incompressible test modes (materials/fit/incompressible.h) against the 3D laws of materials/
+// The incompressible test modes (fit/incompressible.h) against the 3D laws of materials/
 // at the same homogeneous deformation, and the Drucker tangent (stability.h) against central
 // differences of the principal stresses.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "materials/fit/incompressible.h"
-#include "materials/fit/stability.h"
+#include "fit/incompressible.h"
+#include "fit/stability.h"
 #include "materials/hyperelastic.h"
 #include "materials/ogden.h"
 

@@ -1,4 +1,4 @@
-#include "materials/fit/incompressible.h"
+#include "fit/incompressible.h"
 
 #include <cmath>
 #include <memory>
