@@ -9,10 +9,40 @@
 
 #include "core/errors.h"
 #include "core/number_text.h"
+#include "fit/nnls_small.h"
 
 namespace pneufem::fit {
 
+namespace detail {
+
+Nnls nnls_small(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) {
+  const int n = static_cast<int>(A.cols());
+  Nnls best{Eigen::VectorXd::Zero(n), b.squaredNorm()};
+  for (int mask = 1; mask < (1 << n); ++mask) {
+    std::vector<int> cols;
+    for (int k = 0; k < n; ++k)
+      if (mask & (1 << k)) cols.push_back(k);
+    Eigen::MatrixXd S(A.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t k = 0; k < cols.size(); ++k) S.col(static_cast<Eigen::Index>(k)) = A.col(cols[k]);
+    const Eigen::VectorXd xs = S.colPivHouseholderQr().solve(b);
+    if (!xs.allFinite() || (xs.array() <= 0.0).any()) continue;
+    const double rss = (S * xs - b).squaredNorm();
+    if (rss < best.rss) {
+      best.rss = rss;
+      best.x.setZero();
+      for (std::size_t k = 0; k < cols.size(); ++k) best.x[cols[k]] = xs[static_cast<Eigen::Index>(k)];
+    }
+  }
+  return best;
+}
+
+}  // namespace detail
+
 namespace {
+
+using detail::nnls_small;
+using detail::Nnls;
+
 
 /// The files of `tests`, for messages: "uniaxial a.csv (12 points), planar b.csv (8 points)".
 std::string describe(const std::vector<TestCurve>& tests) {
@@ -46,35 +76,6 @@ Rows weighted_rows(const std::vector<TestCurve>& tests, Law law, const std::vect
     }
   }
   return r;
-}
-
-/// min ||A x - b||^2 subject to x >= 0 for A with at most 3 columns, exactly: the optimum is the
-/// unconstrained least-squares solution on its support (the KKT conditions), so trying every
-/// support and keeping the best one whose solution is positive finds it.
-struct Nnls {
-  Eigen::VectorXd x;
-  double rss;
-};
-
-Nnls nnls_small(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) {
-  const int n = static_cast<int>(A.cols());
-  Nnls best{Eigen::VectorXd::Zero(n), b.squaredNorm()};
-  for (int mask = 1; mask < (1 << n); ++mask) {
-    std::vector<int> cols;
-    for (int k = 0; k < n; ++k)
-      if (mask & (1 << k)) cols.push_back(k);
-    Eigen::MatrixXd S(A.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t k = 0; k < cols.size(); ++k) S.col(static_cast<Eigen::Index>(k)) = A.col(cols[k]);
-    const Eigen::VectorXd xs = S.colPivHouseholderQr().solve(b);
-    if (!xs.allFinite() || (xs.array() <= 0.0).any()) continue;
-    const double rss = (S * xs - b).squaredNorm();
-    if (rss < best.rss) {
-      best.rss = rss;
-      best.x.setZero();
-      for (std::size_t k = 0; k < cols.size(); ++k) best.x[cols[k]] = xs[static_cast<Eigen::Index>(k)];
-    }
-  }
-  return best;
 }
 
 void check_constants(const std::vector<TestCurve>& tests, const Constants& k) {

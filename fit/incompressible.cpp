@@ -110,6 +110,28 @@ double nominal_stress(const Constants& k, TestMode m, double lambda) {
   return b.dot(Eigen::Map<const Eigen::VectorXd>(k.c.data(), static_cast<Eigen::Index>(k.c.size())));
 }
 
+double strain_energy(const Constants& k, const Vec3& l) {
+  if (k.law == Law::ogden) {
+    double W = 0.0;
+    for (std::size_t i = 0; i < k.c.size(); ++i) {
+      const double a = k.alpha[i];
+      double s = 0.0;
+      for (int c = 0; c < 3; ++c) s += std::expm1(a * std::log(l[c]));
+      W += 2.0 * k.c[i] / (a * a) * s;
+    }
+    return W;
+  }
+  Invariants v{};
+  v.J = 1.0;
+  v.I1b = l.squaredNorm();
+  v.I2b = l.cwiseInverse().squaredNorm();
+  switch (k.law) {
+    case Law::neo_hookean: return NeoHookean(k.c[0], 1.0).derivatives(v).W;
+    case Law::mooney_rivlin: return MooneyRivlin(k.c[0], k.c[1], 1.0).derivatives(v).W;
+    default: return Yeoh(k.c[0], k.c[1], k.c[2], 1.0).derivatives(v).W;
+  }
+}
+
 MaterialPtr make_law_material(const Constants& k, double K) {
   switch (k.law) {
     case Law::neo_hookean: return std::make_shared<InvariantMaterial<NeoHookean>>(NeoHookean(k.c.at(0), K));

@@ -65,6 +65,10 @@ Eigen::MatrixXd kirchhoff_basis(Law law, const std::vector<double>& alpha, const
 Eigen::VectorXd nominal_stress_basis(Law law, const std::vector<double>& alpha, TestMode m, double lambda);
 /// Nominal stress (Pa) of the constants in mode `m` at stretch `lambda`, from (1).
 double nominal_stress(const Constants& k, TestMode m, double lambda);
+/// Isochoric strain energy density W (Pa) at the principal stretches `lambda` (J = 1): the laws' own
+/// W (materials/) for the invariant laws, sum 2 mu_i/alpha_i^2 (sum_a lambda_a^alpha_i - 3) for Ogden.
+/// The Mullins law is driven by it (fit/inelastic.h).
+double strain_energy(const Constants& k, const Vec3& lambda);
 
 /// The 3D law of materials/ with these constants and bulk modulus K_Pa: the constructor checks
 /// them (InputError from the law: yeoh C10 > 0, ogden mu_i > 0, ...).
