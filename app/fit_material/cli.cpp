@@ -36,7 +36,7 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
       "as Abaqus's test data), by weighted least squares: DIR/material.toml (the scene's [materials.NAME] block), "
       "residuals.csv, fit.svg (+ fit.csv), fit.json, R^2 per test and the Drucker stability check");
   f->add_option("data", o.data,
-                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE (or a FILE whose name says which); CSV whose header "
+                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, relaxation:FILE (or a FILE whose name says which); CSV whose header "
                 "names the strain (strain, strain_percent or stretch) and the stress with its unit (stress_kPa, "
                 "stress_MPa, stress_Pa, stress_psi)")
       ->required();
@@ -62,6 +62,17 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
       ->capture_default_str();
   f->add_option("--stability-range", c->stability_range,
                 "Nominal strain range LO:HI of the Drucker stability check (Abaqus: -0.9:9)")
+      ->capture_default_str();
+  f->add_flag("--mullins", o.mullins,
+              "The tension tests are loading-unloading cycles in time order: fit the law to the primary loading and "
+              "Ogden-Roxburgh r, m, beta to the rest ([materials.NAME.mullins])");
+  f->add_option("--prony", o.prony_terms, "Prony terms (1-3) fitted to a relaxation:FILE ([materials.NAME.viscoelastic])")
+      ->check(CLI::Range(1, 3))
+      ->capture_default_str();
+  f->add_option("--moduli", o.moduli,
+                "The viscoelastic block's convention: instantaneous (the law is the response right after a step, as "
+                "Abaqus) or long_term")
+      ->check(CLI::IsMember({"instantaneous", "long_term"}))
       ->capture_default_str();
   f->add_flag("--allow-unstable", o.allow_unstable,
               "Write a fit that is unstable within its own data's strain range (a warning instead of an error)");
@@ -90,12 +101,23 @@ int run_fit_material_command(FitMaterialCommand& c) {
     if (k.law == fit::Law::ogden) std::printf(" (alpha %s)", short_num(k.alpha[i]).c_str());
   }
   std::printf("; mu0 %s MPa\n", short_num(k.mu0() * 1e-6).c_str());
+  if (r.mullins)
+    std::printf("Mullins (Ogden-Roxburgh, %d unloading/reloading points): r %s, m %s MPa, beta %s; R^2 with it %s\n",
+                r.mullins->unloading_points, short_num(r.mullins->params.r).c_str(),
+                short_num(r.mullins->params.m_Pa * 1e-6).c_str(), short_num(r.mullins->params.beta).c_str(),
+                short_num(r.mullins->r2.front()).c_str());
+  if (r.prony) {
+    std::printf("Prony (%s, %zu points): ", r.relaxation.front().source.c_str(), r.relaxation.front().points.size());
+    for (std::size_t i = 0; i < r.prony->g.size(); ++i)
+      std::printf("%sg %s tau %s s", i ? ", " : "", short_num(r.prony->g[i]).c_str(), short_num(r.prony->tau_s[i]).c_str());
+    std::printf("; R^2 %.4f\n", r.prony->r2);
+  }
   for (const std::string& w : r.warnings) std::printf("warning: %s\n", w.c_str());
   if (r.stability.stable())
     std::printf("Drucker stability: stable for nominal strains %s to %s in all six paths\n",
                 short_num(r.stability.strain_lo).c_str(), short_num(r.stability.strain_hi).c_str());
-  std::printf("wrote %s/material.toml ([materials.%s]), residuals.csv, fit.svg (+ fit.csv), fit.json\n",
-              c.options.out_dir.c_str(), c.options.name.c_str());
+  std::printf("wrote %s/material.toml ([materials.%s]), residuals.csv, fit.svg (+ fit.csv)%s, fit.json\n",
+              c.options.out_dir.c_str(), c.options.name.c_str(), r.prony ? ", relaxation.svg (+ .csv)" : "");
   return 0;
 }
 

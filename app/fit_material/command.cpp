@@ -11,6 +11,7 @@
 #include "core/number_text.h"
 #include "core/output_dir.h"
 #include "core/version.h"
+#include "damage/viscoelastic.h"
 #include "viz/svg_plot.h"
 
 namespace pneufem {
@@ -66,14 +67,35 @@ std::string stability_text(const fit::StabilityLimit& s) {
 
 // --- the steps ----------------------------------------------------------------------------------
 
-std::vector<fit::TestCurve> read_tests(const FitMaterialOptions& o, std::vector<std::string>& notes) {
+void read_tests(const FitMaterialOptions& o, FitMaterialResult& r) {
   if (o.data.empty()) throw InputError("fit-material: give at least one DATA file (uniaxial:FILE, biaxial:FILE, planar:FILE)");
-  std::vector<fit::TestCurve> tests;
+  if (o.mullins && std::isfinite(o.max_strain))
+    throw InputError("--max-strain cannot cut loading-unloading cycles (the Mullins law needs each cycle's peak); "
+                     "leave it out with --mullins");
   for (const std::string& arg : o.data) {
     const TestFileSpec spec = parse_test_spec(arg);
-    tests.push_back(read_test_csv(spec.path, spec.mode, notes, o.max_strain));
+    if (spec.relaxation) r.relaxation.push_back(read_relaxation_csv(spec.path, r.notes));
+    else r.tests.push_back(read_test_csv(spec.path, spec.mode, r.notes, o.max_strain, o.mullins));
   }
-  return tests;
+  if (r.tests.empty())
+    throw InputError("fit-material: no tension test among the DATA files; give the law's uniaxial:, biaxial: or "
+                     "planar: test (a relaxation test only adds Prony terms to it)");
+  if (r.relaxation.size() > 1)
+    throw InputError("fit-material: " + std::to_string(r.relaxation.size()) + " relaxation files; give one");
+}
+
+/// The model's stresses replace the base law's in each test's share of the fit (with --mullins).
+void use_mullins_model(FitMaterialResult& r) {
+  r.mullins = fit::fit_mullins(r.tests, r.fit.constants, r.fit_options.weighting, r.fit_options.max_evaluations);
+  for (std::size_t t = 0; t < r.tests.size(); ++t) {
+    fit::TestFit& f = r.fit.tests[t];
+    f.model_P_Pa = r.mullins->model_P_Pa[t];
+    f.r2 = r.mullins->r2[t];
+    const std::vector<double> rel = fit::point_weights(r.tests[t], fit::Weighting::relative);
+    double s = 0.0;
+    for (std::size_t j = 0; j < rel.size(); ++j) s += std::pow((f.model_P_Pa[j] - r.tests[t].points[j].P_Pa) * rel[j], 2);
+    f.rms_relative = std::sqrt(s / static_cast<double>(rel.size()));
+  }
 }
 
 void write_residuals(const std::string& dir, const FitMaterialResult& r) {
@@ -121,10 +143,15 @@ void write_figure(const std::string& dir, const FitMaterialResult& r) {
     dots.line_width = 0.0;
     top.scatter(x, y, label + " data", dots);
     std::vector<double> xf, yf;
-    for (int k = 0; k <= 200; ++k) {
-      const double e = hi * k / 200.0;
-      xf.push_back(e);
-      yf.push_back(fit::nominal_stress(r.fit.constants, c.mode, 1.0 + e) * 1e-6);
+    if (r.mullins) {  // path-dependent: the model along the test's own path
+      xf = x;
+      for (double P : r.fit.tests[t].model_P_Pa) yf.push_back(P * 1e-6);
+    } else {
+      for (int k = 0; k <= 200; ++k) {
+        const double e = hi * k / 200.0;
+        xf.push_back(e);
+        yf.push_back(fit::nominal_stress(r.fit.constants, c.mode, 1.0 + e) * 1e-6);
+      }
     }
     svg::Style line;
     line.color = svg::palette_color(t);
@@ -132,6 +159,25 @@ void write_figure(const std::string& dir, const FitMaterialResult& r) {
     bottom.scatter(x, res, label, dots);
   }
   fig.save(dir + "/fit.svg");
+  if (!r.prony) return;
+  svg::Figure rel(svg::kColumnWidthPx, 320);
+  const fit::RelaxationCurve& c = r.relaxation.front();
+  svg::Axes& ax = rel.axes();
+  ax.title("relaxation").xlabel("time since the step (s)").ylabel("g_R = stress / stress at 0+").xlog();
+  std::vector<double> t, g, tf, gf;
+  for (const fit::RelaxationPoint& p : c.points)
+    if (p.t_s > 0.0) t.push_back(p.t_s), g.push_back(p.g);
+  svg::Style dots;
+  dots.marker = svg::Marker::Circle;
+  dots.marker_size = 2.0;
+  dots.line_width = 0.0;
+  ax.scatter(t, g, "data", dots);
+  for (int k = 0; k <= 200 && !t.empty(); ++k) {
+    tf.push_back(t.front() * std::pow(t.back() / t.front(), k / 200.0));
+    gf.push_back(fit::prony_relaxation(r.prony->g, r.prony->tau_s, tf.back()));
+  }
+  ax.line(tf, gf, std::to_string(r.prony->g.size()) + "-term Prony fit");
+  rel.save(dir + "/relaxation.svg");
 }
 
 void write_json(const std::string& dir, const FitMaterialOptions& o, const FitMaterialResult& r) {
@@ -180,6 +226,19 @@ void write_json(const std::string& dir, const FitMaterialOptions& o, const FitMa
   root.add("constants", constants.str(2)).add("objective", r.fit.objective);
   root.add("evaluations", json::num(r.fit.evaluations)).add("tests", tests);
   root.add("drucker_stability", stab.str(2)).add("notes", notes);
+  if (r.mullins) {
+    json::Object m;
+    m.add("r", r.mullins->params.r).add("m_MPa", r.mullins->params.m_Pa * 1e-6).add("beta", r.mullins->params.beta);
+    m.add("objective", r.mullins->objective).add("unloading_points", json::num(r.mullins->unloading_points));
+    m.add("r2", json::array(r.mullins->r2));
+    root.add("mullins", m.str(2));
+  }
+  if (r.prony) {
+    json::Object p;
+    p.add("g", json::array(r.prony->g)).add("tau_s", json::array(r.prony->tau_s));
+    p.add("objective", r.prony->objective).add("r2", r.prony->r2).add_str("file", r.relaxation.front().source);
+    root.add("prony", p.str(2));
+  }
   write_file_atomic(dir + "/fit.json", root.str() + "\n");
 }
 
@@ -234,6 +293,24 @@ std::string material_block(const FitMaterialOptions& o, const FitMaterialResult&
   }
   s += "K_over_mu = " + json::num(o.K_over_mu) + "\n";
   s += "density_kg_m3 = " + json::num(o.density_kg_m3) + "\n";
+  if (r.mullins) {
+    const MullinsParams& p = r.mullins->params;
+    s += "\n# Ogden-Roxburgh Mullins softening fitted to " + std::to_string(r.mullins->unloading_points) +
+         " unloading/reloading points (the law above: the primary loading)\n";
+    s += "[materials." + o.name + ".mullins]\nenabled = true\n";
+    s += "r = " + json::num(p.r) + "\nm_MPa = " + json::num(p.m_Pa * 1e-6) + "\nbeta = " + json::num(p.beta) + "\n";
+  }
+  if (r.prony) {
+    const ViscoParams v = prony_from_abaqus(r.prony->g, r.prony->tau_s,
+                                                 o.moduli == "long_term" ? ViscoModuli::long_term : ViscoModuli::instantaneous);
+    s += "\n# Prony terms fitted to " + r.relaxation.front().source + " (R^2 " + fixed(r.prony->r2, 4) +
+         "); Abaqus g_i = " + toml_list(r.prony->g, 1.0) + ", gamma_i = g_i / (1 - sum g).\n";
+    s += "# moduli = \"" + o.moduli + "\": the law above is the " +
+         (o.moduli == "long_term" ? std::string("relaxed (long-term)") : std::string("instantaneous")) +
+         " response (damage/viscoelastic.h)\n";
+    s += "[materials." + o.name + ".viscoelastic]\nenabled = true\nmoduli = \"" + o.moduli + "\"\n";
+    s += "gamma = " + toml_list(v.gamma, 1.0) + "\ntau_s = " + toml_list(v.tau_s, 1.0) + "\n";
+  }
   return s;
 }
 
@@ -265,8 +342,22 @@ FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
   if (!(o.K_over_mu >= 1.0)) throw InputError("--K-over-mu must be >= 1 (silicone: 100-1000), got " + short_num(o.K_over_mu));
   if (!(o.stability_lo > -1.0 && o.stability_lo <= 0.0 && o.stability_hi >= 0.0))
     throw InputError("--stability-range: the low end must lie in (-1, 0] and the high end be >= 0");
-  r.tests = read_tests(o, r.notes);
-  r.fit = fit::fit_hyperelastic(r.tests, r.fit_options);
+  if (o.moduli != "instantaneous" && o.moduli != "long_term")
+    throw InputError("--moduli " + o.moduli + ": use instantaneous (Abaqus's default) or long_term");
+  read_tests(o, r);
+  if (o.mullins) {
+    std::vector<fit::TestCurve> primary;
+    for (const fit::TestCurve& t : r.tests) primary.push_back(fit::primary_loading(t));
+    r.fit = fit::fit_hyperelastic(primary, r.fit_options);
+    r.fit.tests = fit::evaluate_fit(r.tests, r.fit.constants, r.fit_options.weighting);
+    use_mullins_model(r);
+  } else {
+    r.fit = fit::fit_hyperelastic(r.tests, r.fit_options);
+  }
+  if (!r.relaxation.empty()) {
+    r.prony = fit::fit_prony(r.relaxation.front(), o.prony_terms, o.max_evaluations);
+    for (const std::string& n : r.prony->notes) r.notes.push_back(n);
+  }
   for (const std::string& n : r.fit.notes) r.notes.push_back(n);
   check_stability(o, r);
   r.toml = material_block(o, r);

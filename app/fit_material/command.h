@@ -2,7 +2,9 @@
 // `pneufem fit-material`: hyperelastic constants from lab tests (fit/fit.h does the math),
 // written as the scene's [materials.NAME] block with the evidence beside it.
 //
-// Steps, each a function below: read the test files (test_data.h) -> fit -> check Drucker stability
+// Steps, each a function below: read the test files (test_data.h) -> fit the law (to the primary
+// loading of cycles with --mullins, then r, m, beta; fit/inelastic.h) and Prony terms to a relaxation
+// test -> check Drucker stability
 // over a strain range (fit/stability.h; unstable within a test's own data is an error,
 // elsewhere a warning, as Abaqus warns) -> write DIR/material.toml, residuals.csv, fit.svg (+ fit.csv,
 // the plotted series) and fit.json.
@@ -10,7 +12,10 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
 #include "fit/fit.h"
+#include "fit/inelastic.h"
 #include "fit/stability.h"
 
 namespace pneufem {
@@ -27,6 +32,9 @@ struct FitMaterialOptions {
   int max_evaluations = 5000;
   double stability_lo = -0.9, stability_hi = 9.0;  ///< nominal strain range of the Drucker check
   bool allow_unstable = false;    ///< write a fit that is unstable within its own data (warning instead of error)
+  bool mullins = false;           ///< the tension tests are loading-unloading cycles: fit Ogden-Roxburgh too
+  int prony_terms = 1;            ///< Prony terms fitted to a relaxation:FILE
+  std::string moduli = "instantaneous";  ///< the viscoelastic block's convention (damage/viscoelastic.h)
 };
 
 struct FitMaterialResult {
@@ -34,6 +42,9 @@ struct FitMaterialResult {
   fit::FitOptions fit_options;
   fit::FitResult fit;
   fit::StabilityReport stability;
+  std::optional<fit::MullinsFit> mullins;      ///< with --mullins: r, m, beta on the base `fit`
+  std::vector<fit::RelaxationCurve> relaxation;
+  std::optional<fit::PronyFit> prony;          ///< with a relaxation:FILE
   std::vector<std::string> notes;     ///< from reading and fitting
   std::vector<std::string> warnings;  ///< stability
   std::string toml;                   ///< the material block as written

@@ -50,7 +50,7 @@ std::string normalise(const std::string& name) {
 
 /// What a header column holds.
 struct Column {
-  enum Kind { other, strain, stretch, stress, true_quantity } kind = other;
+  enum Kind { other, strain, stretch, stress, true_quantity, time, ratio } kind = other;
   double scale = 1.0;  ///< to dimensionless strain or Pa
   std::string unit;    ///< as written after the quantity ("kpa", "%", "" = none)
   std::string name;    ///< as written in the header
@@ -85,6 +85,20 @@ Column classify(const std::string& raw) {
       c.kind = Column::stretch;
       return c;
     }
+  for (const char* w : {"g_r", "g", "normalized_modulus", "normalised_modulus", "modulus_ratio", "stress_ratio",
+                        "relaxation_modulus_ratio", "normalized_stress", "normalised_stress"})
+    if (s == w) {
+      c.kind = Column::ratio;
+      return c;
+    }
+  if (auto u = unit_after("time")) {
+    static const std::map<std::string, double> kUnits = {{"s", 1.0}, {"sec", 1.0}, {"ms", 1e-3}, {"min", 60.0}, {"h", 3600.0}};
+    c.kind = Column::time;
+    c.unit = *u;
+    const auto it = kUnits.find(*u);
+    c.scale = it == kUnits.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+    return c;
+  }
   if (auto u = unit_after("stress")) {
     static const std::map<std::string, double> kUnits = {
         {"pa", 1.0},     {"kpa", 1e3},    {"mpa", 1e6},   {"gpa", 1e9},  {"psi", 6894.757293168361},
@@ -209,6 +223,8 @@ Layout layout_of(const std::vector<Column>& cols, const std::string& path, int l
 
 TestFileSpec parse_test_spec(const std::string& arg) {
   const std::size_t colon = arg.find(':');
+  if (colon != std::string::npos && lower(arg.substr(0, colon)) == "relaxation")
+    return {TestMode::uniaxial, arg.substr(colon + 1), true};
   if (colon != std::string::npos) {
     const std::string word = lower(arg.substr(0, colon));
     for (const auto& [w, m] : mode_words())
@@ -222,13 +238,17 @@ TestFileSpec parse_test_spec(const std::string& arg) {
     if (found && *found != m) { found.reset(); break; }
     found = m;
   }
+  const bool relaxation = name.find("relaxation") != std::string::npos;
+  if (relaxation) return {TestMode::uniaxial, arg, true};  // a held step of any specimen
   if (!found)
-    throw InputError(arg + ": which test is it? Write uniaxial:" + arg + ", biaxial:" + arg + " or planar:" + arg +
+    throw InputError(arg + ": which test is it? Write uniaxial:" + arg + ", biaxial:" + arg + ", planar:" + arg +
+                     " or relaxation:" + arg +
                      " (nominal stress against nominal strain, as Abaqus's *UNIAXIAL / *BIAXIAL / *PLANAR TEST DATA)");
   return {*found, arg};
 }
 
-fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector<std::string>& notes, double max_strain) {
+fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector<std::string>& notes, double max_strain,
+                             bool cycles) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the test data file; check the path");
   fit::TestCurve curve{mode, path, {}};
@@ -294,12 +314,12 @@ fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector
       throw InputError(where(path, line_no) + "nominal strain " + short_num(strain) +
                        " is negative (compression, or an offset of the extensometer): fit-material fits tension "
                        "tests only; remove the compression rows or shift the strain so the test starts at 0");
-    if (strain < prev_strain)
+    if (strain < prev_strain && !cycles)
       throw InputError(where(path, line_no) + "the strain falls from " + short_num(prev_strain) + " (line " +
                        std::to_string(prev_line) + ") to " + short_num(strain) +
                        ": not a loading curve (an unloading branch, a cycle, or unsorted rows). Keep the first "
                        "loading up to line " + std::to_string(prev_line) +
-                       "; loading-unloading cycles (Mullins) are not fitted yet");
+                       "; for loading-unloading cycles, fit the Mullins effect with --mullins");
     prev_strain = strain;
     prev_line = line_no;
     if (strain > max_strain) {
@@ -325,6 +345,90 @@ fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector
     notes.push_back(path + ":" + std::to_string(first_negative) + ": " + std::to_string(negative) +
                     " point(s) with zero or negative stress at a positive strain, the first here (a load-cell offset or "
                     "a slack specimen), left out: a rubber in tension pulls");
+  return curve;
+}
+
+fit::RelaxationCurve read_relaxation_csv(const std::string& path, std::vector<std::string>& notes) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the relaxation data file; check the path");
+  fit::RelaxationCurve curve{path, {}};
+  std::string text;
+  int line_no = 0, header_line = 0, skipped = 0, time_col = -1, value_col = -1;
+  Column time_c, value_c;
+  char d = ',';
+  double first_stress = 0.0, prev_t = -1.0;
+  int prev_line = 0;
+  while (std::getline(in, text)) {
+    ++line_no;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line_no == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = text.substr(3);
+    const std::size_t first = text.find_first_not_of(" \t");
+    if (first == std::string::npos || text[first] == '#') continue;
+    if (header_line == 0) {
+      const char hd = delimiter_of(text);
+      const std::vector<std::string> cells = split(text, hd);
+      if (all_empty(cells)) continue;
+      if (all_numbers(cells, hd))
+        throw InputError(where(path, line_no) + "data before any header; name the columns, e.g. 'time_s,g_R' (the "
+                         "stress over the stress right after the step) or 'time_s,stress_kPa'");
+      time_col = value_col = -1;
+      for (int i = 0; i < static_cast<int>(cells.size()); ++i) {
+        const Column c = classify(cells[i]);
+        if (c.kind == Column::time && time_col < 0) time_col = i, time_c = c;
+        if ((c.kind == Column::ratio || c.kind == Column::stress) && value_col < 0) value_col = i, value_c = c;
+      }
+      if (time_col < 0 || value_col < 0) {
+        if (++skipped > 200) break;
+        continue;
+      }
+      if (std::isnan(time_c.scale))
+        throw InputError(where(path, line_no) + "column '" + time_c.name + "': " +
+                         (time_c.unit.empty() ? std::string("no time unit") : "unknown time unit '" + time_c.unit + "'") +
+                         "; name it time_s, time_ms, time_min or time_h");
+      if (value_c.kind == Column::stress && std::isnan(value_c.scale))
+        throw InputError(where(path, line_no) + "column '" + value_c.name + "' needs a known stress unit (stress_kPa, "
+                         "stress_MPa, ...) or give the normalised stress as g_R");
+      header_line = line_no;
+      d = hd;
+      if (skipped) notes.push_back(path + ": " + std::to_string(skipped) + " line(s) before the header (line " +
+                                   std::to_string(line_no) + ") skipped");
+      continue;
+    }
+    const std::vector<std::string> cells = split(text, d);
+    if (all_empty(cells)) continue;
+    const auto cell = [&](int col, const Column& c) {
+      const std::optional<double> v = col < static_cast<int>(cells.size()) ? number(cells[col], d) : std::nullopt;
+      if (!v || !std::isfinite(*v))
+        throw InputError(where(path, line_no) + "no number in column '" + c.name + "'; fix or remove the row");
+      return *v;
+    };
+    const double t = cell(time_col, time_c) * time_c.scale, v = cell(value_col, value_c);
+    if (t < 0.0)
+      throw InputError(where(path, line_no) + "time " + short_num(t) + " s is negative: give the time since the step "
+                       "(the step at t = 0)");
+    if (t <= prev_t)
+      throw InputError(where(path, line_no) + "the time does not increase (" + short_num(t) + " s after " +
+                       short_num(prev_t) + " s at line " + std::to_string(prev_line) + "); sort the rows or remove the repeat");
+    prev_t = t;
+    prev_line = line_no;
+    double g = v;
+    if (value_c.kind == Column::stress) {
+      if (curve.points.empty()) {
+        if (!(v > 0.0))
+          throw InputError(where(path, line_no) + "the first stress, " + short_num(v) + " " + value_c.unit +
+                           ", must be > 0: it normalises the curve (the stress right after the step)");
+        first_stress = v;
+        notes.push_back(path + ": stress normalised by its first row's (line " + std::to_string(line_no) + ", " +
+                        short_num(v) + " " + value_c.unit + ", at t = " + short_num(t) + " s) as g_R(t)");
+      }
+      g = v / first_stress;
+    }
+    curve.points.push_back({t, g, line_no});
+  }
+  if (header_line == 0)
+    throw InputError(path + ": no header naming a time column (time_s, ...) and the relaxing stress (g_R, or "
+                     "stress_kPa, ...)");
+  if (curve.points.empty()) throw InputError(path + ": no data rows after the header (line " + std::to_string(header_line) + ")");
   return curve;
 }
 

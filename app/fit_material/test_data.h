@@ -22,21 +22,32 @@
 #include <vector>
 
 #include "fit/fit.h"
+#include "fit/inelastic.h"
 
 namespace pneufem {
 
 /// A DATA argument: "uniaxial:FILE", "biaxial:FILE" (or "equibiaxial:"), "planar:FILE" (or
-/// "pure_shear:", "pureshear:"), or a FILE whose name contains exactly one of those words.
+/// "pure_shear:", "pureshear:"), "relaxation:FILE", or a FILE whose name contains exactly one of
+/// those words.
 struct TestFileSpec {
   fit::TestMode mode;
   std::string path;
+  bool relaxation = false;  ///< a relaxation test (read_relaxation_csv); `mode` is then unused
 };
 TestFileSpec parse_test_spec(const std::string& arg);
 
 /// The curve of `path` (stresses in Pa). Points above `max_strain` are dropped (a note says how
 /// many). Notes (skipped lines, true-stress columns, rows left out) are appended to `notes`.
 /// Throws InputError "<path>:<line>: ..." with what to do.
+/// With `cycles` (loading-unloading data for a Mullins fit) the strain may fall; it must still be >= 0.
 fit::TestCurve read_test_csv(const std::string& path, fit::TestMode mode, std::vector<std::string>& notes,
-                             double max_strain = std::numeric_limits<double>::infinity());
+                             double max_strain = std::numeric_limits<double>::infinity(), bool cycles = false);
+
+/// A relaxation test: a step strain held. The header names the time since the step (time_s, time_ms,
+/// time_min, time_h, "Time (s)") and either the normalised stress g_R (g_R, g, normalized_modulus,
+/// normalised_modulus, modulus_ratio, stress_ratio), or the stress with a unit (stress_kPa, ...), which
+/// is then divided by the first row's stress (a note says so; that row should be right after the
+/// step). The time must increase and be >= 0. Throws InputError "<path>:<line>: ...".
+fit::RelaxationCurve read_relaxation_csv(const std::string& path, std::vector<std::string>& notes);
 
 }  // namespace pneufem

@@ -9,6 +9,7 @@
 
 #include "app/fit_material/command.h"
 #include "app/fit_material/test_data.h"
+#include "fit/inelastic.h"
 #include "scenes/build_model.h"
 #include "scenes/scene.h"
 #include "tests/app/cli_helpers.h"
@@ -251,6 +252,82 @@ TEST(FitMaterialCommand, UnstableWithinItsOwnDataIsAnErrorUnlessAllowed) {
   const FitMaterialResult r = run_fit_material(o);
   EXPECT_FALSE(r.stability.stable());
   EXPECT_NE(test::slurp(fs::path(o.out_dir) / "material.toml").find("UNSTABLE from uniaxial tension"), std::string::npos);
+}
+
+// Loading-unloading cycles and a relaxation test through the whole command: a Yeoh base with Mullins
+// softening (three cycles to stretches 1.5, 2, 2.5) and a 2-term Prony relaxation (stress in kPa,
+// normalised by the first row, at t = 0), written as CSV to 10 significant digits. The constants come back within
+// what that rounding allows (1e-4 relative; measured < 1e-6), and the three blocks - law, mullins,
+// viscoelastic - read back by the scene reader build the decorated material.
+TEST(FitMaterialCommand, MullinsCyclesAndRelaxationGiveTheEffectBlocks) {
+  const fit::Constants base{fit::Law::yeoh, {0.019e6, 9.0e2, -4.75}, {}};
+  const MullinsParams mp{1.8, 0.004e6, 0.15};
+  fit::TestCurve path{TestMode::uniaxial, "", {}};
+  const auto go = [&](double a, double b) {
+    for (int i = 1; i <= 20; ++i) path.points.push_back({a + (b - a) * i / 20, 0.0, 0});
+  };
+  go(1.0, 1.5), go(1.5, 1.05), go(1.05, 2.0), go(2.0, 1.05), go(1.05, 2.5), go(2.5, 1.05);
+  const std::vector<double> P = fit::mullins_stress(path, base, mp);
+  std::string cyc = "strain,stress_MPa\n";
+  char buf[96];
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%.10g,%.10g\n", path.points[i].stretch - 1.0, P[i] * 1e-6);
+    cyc += buf;
+  }
+  const std::vector<double> g{0.2, 0.1}, tau{1.5, 60.0};
+  std::string rel = "time_s,stress_kPa\n0,30\n";  // the first row right after the step normalises
+  for (int k = 0; k <= 60; ++k) {
+    const double t = 0.05 * std::pow(10.0, 4.0 * k / 60.0);
+    std::snprintf(buf, sizeof buf, "%.10g,%.10g\n", t, 30.0 * fit::prony_relaxation(g, tau, t));
+    rel += buf;
+  }
+  FitMaterialOptions o;
+  o.data = {"uniaxial:" + write_temp("cycles.csv", cyc), write_temp("relaxation_test.csv", rel)};
+  o.mullins = true;
+  o.prony_terms = 2;
+  o.out_dir = test::fresh_dir("fit_effects").string();
+  const FitMaterialResult r = run_fit_material(o);
+  ASSERT_TRUE(r.mullins && r.prony);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(r.fit.constants.c[i], base.c[i], 1e-4 * std::abs(base.c[i]) + 1e-6 * base.c[0]);
+  EXPECT_NEAR(r.mullins->params.r, mp.r, 1e-4 * mp.r);
+  EXPECT_NEAR(r.mullins->params.m_Pa, mp.m_Pa, 1e-4 * mp.m_Pa);
+  EXPECT_NEAR(r.mullins->params.beta, mp.beta, 1e-4 * mp.beta);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(r.prony->g[i], g[i], 1e-4 * g[i]);
+    EXPECT_NEAR(r.prony->tau_s[i], tau[i], 1e-4 * tau[i]);
+  }
+  EXPECT_TRUE(fs::exists(fs::path(o.out_dir) / "relaxation.svg"));
+  const Scene s = Scene::load(write_temp("effects_scene.toml", r.toml));
+  const MaterialPtr m = make_material(s, "silicone");
+  EXPECT_EQ(m->name(), "viscoelastic(mullins(yeoh))");
+  EXPECT_NEAR(s.number("materials.silicone.mullins.r"), mp.r, 1e-4 * mp.r);
+  // gamma_i = g_i / (1 - sum g): 0.2 / 0.7, 0.1 / 0.7
+  EXPECT_NEAR(s.numbers("materials.silicone.viscoelastic.gamma")[0], 0.2 / 0.7, 1e-4);
+  EXPECT_EQ(s.string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+}
+
+TEST(FitMaterialCommandErrors, EffectDataMisuse) {
+  FitMaterialOptions o;
+  o.out_dir = test::fresh_dir("fit_misuse").string();
+  o.data = {"uniaxial:" + kEcoflex};
+  o.mullins = true;
+  o.max_strain = 2.0;
+  EXPECT_NE(error_of([&] { run_fit_material(o); }).find("--max-strain cannot cut loading-unloading cycles"),
+            std::string::npos);
+  o.max_strain = std::numeric_limits<double>::infinity();
+  EXPECT_NE(error_of([&] { run_fit_material(o); }).find("needs unloading or reloading points"), std::string::npos);
+  o.mullins = false;
+  o.data = {"relaxation:" + write_temp("r1.csv", "time_s,g_R\n0.1,1\n1,0.9\n10,0.85\n")};
+  EXPECT_NE(error_of([&] { run_fit_material(o); }).find("no tension test among the DATA files"), std::string::npos);
+  std::vector<std::string> notes;
+  const std::string back = write_temp("back.csv", "time_s,g_R\n0.1,1\n1,0.9\n0.5,0.85\n");
+  EXPECT_NE(error_of([&] { read_relaxation_csv(back, notes); }).find("back.csv:4: the time does not increase"),
+            std::string::npos);
+  const std::string neg = write_temp("neg.csv", "Time (min);stress (kPa)\n-1;10\n");
+  EXPECT_NE(error_of([&] { read_relaxation_csv(neg, notes); }).find("neg.csv:2: time -60 s is negative"),
+            std::string::npos);
+  const std::string unit = write_temp("unit.csv", "time_days,g_R\n1,1\n");
+  EXPECT_NE(error_of([&] { read_relaxation_csv(unit, notes); }).find("unknown time unit 'days'"), std::string::npos);
 }
 
 // The executable: exit code 2 and the message for bad input; a run prints R^2 and the constants.
