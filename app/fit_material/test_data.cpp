@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -219,6 +220,77 @@ Layout layout_of(const std::vector<Column>& cols, const std::string& path, int l
   return l;
 }
 
+/// The rows of a delimited file after its header: the first line (not '#', not blank) that
+/// `is_header` accepts; lines before it that are not data (a machine's metadata block) are skipped and
+/// counted, and a line of numbers before any header is an error (`example` shows a header).
+struct Table {
+  std::string path;
+  char delimiter = ',';
+  int header_line = 0;
+  int skipped = 0;
+  struct Row {
+    int line;
+    std::vector<std::string> cells;
+  };
+  std::vector<Row> rows;
+
+  /// The number in column `col` of `row`, or an error naming the file, line and column.
+  double number_at(const Row& row, int col, const Column& c) const {
+    const std::optional<double> v = col < static_cast<int>(row.cells.size()) ? number(row.cells[col], delimiter) : std::nullopt;
+    if (v && std::isfinite(*v)) return *v;
+    const std::string cell = col < static_cast<int>(row.cells.size()) ? row.cells[col] : "";
+    const bool unit_in_cell = cell.find_first_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ%") != std::string::npos;
+    throw InputError(where(path, row.line) + "'" + cell + "' in column '" + c.name + "' is not a number" +
+                     (unit_in_cell ? " (units belong in the header, e.g. stress_kPa, not in the cells)" : "") +
+                     "; fix or remove the row");
+  }
+};
+
+Table read_table(const std::string& path, const std::function<bool(const std::vector<Column>&, int)>& is_header,
+                 const std::string& example) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the data file; check the path");
+  Table t;
+  t.path = path;
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = text.substr(3);  // UTF-8 byte-order mark
+    const std::size_t first = text.find_first_not_of(" \t");
+    if (first == std::string::npos || text[first] == '#') continue;
+    if (t.header_line == 0) {
+      const char d = delimiter_of(text);
+      const std::vector<std::string> cells = split(text, d);
+      if (all_empty(cells)) continue;  // ";;;;": a spreadsheet's blank row
+      if (all_numbers(cells, d))
+        throw InputError(where(path, line) + "data before any header; the first line must name the columns with "
+                         "their units, e.g. '" + example + "'");
+      std::vector<Column> cols;
+      for (const std::string& c : cells) cols.push_back(classify(c));
+      if (!is_header(cols, line)) {
+        if (++t.skipped > 200) break;
+        continue;
+      }
+      t.header_line = line;
+      t.delimiter = d;
+      continue;
+    }
+    std::vector<std::string> cells = split(text, t.delimiter);
+    if (!all_empty(cells)) t.rows.push_back({line, std::move(cells)});
+  }
+  if (t.header_line == 0)
+    throw InputError(path + ": no header naming the columns with their units, e.g. '" + example +
+                     "'; the file's first lines are not one");
+  if (t.rows.empty()) throw InputError(path + ": no data rows after the header (line " + std::to_string(t.header_line) + ")");
+  return t;
+}
+
+void note_skipped(const Table& t, std::vector<std::string>& notes) {
+  if (t.skipped > 0)
+    notes.push_back(t.path + ": " + std::to_string(t.skipped) + " line(s) before the header (line " +
+                    std::to_string(t.header_line) + ") skipped");
+}
+
 }  // namespace
 
 TestFileSpec parse_test_spec(const std::string& arg) {
@@ -249,95 +321,50 @@ TestFileSpec parse_test_spec(const std::string& arg) {
 
 fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector<std::string>& notes, double max_strain,
                              bool cycles) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the test data file; check the path");
-  fit::TestCurve curve{mode, path, {}};
-  std::string text;
-  int line_no = 0, header_line = 0, skipped = 0, dropped = 0, negative = 0, first_negative = 0;
-  char d = ',';
   Layout lay;
+  const Table t = read_table(
+      path,
+      [&](const std::vector<Column>& cols, int line) {
+        lay = layout_of(cols, path, line, notes);
+        return lay.strain_col >= 0 && lay.stress_col >= 0;
+      },
+      "strain,stress_kPa' or 'stretch,stress_MPa");
+  note_skipped(t, notes);
+  fit::TestCurve curve{mode, path, {}};
+  int dropped = 0, negative = 0, first_negative = 0, prev_line = 0;
   double prev_strain = -1.0;
-  int prev_line = 0;
-  while (std::getline(in, text)) {
-    ++line_no;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (line_no == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = text.substr(3);  // UTF-8 byte-order mark
-    std::size_t first = text.find_first_not_of(" \t");
-    if (first == std::string::npos || text[first] == '#') continue;
-    if (header_line == 0) {
-      const char hd = delimiter_of(text);
-      const std::vector<std::string> cells = split(text, hd);
-      if (all_empty(cells)) continue;  // ";;;;": a spreadsheet's blank row
-      if (all_numbers(cells, hd))
-        throw InputError(where(path, line_no) + "data before any header; the first line must name the columns with "
-                         "their units, e.g. 'strain,stress_kPa' or 'stretch,stress_MPa'");
-      std::vector<Column> cols;
-      for (const std::string& c : cells) cols.push_back(classify(c));
-      lay = layout_of(cols, path, line_no, notes);
-      if (lay.strain_col < 0 || lay.stress_col < 0) {
-        if (++skipped > 200) break;
-        continue;  // a metadata line of the machine's export
-      }
-      header_line = line_no;
-      d = hd;
-      if (skipped > 0)
-        notes.push_back(path + ": " + std::to_string(skipped) + " line(s) before the header (line " +
-                        std::to_string(line_no) + ") skipped");
-      continue;
-    }
-    const std::vector<std::string> cells = split(text, d);
-    if (all_empty(cells)) continue;
-    const int need = std::max(lay.strain_col, lay.stress_col);
-    if (static_cast<int>(cells.size()) <= need)
-      throw InputError(where(path, line_no) + "has " + std::to_string(cells.size()) + " field(s); the header (line " +
-                       std::to_string(header_line) + ") puts '" + lay.stress.name + "' in field " +
-                       std::to_string(lay.stress_col + 1) + " and '" + lay.strain.name + "' in field " +
-                       std::to_string(lay.strain_col + 1));
-    const auto cell = [&](int col, const Column& c) {
-      const std::optional<double> v = number(cells[col], d);
-      if (!v || !std::isfinite(*v))
-        throw InputError(where(path, line_no) + "'" + cells[col] + "' in column '" + c.name +
-                         "' is not a number" +
-                         (cells[col].find_first_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ%") !=
-                                  std::string::npos
-                              ? " (units belong in the header, e.g. stress_kPa, not in the cells)"
-                              : "") +
-                         "; fix or remove the row");
-      return *v;
-    };
-    const double x = cell(lay.strain_col, lay.strain), P = cell(lay.stress_col, lay.stress) * lay.stress.scale;
+  for (const Table::Row& row : t.rows) {
+    const double x = t.number_at(row, lay.strain_col, lay.strain);
+    const double P = t.number_at(row, lay.stress_col, lay.stress) * lay.stress.scale;
     const double strain = lay.strain.kind == Column::stretch ? x - 1.0 : x * lay.strain.scale;
     if (lay.strain.kind == Column::stretch && x <= 0.0)
-      throw InputError(where(path, line_no) + "stretch " + short_num(x) + " <= 0 is impossible; the column '" +
+      throw InputError(where(path, row.line) + "stretch " + short_num(x) + " <= 0 is impossible; the column '" +
                        lay.strain.name + "' must hold l = 1 + nominal strain");
     if (strain < 0.0)
-      throw InputError(where(path, line_no) + "nominal strain " + short_num(strain) +
+      throw InputError(where(path, row.line) + "nominal strain " + short_num(strain) +
                        " is negative (compression, or an offset of the extensometer): fit-material fits tension "
                        "tests only; remove the compression rows or shift the strain so the test starts at 0");
     if (strain < prev_strain && !cycles)
-      throw InputError(where(path, line_no) + "the strain falls from " + short_num(prev_strain) + " (line " +
+      throw InputError(where(path, row.line) + "the strain falls from " + short_num(prev_strain) + " (line " +
                        std::to_string(prev_line) + ") to " + short_num(strain) +
                        ": not a loading curve (an unloading branch, a cycle, or unsorted rows). Keep the first "
                        "loading up to line " + std::to_string(prev_line) +
                        "; for loading-unloading cycles, fit the Mullins effect with --mullins");
     prev_strain = strain;
-    prev_line = line_no;
+    prev_line = row.line;
     if (strain > max_strain) {
       ++dropped;
       continue;
     }
     if (strain > 0.0 && P <= 0.0) {  // a rubber in tension pulls: an offset or a slack specimen
-      if (negative++ == 0) first_negative = line_no;
+      if (negative++ == 0) first_negative = row.line;
       continue;
     }
-    curve.points.push_back({1.0 + strain, P, line_no});
+    curve.points.push_back({1.0 + strain, P, row.line});
   }
-  if (header_line == 0)
-    throw InputError(path + ": no header naming a strain (or stretch) column and a stress column with its unit, e.g. "
-                     "'strain,stress_kPa'; the file's first lines are not one");
   if (curve.points.empty())
-    throw InputError(path + ": no data rows " + (dropped ? "at or below --max-strain " + short_num(max_strain) : "") +
-                     " after the header (line " + std::to_string(header_line) + ")");
+    throw InputError(path + ": no usable data rows after the header (line " + std::to_string(t.header_line) + ")" +
+                     (dropped ? ": all above --max-strain " + short_num(max_strain) : std::string()));
   if (dropped)
     notes.push_back(path + ": " + std::to_string(dropped) + " point(s) above --max-strain " + short_num(max_strain) +
                     " left out");
@@ -349,86 +376,55 @@ fit::TestCurve read_test_csv(const std::string& path, TestMode mode, std::vector
 }
 
 fit::RelaxationCurve read_relaxation_csv(const std::string& path, std::vector<std::string>& notes) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the relaxation data file; check the path");
-  fit::RelaxationCurve curve{path, {}};
-  std::string text;
-  int line_no = 0, header_line = 0, skipped = 0, time_col = -1, value_col = -1;
+  int time_col = -1, value_col = -1;
   Column time_c, value_c;
-  char d = ',';
+  const Table t = read_table(
+      path,
+      [&](const std::vector<Column>& cols, int line) {
+        time_col = value_col = -1;
+        for (int i = 0; i < static_cast<int>(cols.size()); ++i) {
+          if (cols[i].kind == Column::time && time_col < 0) time_col = i, time_c = cols[i];
+          if ((cols[i].kind == Column::ratio || cols[i].kind == Column::stress) && value_col < 0) value_col = i, value_c = cols[i];
+        }
+        if (time_col < 0 || value_col < 0) return false;
+        if (std::isnan(time_c.scale))
+          throw InputError(where(path, line) + "column '" + time_c.name + "': " +
+                           (time_c.unit.empty() ? std::string("no time unit") : "unknown time unit '" + time_c.unit + "'") +
+                           "; name it time_s, time_ms, time_min or time_h");
+        if (value_c.kind == Column::stress && std::isnan(value_c.scale))
+          throw InputError(where(path, line) + "column '" + value_c.name + "' needs a known stress unit (stress_kPa, "
+                           "stress_MPa, ...), or give the normalised stress as g_R");
+        return true;
+      },
+      "time_s,g_R' (the stress over the stress right after the step) or 'time_s,stress_kPa");
+  note_skipped(t, notes);
+  fit::RelaxationCurve curve{path, {}};
   double first_stress = 0.0, prev_t = -1.0;
   int prev_line = 0;
-  while (std::getline(in, text)) {
-    ++line_no;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (line_no == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = text.substr(3);
-    const std::size_t first = text.find_first_not_of(" \t");
-    if (first == std::string::npos || text[first] == '#') continue;
-    if (header_line == 0) {
-      const char hd = delimiter_of(text);
-      const std::vector<std::string> cells = split(text, hd);
-      if (all_empty(cells)) continue;
-      if (all_numbers(cells, hd))
-        throw InputError(where(path, line_no) + "data before any header; name the columns, e.g. 'time_s,g_R' (the "
-                         "stress over the stress right after the step) or 'time_s,stress_kPa'");
-      time_col = value_col = -1;
-      for (int i = 0; i < static_cast<int>(cells.size()); ++i) {
-        const Column c = classify(cells[i]);
-        if (c.kind == Column::time && time_col < 0) time_col = i, time_c = c;
-        if ((c.kind == Column::ratio || c.kind == Column::stress) && value_col < 0) value_col = i, value_c = c;
-      }
-      if (time_col < 0 || value_col < 0) {
-        if (++skipped > 200) break;
-        continue;
-      }
-      if (std::isnan(time_c.scale))
-        throw InputError(where(path, line_no) + "column '" + time_c.name + "': " +
-                         (time_c.unit.empty() ? std::string("no time unit") : "unknown time unit '" + time_c.unit + "'") +
-                         "; name it time_s, time_ms, time_min or time_h");
-      if (value_c.kind == Column::stress && std::isnan(value_c.scale))
-        throw InputError(where(path, line_no) + "column '" + value_c.name + "' needs a known stress unit (stress_kPa, "
-                         "stress_MPa, ...) or give the normalised stress as g_R");
-      header_line = line_no;
-      d = hd;
-      if (skipped) notes.push_back(path + ": " + std::to_string(skipped) + " line(s) before the header (line " +
-                                   std::to_string(line_no) + ") skipped");
-      continue;
-    }
-    const std::vector<std::string> cells = split(text, d);
-    if (all_empty(cells)) continue;
-    const auto cell = [&](int col, const Column& c) {
-      const std::optional<double> v = col < static_cast<int>(cells.size()) ? number(cells[col], d) : std::nullopt;
-      if (!v || !std::isfinite(*v))
-        throw InputError(where(path, line_no) + "no number in column '" + c.name + "'; fix or remove the row");
-      return *v;
-    };
-    const double t = cell(time_col, time_c) * time_c.scale, v = cell(value_col, value_c);
-    if (t < 0.0)
-      throw InputError(where(path, line_no) + "time " + short_num(t) + " s is negative: give the time since the step "
-                       "(the step at t = 0)");
-    if (t <= prev_t)
-      throw InputError(where(path, line_no) + "the time does not increase (" + short_num(t) + " s after " +
+  for (const Table::Row& row : t.rows) {
+    const double time = t.number_at(row, time_col, time_c) * time_c.scale, v = t.number_at(row, value_col, value_c);
+    if (time < 0.0)
+      throw InputError(where(path, row.line) + "time " + short_num(time) +
+                       " s is negative: give the time since the step (the step at t = 0)");
+    if (time <= prev_t)
+      throw InputError(where(path, row.line) + "the time does not increase (" + short_num(time) + " s after " +
                        short_num(prev_t) + " s at line " + std::to_string(prev_line) + "); sort the rows or remove the repeat");
-    prev_t = t;
-    prev_line = line_no;
+    prev_t = time;
+    prev_line = row.line;
     double g = v;
     if (value_c.kind == Column::stress) {
       if (curve.points.empty()) {
         if (!(v > 0.0))
-          throw InputError(where(path, line_no) + "the first stress, " + short_num(v) + " " + value_c.unit +
+          throw InputError(where(path, row.line) + "the first stress, " + short_num(v) + " " + value_c.unit +
                            ", must be > 0: it normalises the curve (the stress right after the step)");
         first_stress = v;
-        notes.push_back(path + ": stress normalised by its first row's (line " + std::to_string(line_no) + ", " +
-                        short_num(v) + " " + value_c.unit + ", at t = " + short_num(t) + " s) as g_R(t)");
+        notes.push_back(path + ": stress normalised by its first row's (line " + std::to_string(row.line) + ", " +
+                        short_num(v) + " " + value_c.unit + ", at t = " + short_num(time) + " s) as g_R(t)");
       }
       g = v / first_stress;
     }
-    curve.points.push_back({t, g, line_no});
+    curve.points.push_back({time, g, row.line});
   }
-  if (header_line == 0)
-    throw InputError(path + ": no header naming a time column (time_s, ...) and the relaxing stress (g_R, or "
-                     "stress_kPa, ...)");
-  if (curve.points.empty()) throw InputError(path + ": no data rows after the header (line " + std::to_string(header_line) + ")");
   return curve;
 }
 

@@ -137,7 +137,7 @@ TEST(TestDataErrors, NoHeader) {
   const std::string e = error_of([&] { read(p); });
   EXPECT_NE(e.find("bare.csv:1: data before any header; the first line must name the columns"), std::string::npos) << e;
   const std::string q = write_temp("words.csv", "a,b\nc,d\n");
-  EXPECT_NE(error_of([&] { read(q); }).find("words.csv: no header naming a strain"), std::string::npos);
+  EXPECT_NE(error_of([&] { read(q); }).find("words.csv: no header naming the columns with their units, e.g. 'strain,stress_kPa'"), std::string::npos);
 }
 
 // --- fits ------------------------------------------------------------------------------------
