@@ -36,7 +36,7 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
       "as Abaqus's test data), by weighted least squares: DIR/material.toml (the scene's [materials.NAME] block), "
       "residuals.csv, fit.svg (+ fit.csv), fit.json, R^2 per test and the Drucker stability check");
   f->add_option("data", o.data,
-                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, relaxation:FILE (or a FILE whose name says which); CSV whose header "
+                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, volumetric:FILE, relaxation:FILE (or a FILE whose name says which); CSV whose header "
                 "names the strain (strain, strain_percent or stretch) and the stress with its unit (stress_kPa, "
                 "stress_MPa, stress_Pa, stress_psi)")
       ->required();
@@ -106,6 +106,10 @@ int run_fit_material_command(FitMaterialCommand& c) {
                 r.mullins->unloading_points, short_num(r.mullins->params.r).c_str(),
                 short_num(r.mullins->params.m_Pa * 1e-6).c_str(), short_num(r.mullins->params.beta).c_str(),
                 short_num(r.mullins->r2.front()).c_str());
+  if (r.bulk)
+    std::printf("bulk modulus (%s): K %s +- %s MPa, K/mu0 %s, R^2 %.4f\n", r.volumetric.front().source.c_str(),
+                short_num(r.bulk->K_Pa * 1e-6).c_str(), short_num(r.bulk->std_error_Pa * 1e-6).c_str(),
+                short_num(r.bulk->K_Pa / k.mu0()).c_str(), r.bulk->r2);
   if (r.prony) {
     std::printf("Prony (%s, %zu points): ", r.relaxation.front().source.c_str(), r.relaxation.front().points.size());
     for (std::size_t i = 0; i < r.prony->g.size(); ++i)

@@ -74,7 +74,8 @@ void read_tests(const FitMaterialOptions& o, FitMaterialResult& r) {
                      "leave it out with --mullins");
   for (const std::string& arg : o.data) {
     const TestFileSpec spec = parse_test_spec(arg);
-    if (spec.relaxation) r.relaxation.push_back(read_relaxation_csv(spec.path, r.notes));
+    if (spec.kind == TestFileSpec::Kind::relaxation) r.relaxation.push_back(read_relaxation_csv(spec.path, r.notes));
+    else if (spec.kind == TestFileSpec::Kind::volumetric) r.volumetric.push_back(read_volumetric_csv(spec.path, r.notes));
     else r.tests.push_back(read_test_csv(spec.path, spec.mode, r.notes, o.max_strain, o.mullins));
   }
   if (r.tests.empty())
@@ -82,6 +83,8 @@ void read_tests(const FitMaterialOptions& o, FitMaterialResult& r) {
                      "planar: test (a relaxation test only adds Prony terms to it)");
   if (r.relaxation.size() > 1)
     throw InputError("fit-material: " + std::to_string(r.relaxation.size()) + " relaxation files; give one");
+  if (r.volumetric.size() > 1)
+    throw InputError("fit-material: " + std::to_string(r.volumetric.size()) + " volumetric files; give one");
 }
 
 /// The model's stresses replace the base law's in each test's share of the fit (with --mullins).
@@ -110,6 +113,15 @@ void write_residuals(const std::string& dir, const FitMaterialResult& r) {
            std::to_string(p.line) + "," + json::num(p.stretch) + "," + json::num(p.stretch - 1.0) + "," +
            json::num(p.P_Pa * 1e-6) + "," + json::num(Pm * 1e-6) + "," + json::num((Pm - p.P_Pa) * 1e-6) + "," +
            json::num((Pm - p.P_Pa) * rel[j]) + "," + json::num(r.fit.tests[t].weight[j] * 1e6) + "\n";
+    }
+  }
+  if (r.bulk) {  // volumetric rows: stretch = J, stress = pressure
+    const fit::VolumetricCurve& v = r.volumetric.front();
+    for (std::size_t j = 0; j < v.points.size(); ++j) {
+      const double p = v.points[j].p_Pa, pm = r.bulk->model_p_Pa[j];
+      s += std::to_string(r.tests.size() + 1) + ",volumetric," + svg::csv_field(v.source) + "," +
+           std::to_string(v.points[j].line) + "," + json::num(v.points[j].J) + ",," + json::num(p * 1e-6) + "," +
+           json::num(pm * 1e-6) + "," + json::num((pm - p) * 1e-6) + ",,\n";
     }
   }
   write_file_atomic(dir + "/residuals.csv", s);
@@ -233,6 +245,13 @@ void write_json(const std::string& dir, const FitMaterialOptions& o, const FitMa
     m.add("r2", json::array(r.mullins->r2));
     root.add("mullins", m.str(2));
   }
+  if (r.bulk) {
+    json::Object b;
+    b.add("K_MPa", r.bulk->K_Pa * 1e-6).add("std_error_MPa", r.bulk->std_error_Pa * 1e-6);
+    b.add("K_over_mu", r.bulk->K_Pa / r.fit.constants.mu0()).add("r2", r.bulk->r2);
+    b.add_str("file", r.volumetric.front().source);
+    root.add("volumetric", b.str(2));
+  }
   if (r.prony) {
     json::Object p;
     p.add("g", json::array(r.prony->g)).add("tau_s", json::array(r.prony->tau_s));
@@ -281,7 +300,8 @@ std::string material_block(const FitMaterialOptions& o, const FitMaterialResult&
       if (!std::isnan(l.strain)) lim += (lim.empty() ? "" : "; ") + stability_text(l);
     s += "UNSTABLE from " + lim + "\n";
   }
-  s += "# K_over_mu and density_kg_m3 are not fitted (incompressible tests): set them for your material.\n";
+  s += r.bulk ? "# density_kg_m3 is not fitted: set it for your material.\n"
+              : "# K_over_mu and density_kg_m3 are not fitted (incompressible tests): set them for your material.\n";
   s += "[materials." + o.name + "]\n";
   s += "model = \"" + std::string(fit::law_name(k.law)) + "\"\n";
   if (k.law == Law::ogden) {
@@ -291,7 +311,11 @@ std::string material_block(const FitMaterialOptions& o, const FitMaterialResult&
     const std::vector<std::string> keys = modulus_keys(k.law);
     for (std::size_t i = 0; i < keys.size(); ++i) s += keys[i] + " = " + json::num(k.c[i] * 1e-6) + "\n";
   }
-  s += "K_over_mu = " + json::num(o.K_over_mu) + "\n";
+  if (r.bulk)
+    s += "K_over_mu = " + json::num(r.bulk->K_Pa / k.mu0()) + "  # fitted: K = " + short_num(r.bulk->K_Pa * 1e-6) +
+         " MPa (D1 = " + short_num(2.0 / (r.bulk->K_Pa * 1e-6)) + " /MPa) from " + r.volumetric.front().source + "\n";
+  else
+    s += "K_over_mu = " + json::num(o.K_over_mu) + "\n";
   s += "density_kg_m3 = " + json::num(o.density_kg_m3) + "\n";
   if (r.mullins) {
     const MullinsParams& p = r.mullins->params;
@@ -353,6 +377,14 @@ FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
     use_mullins_model(r);
   } else {
     r.fit = fit::fit_hyperelastic(r.tests, r.fit_options);
+  }
+  if (!r.volumetric.empty()) {
+    r.bulk = fit::fit_bulk_modulus(r.volumetric.front(), r.fit_options.weighting);
+    const double ratio = r.bulk->K_Pa / r.fit.constants.mu0();
+    if (!(ratio >= 1.0 && ratio <= 1e5))
+      throw InputError(r.volumetric.front().source + ": the fitted bulk modulus K = " + short_num(r.bulk->K_Pa * 1e-6) +
+                       " MPa is " + short_num(ratio) + " times the law's mu0; scenes take K_over_mu in [1, 1e5] "
+                       "(silicone: 100-1000). Check the pressure and volume-ratio units");
   }
   if (!r.relaxation.empty()) {
     r.prony = fit::fit_prony(r.relaxation.front(), o.prony_terms, o.max_evaluations);

@@ -16,6 +16,7 @@
 
 #include "fit/fit.h"
 #include "fit/inelastic.h"
+#include "fit/volumetric.h"
 #include "fit/stability.h"
 
 namespace pneufem {
@@ -45,6 +46,8 @@ struct FitMaterialResult {
   std::optional<fit::MullinsFit> mullins;      ///< with --mullins: r, m, beta on the base `fit`
   std::vector<fit::RelaxationCurve> relaxation;
   std::optional<fit::PronyFit> prony;          ///< with a relaxation:FILE
+  std::vector<fit::VolumetricCurve> volumetric;
+  std::optional<fit::BulkFit> bulk;            ///< with a volumetric:FILE: K, written as K_over_mu
   std::vector<std::string> notes;     ///< from reading and fitting
   std::vector<std::string> warnings;  ///< stability
   std::string toml;                   ///< the material block as written

@@ -51,7 +51,7 @@ std::string normalise(const std::string& name) {
 
 /// What a header column holds.
 struct Column {
-  enum Kind { other, strain, stretch, stress, true_quantity, time, ratio } kind = other;
+  enum Kind { other, strain, stretch, stress, true_quantity, time, ratio, volume_ratio, pressure } kind = other;
   double scale = 1.0;  ///< to dimensionless strain or Pa
   std::string unit;    ///< as written after the quantity ("kpa", "%", "" = none)
   std::string name;    ///< as written in the header
@@ -92,6 +92,11 @@ Column classify(const std::string& raw) {
       c.kind = Column::ratio;
       return c;
     }
+  for (const char* w : {"volume_ratio", "volume_ratio_j", "j", "volumetric_ratio", "v_v0"})
+    if (s == w) {
+      c.kind = Column::volume_ratio;
+      return c;
+    }
   if (auto u = unit_after("time")) {
     static const std::map<std::string, double> kUnits = {{"s", 1.0}, {"sec", 1.0}, {"ms", 1e-3}, {"min", 60.0}, {"h", 3600.0}};
     c.kind = Column::time;
@@ -100,11 +105,14 @@ Column classify(const std::string& raw) {
     c.scale = it == kUnits.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
     return c;
   }
-  if (auto u = unit_after("stress")) {
+  std::optional<std::string> su = unit_after("stress");
+  const bool is_pressure = !su && unit_after("pressure");
+  if (is_pressure) su = unit_after("pressure");
+  if (auto u = su) {
     static const std::map<std::string, double> kUnits = {
         {"pa", 1.0},     {"kpa", 1e3},    {"mpa", 1e6},   {"gpa", 1e9},  {"psi", 6894.757293168361},
         {"n_mm2", 1e6},  {"n_mm_2", 1e6}, {"n_m2", 1.0},  {"n_m_2", 1.0}};
-    c.kind = Column::stress;
+    c.kind = is_pressure ? Column::pressure : Column::stress;
     c.unit = *u;
     const auto it = kUnits.find(*u);
     c.scale = it == kUnits.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
@@ -295,8 +303,11 @@ void note_skipped(const Table& t, std::vector<std::string>& notes) {
 
 TestFileSpec parse_test_spec(const std::string& arg) {
   const std::size_t colon = arg.find(':');
+  using Kind = TestFileSpec::Kind;
   if (colon != std::string::npos && lower(arg.substr(0, colon)) == "relaxation")
-    return {TestMode::uniaxial, arg.substr(colon + 1), true};
+    return {TestMode::uniaxial, arg.substr(colon + 1), Kind::relaxation};
+  if (colon != std::string::npos && lower(arg.substr(0, colon)) == "volumetric")
+    return {TestMode::uniaxial, arg.substr(colon + 1), Kind::volumetric};
   if (colon != std::string::npos) {
     const std::string word = lower(arg.substr(0, colon));
     for (const auto& [w, m] : mode_words())
@@ -311,10 +322,11 @@ TestFileSpec parse_test_spec(const std::string& arg) {
     found = m;
   }
   const bool relaxation = name.find("relaxation") != std::string::npos;
-  if (relaxation) return {TestMode::uniaxial, arg, true};  // a held step of any specimen
+  if (relaxation) return {TestMode::uniaxial, arg, Kind::relaxation};  // a held step of any specimen
+  if (name.find("volumetric") != std::string::npos) return {TestMode::uniaxial, arg, Kind::volumetric};
   if (!found)
     throw InputError(arg + ": which test is it? Write uniaxial:" + arg + ", biaxial:" + arg + ", planar:" + arg +
-                     " or relaxation:" + arg +
+                     ", relaxation:" + arg + " or volumetric:" + arg +
                      " (nominal stress against nominal strain, as Abaqus's *UNIAXIAL / *BIAXIAL / *PLANAR TEST DATA)");
   return {*found, arg};
 }
@@ -426,6 +438,36 @@ fit::RelaxationCurve read_relaxation_csv(const std::string& path, std::vector<st
     curve.points.push_back({time, g, row.line});
   }
   return curve;
+}
+
+fit::VolumetricCurve read_volumetric_csv(const std::string& path, std::vector<std::string>& notes) {
+  int J_col = -1, p_col = -1;
+  Column J_c, p_c;
+  const Table t = read_table(
+      path,
+      [&](const std::vector<Column>& cols, int line) {
+        J_col = p_col = -1;
+        for (int i = 0; i < static_cast<int>(cols.size()); ++i) {
+          if (cols[i].kind == Column::volume_ratio && J_col < 0) J_col = i, J_c = cols[i];
+          if (cols[i].kind == Column::pressure && p_col < 0) p_col = i, p_c = cols[i];
+        }
+        if (J_col < 0 || p_col < 0) return false;
+        if (p_c.unit.empty() || std::isnan(p_c.scale))
+          throw InputError(where(path, line) + "column '" + p_c.name + "' needs a known unit: pressure_Pa, pressure_kPa, "
+                           "pressure_MPa or pressure_psi");
+        return true;
+      },
+      "volume_ratio,pressure_MPa");
+  note_skipped(t, notes);
+  fit::VolumetricCurve c{path, {}};
+  for (const Table::Row& row : t.rows) {
+    const double J = t.number_at(row, J_col, J_c), p = t.number_at(row, p_col, p_c) * p_c.scale;
+    if (!(J > 0.0))
+      throw InputError(where(path, row.line) + "volume ratio " + short_num(J) +
+                       " <= 0 is impossible; the column '" + J_c.name + "' must hold J = V / V0");
+    c.points.push_back({J, p, row.line});
+  }
+  return c;
 }
 
 }  // namespace pneufem

@@ -23,16 +23,18 @@
 
 #include "fit/fit.h"
 #include "fit/inelastic.h"
+#include "fit/volumetric.h"
 
 namespace pneufem {
 
 /// A DATA argument: "uniaxial:FILE", "biaxial:FILE" (or "equibiaxial:"), "planar:FILE" (or
-/// "pure_shear:", "pureshear:"), "relaxation:FILE", or a FILE whose name contains exactly one of
-/// those words.
+/// "pure_shear:", "pureshear:"), "relaxation:FILE", "volumetric:FILE", or a FILE whose name contains
+/// exactly one of those words.
 struct TestFileSpec {
+  enum class Kind { tension, relaxation, volumetric };
   fit::TestMode mode;
   std::string path;
-  bool relaxation = false;  ///< a relaxation test (read_relaxation_csv); `mode` is then unused
+  Kind kind = Kind::tension;  ///< relaxation (read_relaxation_csv), volumetric: `mode` is unused
 };
 TestFileSpec parse_test_spec(const std::string& arg);
 
@@ -49,5 +51,9 @@ fit::TestCurve read_test_csv(const std::string& path, fit::TestMode mode, std::v
 /// is then divided by the first row's stress (a note says so; that row should be right after the
 /// step). The time must increase and be >= 0. Throws InputError "<path>:<line>: ...".
 fit::RelaxationCurve read_relaxation_csv(const std::string& path, std::vector<std::string>& notes);
+
+/// A volumetric test: the header names the volume ratio (volume_ratio, J, V_V0) and the pressure with
+/// its unit (pressure_kPa, pressure_MPa, ...; > 0 in compression). J must be > 0.
+fit::VolumetricCurve read_volumetric_csv(const std::string& path, std::vector<std::string>& notes);
 
 }  // namespace pneufem

@@ -330,6 +330,31 @@ TEST(FitMaterialCommandErrors, EffectDataMisuse) {
   EXPECT_NE(error_of([&] { read_relaxation_csv(unit, notes); }).find("unknown time unit 'days'"), std::string::npos);
 }
 
+// All four test kinds at once: Treloar's three tension tests with a volumetric test made for K = 2000
+// mu0-ish (p = K (1 - J), K = 800 MPa): the block's K_over_mu is K / mu0 of the fit, marked as fitted.
+TEST(FitMaterialCommand, AVolumetricTestSetsKOverMu) {
+  std::string vol = "Volume ratio (J),Pressure (MPa)\n1,0\n";
+  for (int i = 1; i <= 10; ++i) vol += std::to_string(1.0 - 0.0005 * i) + "," + std::to_string(800.0 * 0.0005 * i) + "\n";
+  FitMaterialOptions o;
+  o.data = {treloar_csv("uniaxial"), "biaxial:" + treloar_csv("equibiaxial"), treloar_csv("pureshear"),
+            "volumetric:" + write_temp("vol.csv", vol)};
+  o.model = "ogden3";
+  o.out_dir = test::fresh_dir("fit_volumetric").string();
+  const FitMaterialResult r = run_fit_material(o);
+  ASSERT_TRUE(r.bulk);
+  EXPECT_NEAR(r.bulk->K_Pa, 800e6, 1e-6 * 800e6);  // the file's 6 decimals of J
+  const Scene s = Scene::load(write_temp("vol_scene.toml", r.toml));
+  EXPECT_NEAR(s.number("materials.silicone.K_over_mu"), 800e6 / r.fit.constants.mu0(), 1e-3);
+  EXPECT_NE(r.toml.find("# fitted: K = 800 MPa"), std::string::npos) << r.toml;
+  std::vector<std::string> notes;
+  EXPECT_NE(error_of([&] { read_volumetric_csv(write_temp("v1.csv", "J,pressure\n0.9,1\n"), notes); })
+                .find("v1.csv:1: column 'pressure' needs a known unit"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { read_volumetric_csv(write_temp("v2.csv", "J,pressure_kPa\n0,1\n"), notes); })
+                .find("v2.csv:2: volume ratio 0 <= 0 is impossible"),
+            std::string::npos);
+}
+
 // The executable: exit code 2 and the message for bad input; a run prints R^2 and the constants.
 TEST(FitMaterialCli, ExitCodesAndOutput) {
   const std::string out = test::fresh_dir("fit_cli").string();
