@@ -36,7 +36,7 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
       "as Abaqus's test data), by weighted least squares: DIR/material.toml (the scene's [materials.NAME] block), "
       "residuals.csv, fit.svg (+ fit.csv), fit.json, R^2 per test and the Drucker stability check");
   f->add_option("data", o.data,
-                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, volumetric:FILE, relaxation:FILE (or a FILE whose name says which); CSV whose header "
+                "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, volumetric:FILE, relaxation:FILE (or a FILE whose name says which), or deck:FILE.inp (its *HYPERELASTIC, TEST DATA INPUT); CSV whose header "
                 "names the strain (strain, strain_percent or stretch) and the stress with its unit (stress_kPa, "
                 "stress_MPa, stress_Pa, stress_psi)")
       ->required();
@@ -63,6 +63,12 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
   f->add_option("--stability-range", c->stability_range,
                 "Nominal strain range LO:HI of the Drucker stability check (Abaqus: -0.9:9)")
       ->capture_default_str();
+  f->add_option("--deck-material", o.deck_material,
+                "The *MATERIAL of a deck:FILE.inp to fit (needed when several have *HYPERELASTIC, TEST DATA INPUT)");
+  f->add_option("--deck-length-unit", o.deck_length_unit,
+                "A deck's consistent units: mm (stresses in MPa, as pneufem's decks) or m (Pa)")
+      ->check(CLI::IsMember({"mm", "m"}))
+      ->capture_default_str();
   f->add_flag("--mullins", o.mullins,
               "The tension tests are loading-unloading cycles in time order: fit the law to the primary loading and "
               "Ogden-Roxburgh r, m, beta to the rest ([materials.NAME.mullins])");
@@ -80,6 +86,7 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
 }
 
 int run_fit_material_command(FitMaterialCommand& c) {
+  c.options.model_given = c.cmd->count("--model") > 0;
   parse_range(c.stability_range, c.options.stability_lo, c.options.stability_hi);
   const FitMaterialResult r = run_fit_material(c.options);
   for (const std::string& n : r.notes) std::printf("note: %s\n", n.c_str());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "app/fit_material/deck_test_data.h"
 #include "app/fit_material/test_data.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -67,12 +68,40 @@ std::string stability_text(const fit::StabilityLimit& s) {
 
 // --- the steps ----------------------------------------------------------------------------------
 
+/// The test data of one *MATERIAL of a deck (deck_test_data.h); its law unless --model was given.
+void read_deck(const FitMaterialOptions& o, const std::string& path, FitMaterialResult& r) {
+  const std::vector<DeckTestData> all = read_deck_test_data(path, o.deck_length_unit);
+  std::string names;
+  for (const DeckTestData& d : all) names += (names.empty() ? "" : ", ") + d.material;
+  if (all.empty())
+    throw InputError(path + ": no *HYPERELASTIC, TEST DATA INPUT with test data in this deck");
+  const DeckTestData* pick = nullptr;
+  for (const DeckTestData& d : all)
+    if (o.deck_material.empty() ? all.size() == 1 : d.material == o.deck_material) pick = &d;
+  if (!pick)
+    throw InputError(path + ": " + (o.deck_material.empty() ? "several materials have test data (" + names +
+                                                                  "); choose one with --deck-material NAME"
+                                                            : "no material '" + o.deck_material + "' with test data; it has " + names));
+  if (pick->tests.empty()) throw InputError(pick->where + ": *MATERIAL " + pick->material + " has no tension test data");
+  for (const fit::TestCurve& t : pick->tests) r.tests.push_back(t);
+  for (const fit::VolumetricCurve& v : pick->volumetric) r.volumetric.push_back(v);
+  if (!o.model_given) r.model = pick->law;
+  r.notes.push_back(path + ": test data of *MATERIAL " + pick->material + " (" + std::to_string(pick->tests.size()) +
+                    " tension, " + std::to_string(pick->volumetric.size()) + " volumetric block(s); stresses in " +
+                    (o.deck_length_unit == "mm" ? "MPa" : "Pa") + ", --deck-length-unit " + o.deck_length_unit +
+                    "), law " + r.model + (o.model_given ? " (--model)" : " (its *HYPERELASTIC line, " + pick->where + ")"));
+}
+
 void read_tests(const FitMaterialOptions& o, FitMaterialResult& r) {
   if (o.data.empty()) throw InputError("fit-material: give at least one DATA file (uniaxial:FILE, biaxial:FILE, planar:FILE)");
   if (o.mullins && std::isfinite(o.max_strain))
     throw InputError("--max-strain cannot cut loading-unloading cycles (the Mullins law needs each cycle's peak); "
                      "leave it out with --mullins");
   for (const std::string& arg : o.data) {
+    if (arg.rfind("deck:", 0) == 0 || (arg.size() > 4 && arg.substr(arg.size() - 4) == ".inp")) {
+      read_deck(o, arg.rfind("deck:", 0) == 0 ? arg.substr(5) : arg, r);
+      continue;
+    }
     const TestFileSpec spec = parse_test_spec(arg);
     if (spec.kind == TestFileSpec::Kind::relaxation) r.relaxation.push_back(read_relaxation_csv(spec.path, r.notes));
     else if (spec.kind == TestFileSpec::Kind::volumetric) r.volumetric.push_back(read_volumetric_csv(spec.path, r.notes));
@@ -361,14 +390,16 @@ void check_stability(const FitMaterialOptions& o, FitMaterialResult& r) {
 FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
   check_output_dir(o.out_dir, "--out");
   FitMaterialResult r;
-  r.fit_options = parse_model(o.model, o.weights);
-  r.fit_options.max_evaluations = o.max_evaluations;
+  r.model = o.model;
+  parse_model(o.model, o.weights);  // a bad --model or --weights fails before any file is read
   if (!(o.K_over_mu >= 1.0)) throw InputError("--K-over-mu must be >= 1 (silicone: 100-1000), got " + short_num(o.K_over_mu));
   if (!(o.stability_lo > -1.0 && o.stability_lo <= 0.0 && o.stability_hi >= 0.0))
     throw InputError("--stability-range: the low end must lie in (-1, 0] and the high end be >= 0");
   if (o.moduli != "instantaneous" && o.moduli != "long_term")
     throw InputError("--moduli " + o.moduli + ": use instantaneous (Abaqus's default) or long_term");
   read_tests(o, r);
+  r.fit_options = parse_model(r.model, o.weights);
+  r.fit_options.max_evaluations = o.max_evaluations;
   if (o.mullins) {
     std::vector<fit::TestCurve> primary;
     for (const fit::TestCurve& t : r.tests) primary.push_back(fit::primary_loading(t));

@@ -22,7 +22,7 @@
 namespace pneufem {
 
 struct FitMaterialOptions {
-  std::vector<std::string> data;  ///< "uniaxial:FILE", ... (test_data.h: parse_test_spec)
+  std::vector<std::string> data;  ///< "uniaxial:FILE", ... (test_data.h: parse_test_spec), "deck:FILE.inp"
   std::string model = "yeoh";     ///< neo_hookean | mooney_rivlin | yeoh | ogden | ogden1..3
   std::string out_dir;
   std::string name = "silicone";  ///< the NAME of [materials.NAME]
@@ -36,6 +36,9 @@ struct FitMaterialOptions {
   bool mullins = false;           ///< the tension tests are loading-unloading cycles: fit Ogden-Roxburgh too
   int prony_terms = 1;            ///< Prony terms fitted to a relaxation:FILE
   std::string moduli = "instantaneous";  ///< the viscoelastic block's convention (damage/viscoelastic.h)
+  bool model_given = false;       ///< --model was given: it overrides the law of a deck's *HYPERELASTIC line
+  std::string deck_material;      ///< which *MATERIAL of a deck:FILE (needed when it has several)
+  std::string deck_length_unit = "mm";  ///< mm: the deck's stresses in MPa; m: in Pa
 };
 
 struct FitMaterialResult {
@@ -51,6 +54,7 @@ struct FitMaterialResult {
   std::vector<std::string> notes;     ///< from reading and fitting
   std::vector<std::string> warnings;  ///< stability
   std::string toml;                   ///< the material block as written
+  std::string model;                  ///< the law fitted (options.model, or a deck's)
 };
 
 /// "yeoh", "neo_hookean", "mooney_rivlin", "ogden" (1 term, Abaqus's default), "ogden1".."ogden3" (also
