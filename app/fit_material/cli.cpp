@@ -32,8 +32,9 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
   FitMaterialOptions& o = c->options;
   CLI::App* f = c->cmd = app.add_subcommand(
       "fit-material",
-      "Hyperelastic constants from uniaxial, equibiaxial and planar tension tests (nominal stress vs nominal strain, "
-      "as Abaqus's test data), by weighted least squares: DIR/material.toml (the scene's [materials.NAME] block), "
+      "Material constants from lab tests: a hyperelastic law from uniaxial, equibiaxial, planar (nominal stress vs "
+      "nominal strain, as Abaqus's test data) and volumetric tests, Mullins from loading-unloading cycles, Prony terms "
+      "from relaxation, by weighted least squares: DIR/material.toml (the scene's [materials.NAME] block), "
       "residuals.csv, fit.svg (+ fit.csv), fit.json, R^2 per test and the Drucker stability check");
   f->add_option("data", o.data,
                 "Test files: uniaxial:FILE, biaxial:FILE, planar:FILE, volumetric:FILE, relaxation:FILE (or a FILE whose name says which), or deck:FILE.inp (its *HYPERELASTIC, TEST DATA INPUT); CSV whose header "
@@ -51,13 +52,13 @@ std::unique_ptr<FitMaterialCommand> add_fit_material_command(CLI::App& app) {
       ->capture_default_str();
   f->add_option("--max-strain", o.max_strain, "Fit only points up to this nominal strain (e.g. the actuator's range)")
       ->check(CLI::PositiveNumber);
-  f->add_option("--K-over-mu", o.K_over_mu, "Written as K_over_mu (not fitted: the tests are incompressible)")
+  f->add_option("--K-over-mu", o.K_over_mu, "Written as K_over_mu unless a volumetric:FILE fits it (tension tests are incompressible)")
       ->check(CLI::Range(1.0, 1e5))
       ->capture_default_str();
   f->add_option("--density", o.density_kg_m3, "Written as density_kg_m3 (kg/m^3, not fitted)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  f->add_option("--max-evaluations", o.max_evaluations, "ogden: objective evaluations per optimiser start")
+  f->add_option("--max-evaluations", o.max_evaluations, "Ogden, Mullins and Prony fits: objective evaluations per optimiser start")
       ->check(CLI::Range(1, 10000000))
       ->capture_default_str();
   f->add_option("--stability-range", c->stability_range,

@@ -83,7 +83,14 @@ void read_deck(const FitMaterialOptions& o, const std::string& path, FitMaterial
                                                                   "); choose one with --deck-material NAME"
                                                             : "no material '" + o.deck_material + "' with test data; it has " + names));
   if (pick->tests.empty()) throw InputError(pick->where + ": *MATERIAL " + pick->material + " has no tension test data");
-  for (const fit::TestCurve& t : pick->tests) r.tests.push_back(t);
+  for (fit::TestCurve t : pick->tests) {  // --max-strain as for CSV files
+    const std::size_t n = t.points.size();
+    std::erase_if(t.points, [&](const fit::TestPoint& p) { return p.stretch - 1.0 > o.max_strain; });
+    if (t.points.size() < n)
+      r.notes.push_back(t.source + ": " + std::to_string(n - t.points.size()) + " point(s) above --max-strain " +
+                        short_num(o.max_strain) + " left out");
+    r.tests.push_back(std::move(t));
+  }
   for (const fit::VolumetricCurve& v : pick->volumetric) r.volumetric.push_back(v);
   if (!o.model_given) r.model = pick->law;
   r.notes.push_back(path + ": test data of *MATERIAL " + pick->material + " (" + std::to_string(pick->tests.size()) +
@@ -387,48 +394,73 @@ void check_stability(const FitMaterialOptions& o, FitMaterialResult& r) {
     }
 }
 
-FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
-  check_output_dir(o.out_dir, "--out");
-  FitMaterialResult r;
-  r.model = o.model;
-  parse_model(o.model, o.weights);  // a bad --model or --weights fails before any file is read
+namespace {
+
+/// Options that are wrong whatever the files hold, before any file is read.
+void check_options(const FitMaterialOptions& o) {
+  parse_model(o.model, o.weights);
   if (!(o.K_over_mu >= 1.0)) throw InputError("--K-over-mu must be >= 1 (silicone: 100-1000), got " + short_num(o.K_over_mu));
   if (!(o.stability_lo > -1.0 && o.stability_lo <= 0.0 && o.stability_hi >= 0.0))
     throw InputError("--stability-range: the low end must lie in (-1, 0] and the high end be >= 0");
   if (o.moduli != "instantaneous" && o.moduli != "long_term")
     throw InputError("--moduli " + o.moduli + ": use instantaneous (Abaqus's default) or long_term");
-  read_tests(o, r);
+}
+
+/// The law: on all tension points, or with --mullins on the primary loading and then r, m, beta.
+void fit_law(const FitMaterialOptions& o, FitMaterialResult& r) {
   r.fit_options = parse_model(r.model, o.weights);
   r.fit_options.max_evaluations = o.max_evaluations;
-  if (o.mullins) {
-    std::vector<fit::TestCurve> primary;
-    for (const fit::TestCurve& t : r.tests) primary.push_back(fit::primary_loading(t));
-    r.fit = fit::fit_hyperelastic(primary, r.fit_options);
-    r.fit.tests = fit::evaluate_fit(r.tests, r.fit.constants, r.fit_options.weighting);
-    use_mullins_model(r);
-  } else {
+  if (!o.mullins) {
     r.fit = fit::fit_hyperelastic(r.tests, r.fit_options);
+    return;
   }
-  if (!r.volumetric.empty()) {
-    r.bulk = fit::fit_bulk_modulus(r.volumetric.front(), r.fit_options.weighting);
-    const double ratio = r.bulk->K_Pa / r.fit.constants.mu0();
-    if (!(ratio >= 1.0 && ratio <= 1e5))
-      throw InputError(r.volumetric.front().source + ": the fitted bulk modulus K = " + short_num(r.bulk->K_Pa * 1e-6) +
-                       " MPa is " + short_num(ratio) + " times the law's mu0; scenes take K_over_mu in [1, 1e5] "
-                       "(silicone: 100-1000). Check the pressure and volume-ratio units");
-  }
-  if (!r.relaxation.empty()) {
-    r.prony = fit::fit_prony(r.relaxation.front(), o.prony_terms, o.max_evaluations);
-    for (const std::string& n : r.prony->notes) r.notes.push_back(n);
-  }
-  for (const std::string& n : r.fit.notes) r.notes.push_back(n);
-  check_stability(o, r);
+  std::vector<fit::TestCurve> primary;
+  for (const fit::TestCurve& t : r.tests) primary.push_back(fit::primary_loading(t));
+  r.fit = fit::fit_hyperelastic(primary, r.fit_options);
+  r.fit.tests = fit::evaluate_fit(r.tests, r.fit.constants, r.fit_options.weighting);
+  use_mullins_model(r);
+}
+
+/// K from a volumetric test, within the scenes' range of K_over_mu.
+void fit_volumetric(FitMaterialResult& r) {
+  if (r.volumetric.empty()) return;
+  r.bulk = fit::fit_bulk_modulus(r.volumetric.front(), r.fit_options.weighting);
+  const double ratio = r.bulk->K_Pa / r.fit.constants.mu0();
+  if (!(ratio >= 1.0 && ratio <= 1e5))
+    throw InputError(r.volumetric.front().source + ": the fitted bulk modulus K = " + short_num(r.bulk->K_Pa * 1e-6) +
+                     " MPa is " + short_num(ratio) + " times the law's mu0; scenes take K_over_mu in [1, 1e5] "
+                     "(silicone: 100-1000). Check the pressure and volume-ratio units");
+}
+
+void fit_relaxation(const FitMaterialOptions& o, FitMaterialResult& r) {
+  if (r.relaxation.empty()) return;
+  r.prony = fit::fit_prony(r.relaxation.front(), o.prony_terms, o.max_evaluations);
+  for (const std::string& n : r.prony->notes) r.notes.push_back(n);
+}
+
+void write_outputs(const FitMaterialOptions& o, FitMaterialResult& r) {
   r.toml = material_block(o, r);
   prepare_output_dir(o.out_dir, "--out");
   write_file_atomic(o.out_dir + "/material.toml", r.toml);
   write_residuals(o.out_dir, r);
   write_figure(o.out_dir, r);
   write_json(o.out_dir, o, r);
+}
+
+}  // namespace
+
+FitMaterialResult run_fit_material(const FitMaterialOptions& o) {
+  check_output_dir(o.out_dir, "--out");
+  check_options(o);
+  FitMaterialResult r;
+  r.model = o.model;
+  read_tests(o, r);  // a deck's *HYPERELASTIC line may set r.model
+  fit_law(o, r);
+  fit_volumetric(r);
+  fit_relaxation(o, r);
+  for (const std::string& n : r.fit.notes) r.notes.push_back(n);
+  check_stability(o, r);
+  write_outputs(o, r);
   return r;
 }
 
