@@ -346,6 +346,10 @@ TEST(FitMaterialCommand, AVolumetricTestSetsKOverMu) {
   EXPECT_NEAR(r.bulk->K_Pa, 800e6, 1e-6 * 800e6);  // the file's 6 decimals of J
   const Scene s = Scene::load(write_temp("vol_scene.toml", r.toml));
   EXPECT_NEAR(s.number("materials.silicone.K_over_mu"), 800e6 / r.fit.constants.mu0(), 1e-3);
+  // an Ogden block over the default silicone (a Yeoh table): the default's C10_MPa ... do not leak in
+  const MaterialPtr m = make_material(s, "silicone");
+  EXPECT_EQ(m->name(), "ogden");
+  EXPECT_NEAR(m->initial_bulk_modulus(), 800e6, 1e-6 * 800e6);
   EXPECT_NE(r.toml.find("# fitted: K = 800 MPa"), std::string::npos) << r.toml;
   std::vector<std::string> notes;
   EXPECT_NE(error_of([&] { read_volumetric_csv(write_temp("v1.csv", "J,pressure\n0.9,1\n"), notes); })
