@@ -11,6 +11,7 @@
 
 #include "app/compare/cli.h"
 #include "app/diagnose/cli.h"
+#include "app/fit_material/cli.h"
 #include "app/simulate/cli.h"
 #include "app/sweep/cli.h"
 #include "app/synth/cli.h"
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<SynthCommand> sy = add_synth_command(app);
   std::unique_ptr<CompareCommand> cmp = add_compare_command(app);
   std::unique_ptr<DiagnoseCommand> dia = add_diagnose_command(app);
+  std::unique_ptr<FitMaterialCommand> fm = add_fit_material_command(app);
 
   try {
     app.parse(argc, argv);
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     if (sy->cmd->parsed()) return run_synth_command(*sy, join_args(argc, argv));
     if (mesh->cmd->parsed()) return run_mesh_command(*mesh);
     if (sc->cmd->parsed()) return run_scene_command(*sc);
+    if (fm->cmd->parsed()) return run_fit_material_command(*fm);
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

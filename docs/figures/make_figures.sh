@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the figures of the user guide (docs/user_guide.md) and the README by running its
 # tutorial on the small actuator of the test recordings: a compare of the hidden-creep recording,
-# a diagnose, and a compare of the fitted scene. About 3 min on 2 cores.
+# a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve.
+# About 3 min on 2 cores.
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -19,4 +20,7 @@ cp "$RUN/study/fig_trial_1.svg" docs/figures/tutorial_fitted_trial_1.svg
 cp "$RUN/study/fig_trial_1.csv" docs/figures/tutorial_fitted_trial_1.csv
 cp "$RUN/study/fig_history.svg" docs/figures/tutorial_history.svg
 cp "$RUN/study/fig_history.csv" docs/figures/tutorial_history.csv
+"$EXE" fit-material uniaxial:tests/data/soro-materials-db/ecoflex_00-50.csv --max-strain 2 --out "$RUN/material"
+cp "$RUN/material/fit.svg" docs/figures/fit_material_ecoflex.svg
+cp "$RUN/material/fit.csv" docs/figures/fit_material_ecoflex.csv
 echo "figures written to docs/figures (runs in $RUN)"
