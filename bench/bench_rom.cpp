@@ -2,6 +2,11 @@
 // engine/rom.h against the full quasi-static FEM on a scene's protocol.
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
+//             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--dump-points]
+// --softened N adds softened equilibria (N levels to --softened-max; the scenes' default is 6 to 0.9,
+// the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
+// adjoint and Newton-step indicators beside every report's error; --dump-points runs the FEM beside
+// the reduced model and compares damage and largest stretch at the kept points at every trial's end.
 // Prints the offline cost (elastic trace, basis), the online cost (states, Newton iterations,
 // wall), and with --fem the FEM's record and the differences: every report angle, and the paper's
 // NRMSE per trial against the ideal elastic model, for both. --work DIR keeps the elastic trace
@@ -19,6 +24,8 @@
 #include <vector>
 
 #include <tbb/global_control.h>
+#include <Eigen/Eigenvalues>
+#include <tuple>
 
 #include "analysis/paper_metrics.h"
 #include "engine/angle.h"
@@ -95,7 +102,7 @@ std::vector<double> nrmse_per_trial(const LoadHistory& load, const Record& a, co
 int main(int argc, char** argv) {
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
-  bool fem = false;
+  bool fem = false, check = false, dump = false;
   int snap_trials = 0;
   int threads = 0;
   RomBasisOptions ro;
@@ -109,6 +116,8 @@ int main(int argc, char** argv) {
     else if (a == "--snap-trials") snap_trials = std::stoi(next());  // FEM snapshots of the first N trials enrich the basis
     else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
+    else if (a == "--check") check = true;
+    else if (a == "--dump-points") dump = true;  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
     else if (a == "--clusters") ro.clusters = std::stoi(next());
@@ -116,6 +125,8 @@ int main(int argc, char** argv) {
     else if (a == "--ecsw-tol") ro.ecsw_tolerance = std::stod(next());
     else if (a == "--pod-tol") ro.pod_tolerance = std::stod(next());
     else if (a == "--no-hyper") ro.hyper_reduce = false;
+    else if (a == "--softened") ro.softened_levels = std::stoi(next());  // softened equilibria as snapshots (levels)
+    else if (a == "--softened-max") ro.softened_max = std::stod(next());
     else if (a[0] != '-') scene_path = a;
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
@@ -207,8 +218,11 @@ int main(int argc, char** argv) {
   const auto t_on = Clock::now();
   const ReducedOrderModel rom(ref->model, basis, bm->model);
   ReducedRun run(rom, bm->solver.quasi_static);
+  std::vector<Eigen::VectorXd> rom_u;
+  std::vector<std::vector<double>> rom_h;
   try {
-    run.run(bm->load, [&](const StateRecord& r, const ReducedCoordinates& z, const Eigen::VectorXd&) {
+    run.run(bm->load, [&](const StateRecord& r, const ReducedCoordinates& z, const Eigen::VectorXd& u) {
+      if (dump) rom_u.push_back(u), rom_h.push_back(rom.history_scalars(run.history()));
       red.trial.push_back(r.trial);
       red.t.push_back(r.time_s);
       red.p.push_back(r.pressure_Pa);
@@ -226,6 +240,63 @@ int main(int argc, char** argv) {
   std::printf("reduced run: %.2f s wall, %ld states (%ld rejected), %ld Newton its, %ld tangents, %ld residuals, %d points%s\n",
               since(t_on), st.states, st.rejected_steps, st.newton_iterations, st.tangents, st.residuals, rom.num_points(),
               st.beyond_path ? ", BEYOND THE PATH" : "");
+  // The a-posteriori indicators at every report: the adjoint-weighted residual and one full Newton step.
+  std::vector<double> est_adj, est_newton;
+  if (check) {
+    const auto t0 = Clock::now();
+    replay_reduced_run(
+        rom, run.trajectory(),
+        [&](const ReducedStep& s, const Eigen::VectorXd&, const std::vector<double>&, const ReducedCheck& c) {
+          if (s.report < 0) return;
+          const std::size_t i = static_cast<std::size_t>(s.report);
+          if (est_adj.size() <= i) est_adj.resize(i + 1, std::nan("")), est_newton.resize(i + 1, std::nan(""));
+          est_adj[i] = c.angle_error_deg;
+          est_newton[i] = c.newton_angle_error_deg;
+        },
+        [](const ReducedStep& s) { return s.report >= 0 && s.pressure_Pa > 0.0; });
+    std::printf("replay with checks: %.1f s\n", since(t0));
+  }
+  // Kept points, ROM against FEM, at the last report of every trial: damage and largest stretch.
+  if (dump) {
+    Assembler A(bm->model);
+    QuasiStaticRun q(A, bm->solver.quasi_static);
+    std::vector<Eigen::VectorXd> fu;
+    std::vector<std::vector<double>> fh;
+    std::vector<int> ftrial;
+    q.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& h) {
+      fu.push_back(u), fh.push_back(A.history_scalars(h)), ftrial.push_back(r.trial);
+    });
+    const ElementGeometry& geom = A.geometry();
+    auto stretch = [&](const Eigen::VectorXd& u, int e, int qp) {
+      Mat3 F = Mat3::Identity();
+      const int* n = bm->model.mesh.element(e);
+      const double* g = geom.grad(e, qp);
+      for (int a = 0; a < geom.npe; ++a) F += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+      return std::sqrt(Eigen::SelfAdjointEigenSolver<Mat3>(F.transpose() * F).eigenvalues().maxCoeff());
+    };
+    for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
+      if (i + 1 < fu.size() && ftrial[i + 1] == ftrial[i]) continue;  // last report of a trial
+      // the loaded top: the report before the last (the last one is at the hold end, same p)
+      double sd_rom = 0, sd_fem = 0, n = 0, sl_rom = 0, sl_fem = 0;
+      std::vector<std::tuple<double, int, int, double, double, double, double>> rows;
+      for (int k = 0; k < rom.num_points(); ++k) {
+        const int e = rom.element_of_point(k), qp = k % geom.nqp;
+        const double dr = rom_h[i][2 * k], df = fh[i][2 * (e * geom.nqp + qp)];
+        const double lr = stretch(rom_u[i], e, qp), lf = stretch(fu[i], e, qp);
+        sd_rom += dr, sd_fem += df;
+        if (df > 0.01) n += 1, sl_rom += lr - 1, sl_fem += lf - 1;
+        rows.emplace_back(dr - df, e, qp, dr, df, lr, lf);
+      }
+      std::printf("trial %d: kept points' damage sum ROM %.3f FEM %.3f (%+.1f %%); over %g points with FEM damage > 0.01: mean stretch-1 ROM %.4f FEM %.4f\n",
+                  ftrial[i], sd_rom, sd_fem, 100 * (sd_rom / sd_fem - 1), n, sl_rom / std::max(n, 1.0), sl_fem / std::max(n, 1.0));
+      std::sort(rows.begin(), rows.end());
+      for (int j = 0; j < 8 && j < static_cast<int>(rows.size()); ++j) {
+        auto [dd, e, qp, dr, df, lr, lf] = rows[static_cast<std::size_t>(j)];
+        std::printf("   element %5d qp %d region %-14s damage ROM %.4f FEM %.4f  stretch ROM %.4f FEM %.4f\n", e, qp,
+                    bm->model.mesh.region_names[bm->model.mesh.region[e]].c_str(), dr, df, lr, lf);
+      }
+    }
+  }
   // 4. FEM (cached).
   Record full;
   if (fem) {
@@ -275,10 +346,13 @@ int main(int argc, char** argv) {
       else
         std::printf("%5d  %14.3f\n", tr, w);
     }
-    std::printf("reports (trial, t, p kPa, fem, rom, diff):\n");
-    for (std::size_t i = 0; i < n; ++i)
-      std::printf("  %d %7.2f %6.2f %9.3f %9.3f %+7.3f\n", full.trial[i], full.t[i], full.p[i] * 1e-3, full.angle[i], red.angle[i],
+    std::printf("reports (trial, t, p kPa, fem, rom, diff%s):\n", check ? ", adjoint estimate, Newton estimate" : "");
+    for (std::size_t i = 0; i < n; ++i) {
+      std::printf("  %d %7.2f %6.2f %9.3f %9.3f %+7.3f", full.trial[i], full.t[i], full.p[i] * 1e-3, full.angle[i], red.angle[i],
                   red.angle[i] - full.angle[i]);
+      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f", est_adj[i], est_newton[i]);
+      std::printf("\n");
+    }
   } else {
     for (std::size_t i = 0; i < red.angle.size(); ++i)
       std::printf("  %d %7.2f %6.2f %9.3f (ideal %9.3f)\n", red.trial[i], red.t[i], red.p[i] * 1e-3, red.angle[i],

@@ -533,6 +533,25 @@ void ReducedRun::solve_segment(const Segment& s) {
       // solve fails; the end state does not depend on the way (rate-independent laws only load up).
       const ReducedCoordinates z0 = z_;
       const double t = s.g1, dt = span;
+      // A release to zero pressure in zero time starts from the undeformed state, as the FEM's does
+      // (StaticSolver::advance): Newton from the loaded state can reach another root of the reduced
+      // equations. Measured: with modes of strongly softened states in the basis, a vent from
+      // 45 kPa of a 3-chamber actuator stopped at theta = -1.5 deg with a large correction and
+      // stayed on that branch through the next trial (bench_rom, 2026-11-27).
+      if (span <= 0.0 && s.p1 == 0.0 && s.p0 > 0.0) {
+        try {
+          z_.theta = 0.0;
+          z_.q.setZero();
+          z_.lambda = 0.0;
+          equilibrium(0.0, t, dt);
+          commit(t, dt, s.p1, s.report);
+          hist_prev_.clear();
+          hist_cur_.clear();
+          return;
+        } catch (const PhysicsError&) {
+          ++stats_.rejected_steps;
+        }
+      }
       int pieces = 1;
       for (;;) {
         try {

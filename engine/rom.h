@@ -18,11 +18,22 @@
 // Every history effect of damage/ acts on the isochoric stress, locally (Mullins, fatigue, Prony
 // terms, region scales), so a local softening is the generic first-order deformation change; no
 // effect's constants enter the basis (the same basis serves any constants and any registered effect).
-// More modes can be added from snapshots (an FEM state, an indicator's correction): they come first,
-// by size. One FEM trial of a 3-chamber actuator with fatigue (at other constants) cut the error of
-// three trials' drift 7x (tests/engine/test_rom.cpp); on the 15-chamber story near its limit point
-// they fixed trial 1 but not the later trials, and worsened Mullins' reloading
-// (bench/results/rom_h2_story/snapshots.md), so the product does not use them yet.
+// The linear responses miss what damage does where it concentrates: a pneu-net's thin interior
+// walls stretch ~2x on the path, and a damaged wall balloons into the gap far beyond its linear
+// response (measured on a 5-chamber actuator with fatigue: stretch 2.0 -> 2.5-2.7 over three trials
+// in the FEM, held at 1.7-1.9 by a basis of 120 linear-response modes of 240 clusters; no basis
+// granularity, hyper-reduction, time step or exact follower pressure changed that; a basis holding
+// the FEM's own trajectory followed it within 0.03 deg). So the basis also takes softened
+// equilibria (softened_states below, RomBasisOptions::softened_levels): static solves of the
+// reference at the mode samples' pressures with the isochoric stress of each soft element scaled
+// by 1 - s (W_e / W_max)^m, the shape a damage law driven by the strain energy would give. With
+// them the fatigue drift errors fell 2-3x (bench/results/rom_h2_story/softened.md).
+// More modes can be added from snapshots (an FEM state, an indicator's correction). Snapshots and
+// softened equilibria come first, by size (their departure from the path at equal angle). One FEM
+// trial of a 3-chamber actuator with fatigue (at other constants) cut the error of three trials'
+// drift 7x (tests/engine/test_rom.cpp); on the 15-chamber story near its limit point they fixed
+// trial 1 but not the later trials (bench/results/rom_h2_story/snapshots.md), so the product uses
+// the softened equilibria, not FEM snapshots.
 //
 // Equations: a Petrov-Galerkin projection of the equilibrium R(u) = f_int(u) - p dV/du - f_g = 0. The
 // q rows are Galerkin (tested with Phi). The theta row is tested with the bending angle's influence
@@ -96,6 +107,10 @@ struct RomBasisOptions {
   double training_amplitude = 0.05;  ///< cap of a field's response, relative to the path's top RMS displacement
   double stiff_modulus_ratio = 100.0;  ///< parts this much stiffer than the softest are "stiff" (fabric)
   bool hyper_reduce = true;       ///< false: every soft element, weight 1 (for tests and verification)
+  /// Softened equilibria as snapshots (softened_states below): 0 = none, else the number of
+  /// softening levels per field and mode sample.
+  int softened_levels = 0;
+  double softened_max = 0.9;      ///< the largest isochoric softening of the most strained element
   bool verbose = false;
 };
 
@@ -155,6 +170,19 @@ double mesh_fingerprint(const Mesh& mesh);
 /// POD in what those modes leave out; the snapshots also join the ECSW training states.
 ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& options,
                                  const std::vector<Eigen::VectorXd>& snapshots = {});
+
+/// Nonlinear equilibria of the reference with its soft elements softened like a damage law would
+/// soften them, at the mode samples' pressures: the isochoric stress of element e scaled by
+/// 1 - s (W_e / W_max)^m (W_e its isochoric energy density on the path there, W_max the largest of
+/// the soft elements), for the fields m = 0 (uniform: creep), 1 and 4 (concentrated where the
+/// stretch is largest: Mullins, fatigue), at `levels` levels s up to `max_softening`, each solved
+/// by Newton from the previous level. Why: damage concentrates where the path is most strained (a
+/// pneu-net's thin interior walls), and there the softened wall balloons far beyond its linear
+/// response (measured: stretch 2.0 -> 2.7 in three fatigue trials where the linear responses' basis
+/// held it at 1.9), a large nonlinear deformation that only equilibria of softened states contain.
+/// Levels past the softened structure's limit point (no equilibrium at that pressure) are skipped.
+std::vector<Eigen::VectorXd> softened_states(const Model& reference, const ElasticPathTrace& trace, const std::vector<int>& samples,
+                                             int levels, double max_softening, bool verbose = false);
 
 /// A reduced state: path coordinate, correction amplitudes, gauge multiplier.
 struct ReducedCoordinates {

@@ -237,7 +237,102 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   }
 }
 
+/// The isochoric part of a material scaled by s (the volumetric part kept): what a damage law's
+/// (1 - d) does to the stress.
+class IsochoricScaled final : public Material {
+ public:
+  IsochoricScaled(MaterialPtr base, double s) : base_(std::move(base)), s_(s) {}
+  std::string name() const override { return "isochoric_scaled(" + base_->name() + ")"; }
+  void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> so, std::span<double> sn,
+                std::span<PointResponse> out, bool tangent) const override {
+    base_->evaluate(F, step, so, sn, out, tangent);
+    for (PointResponse& r : out) {
+      r.psi_iso *= s_;
+      r.P_iso *= s_;
+      if (tangent) r.A_iso *= s_;
+    }
+  }
+  void stress(StressBatch& b, const TimeStep& step, std::span<const double> so, std::span<double> sn) const override {
+    base_->stress(b, step, so, sn);
+    for (int l = 0; l < b.n; ++l) {
+      b.psi_iso[l] *= s_;
+      for (int k = 0; k < 9; ++k) b.P_iso[k][l] *= s_;
+    }
+  }
+  double initial_shear_modulus() const override { return s_ * base_->initial_shear_modulus(); }
+  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+
+ private:
+  MaterialPtr base_;
+  double s_;
+};
+
 }  // namespace
+
+std::vector<Eigen::VectorXd> softened_states(const Model& reference, const ElasticPathTrace& trace, const std::vector<int>& samples,
+                                             int levels, double max_softening, bool verbose) {
+  std::vector<Eigen::VectorXd> out;
+  if (levels <= 0) return out;
+  const auto t0 = Clock::now();
+  const std::vector<char> stiff = stiff_parts(reference, 100.0);
+  const Assembler A0(reference);
+  const ElementGeometry& geom = A0.geometry();
+  const int ne = reference.mesh.num_elements();
+  constexpr int kBins = 16;  // softening levels are binned: one part per bin and original part
+  for (int k : samples) {
+    const Eigen::VectorXd& uk = trace.u[static_cast<std::size_t>(k)];
+    const double pk = trace.p_Pa[static_cast<std::size_t>(k)];
+    // Isochoric energy density per soft element (mean over its points).
+    std::vector<double> W(static_cast<std::size_t>(ne), 0.0);
+    double wmax = 0.0;
+    for (int e = 0; e < ne; ++e) {
+      if (stiff[reference.element_part[e]]) continue;
+      std::array<Mat3, 4> F;
+      std::array<PointResponse, 4> resp;
+      const int* n = reference.mesh.element(e);
+      for (int q = 0; q < geom.nqp; ++q) {
+        const double* g = geom.grad(e, q);
+        F[q] = Mat3::Identity();
+        for (int a = 0; a < geom.npe; ++a) F[q] += uk.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+      }
+      reference.material_of(e).evaluate(std::span<const Mat3>(F.data(), geom.nqp), TimeStep{}, {}, {},
+                                        std::span<PointResponse>(resp.data(), geom.nqp), false);
+      for (int q = 0; q < geom.nqp; ++q) W[static_cast<std::size_t>(e)] += resp[q].psi_iso / geom.nqp;
+      wmax = std::max(wmax, W[static_cast<std::size_t>(e)]);
+    }
+    if (!(wmax > 0.0)) continue;
+    for (double m : {0.0, 1.0, 4.0}) {
+      Eigen::VectorXd u = uk;
+      for (int l = 1; l <= levels; ++l) {
+        const double s = max_softening * l / levels;
+        Model soft = reference;
+        std::map<std::pair<int, int>, int> part_of;  // (original part, bin) -> new part
+        for (int e = 0; e < ne; ++e) {
+          const int op = reference.element_part[e];
+          if (stiff[op]) continue;
+          const double d = s * std::pow(W[static_cast<std::size_t>(e)] / wmax, m);
+          const int bin = std::min(kBins, static_cast<int>(std::lround(d / max_softening * kBins)));
+          if (bin == 0) continue;
+          auto [it, fresh] = part_of.try_emplace({op, bin}, static_cast<int>(soft.parts.size()));
+          if (fresh) {
+            Part p = reference.parts[static_cast<std::size_t>(op)];
+            p.material = std::make_shared<IsochoricScaled>(p.material, 1.0 - max_softening * bin / kBins);
+            soft.parts.push_back(p);
+          }
+          soft.element_part[e] = it->second;
+        }
+        const Assembler A(soft);
+        StaticSolver solver(A);
+        const NewtonReport rep = solver.solve(pk, TimeStep{}, {}, {}, u);
+        if (!rep.converged || !u.allFinite()) break;  // past the softened structure's limit point
+        out.push_back(u);
+      }
+    }
+  }
+  if (verbose)
+    std::fprintf(stderr, "reduced basis: %zu softened equilibria at %zu samples, %.1f s\n", out.size(), samples.size(), seconds_since(t0));
+  return out;
+}
 
 double mesh_fingerprint(const Mesh& mesh) {
   std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a over the bytes
@@ -310,6 +405,8 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
       if (std::find(mode_k.begin(), mode_k.end(), static_cast<int>(best)) == mode_k.end()) mode_k.push_back(static_cast<int>(best));
     }
   }
+  std::vector<Eigen::VectorXd> softened;
+  if (opt.softened_levels > 0) softened = softened_states(reference, trace, mode_k, opt.softened_levels, opt.softened_max, opt.verbose);
   std::vector<Eigen::VectorXd> responses;
   std::vector<int> response_sample, response_cluster;
   for (int k : mode_k) {
@@ -348,7 +445,9 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     }
   }
   // Snapshots: their departure from the path point of equal angle (bisection on the path's angle).
-  for (const Eigen::VectorXd& u : snapshots) {
+  std::vector<Eigen::VectorXd> all_snapshots = snapshots;
+  all_snapshots.insert(all_snapshots.end(), softened.begin(), softened.end());
+  for (const Eigen::VectorXd& u : all_snapshots) {
     if (u.size() != ndof) throw InputError("reduced model: a snapshot has " + std::to_string(u.size()) + " dof, the model " + std::to_string(ndof));
     const double target = bending_angle(reference, u).angle_deg;
     double lo = B.theta.front(), hi = B.theta.back();
@@ -507,7 +606,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     // The snapshots themselves: the states a run with history visits, with the theta row's test
     // vector of the path sample nearest in angle. As among the path samples above, the unloaded
     // sample 0 gives no training state.
-    for (const Eigen::VectorXd& u : snapshots) {
+    for (const Eigen::VectorXd& u : all_snapshots) {
       const double th = bending_angle(reference, u).angle_deg;
       int k = path_segment_index(B.theta, th);
       if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;

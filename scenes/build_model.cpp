@@ -417,6 +417,7 @@ SolverSettings solver_settings(const Scene& s) {
   sv.reduced.max_modes = s.integer("solver.reduced_modes");
   if (sv.reduced.max_modes < 1) s.fail("solver.reduced_modes", "must be >= 1");
   sv.reduced.ecsw_tolerance = positive(s, "solver.reduced_ecsw_tol");
+  sv.reduced.softened_levels = s.integer("solver.reduced_softened_levels");
   if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
   sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
   if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)

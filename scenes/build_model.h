@@ -20,7 +20,7 @@ struct SolverSettings {
   Mode mode = Mode::QuasiStatic;
   enum class Model { Full, Reduced };  ///< quasi-static: the full FEM or the reduced model (engine/rom.h)
   Model model = Model::Full;
-  RomBasisOptions reduced;             ///< solver.reduced_modes, solver.reduced_ecsw_tol
+  RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels
   double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
   QuasiStaticOptions quasi_static;
   ExplicitOptions explicit_dynamics;

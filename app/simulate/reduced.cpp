@@ -78,6 +78,8 @@ std::unique_ptr<ReducedSetup> reduced_setup(const Scene& scene, double p_max_Pa,
   h.num(options.training_amplitude);
   h.num(options.stiff_modulus_ratio);
   h.num(options.hyper_reduce ? 1.0 : 0.0);
+  h.num(options.softened_levels);
+  h.num(options.softened_max);
   auto build = [&] { return build_reduced_basis(ref, path, options).to_doubles(); };
   out->basis = ReducedBasis::from_doubles(cache_dir.empty() ? (out->basis_source = "computed", build())
                                                             : cached_doubles(cache_dir, "rom_basis", h.hex(), build, &out->basis_source));

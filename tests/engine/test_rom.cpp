@@ -16,6 +16,7 @@
 #include "analysis/paper_metrics.h"
 #include "core/errors.h"
 #include "damage/registry.h"
+#include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/nnls.h"
 #include "engine/path_model.h"
@@ -140,6 +141,17 @@ const Offline& offline() {
   return *o;
 }
 
+/// The same with softened equilibria (6 levels to 0.9, the scenes' default): built once (~20 s).
+const ReducedBasis& softened_basis() {
+  static const ReducedBasis* b = [] {
+    RomBasisOptions opt;
+    opt.softened_levels = 6;
+    opt.softened_max = 0.9;
+    return new ReducedBasis(build_reduced_basis(offline().ref->model, offline().trace, opt));
+  }();
+  return *b;
+}
+
 struct Record {
   std::vector<int> trial;
   std::vector<double> t, angle;
@@ -194,9 +206,10 @@ std::vector<double> nrmse(const LoadHistory& load, const Record& a, const Record
 /// The issue's accuracy targets: every report angle within `angle_tol` deg of the FEM's, every
 /// trial's NRMSE (against the elastic model) within `nrmse_tol` points; and the drift of the top
 /// angle from trial 1 to the last trial (what the effects do) within `drift_rel` of the FEM's.
-void expect_follows_fem(const std::vector<std::string>& effects, double angle_tol, double nrmse_tol, double drift_rel) {
+void expect_follows_fem(const std::vector<std::string>& effects, double angle_tol, double nrmse_tol, double drift_rel,
+                        const ReducedBasis* basis = nullptr) {
   const auto bm = build_model(small_scene(effects));
-  const Record fem = fem_run(*bm), rom = rom_run(*bm, offline().basis);
+  const Record fem = fem_run(*bm), rom = rom_run(*bm, basis ? *basis : offline().basis);
   ASSERT_EQ(fem.angle.size(), rom.angle.size());
   double worst = 0.0;
   for (std::size_t i = 0; i < fem.angle.size(); ++i) {
@@ -211,6 +224,9 @@ void expect_follows_fem(const std::vector<std::string>& effects, double angle_to
   const std::vector<double> nf = nrmse(bm->load, fem, ideal), nr = nrmse(bm->load, rom, ideal);
   for (std::size_t k = 0; k < nf.size(); ++k)
     EXPECT_NEAR(100.0 * nr[k], 100.0 * nf[k], nrmse_tol) << "NRMSE (points) of trial " << k + 1;
+  std::printf("worst %.4f deg; NRMSE points:", worst);
+  for (std::size_t k = 0; k < nf.size(); ++k) std::printf(" %.3f/%.3f", 100 * nf[k], 100 * nr[k]);
+  std::printf("\n");
   if (drift_rel > 0.0) {
     // The change from trial 1 to the last trial at every report (what the effects do over trials):
     // the ROM's against the FEM's, relative to the FEM's largest change.
@@ -300,6 +316,44 @@ TEST(ReducedModel, SnapshotsOfOneDamagedTrialCarryTheFatigueFeedback) {
   EXPECT_LE(with_snapshots, 0.5 * plain) << "plain basis " << plain << " deg";
 }
 
+// Softened equilibria instead of FEM snapshots (RomBasisOptions::softened_levels): the same
+// fatigue case, with a basis that has seen no run with history at all, only static equilibria of
+// the elastic reference with its most strained elements softened. Measured (bench_rom,
+// 2026-11-27): the trial-3 error falls from 0.108 deg (plain) to 0.040 deg (6 levels), the kept
+// points' fatigue damage deficit from -11 % to a few %. Bounds: 0.06 deg (the measurement with a
+// margin for compilers and thread counts) and at most 0.6 x the plain basis's error. The same
+// basis must also survive the vent between trials: without starting a release from rest, this
+// basis stopped at theta = -1.5 deg at 0 kPa and stayed on that branch (12 deg off in trial 3).
+TEST(ReducedModel, SoftenedEquilibriaCarryTheFatigueFeedback) {
+  const std::vector<std::string> fatigue = {"load.hold_s=16.0", "load.mark_s=2.5", "load.trials=3",
+                                            "materials.silicone.mullins.enabled=false",
+                                            "materials.silicone.viscoelastic.enabled=false"};
+  const auto bm = build_model(small_scene(fatigue));
+  const ReducedBasis& softened = softened_basis();
+  EXPECT_GT(softened.num_modes(), offline().basis.num_modes()) << "the softened equilibria add modes of their own";
+  const Record fem = fem_run(*bm);
+  const double plain = largest_difference(fem, rom_run(*bm, offline().basis));
+  const Record rom = rom_run(*bm, softened);
+  const double with_softened = largest_difference(fem, rom);
+  EXPECT_GT(fem.angle.back() - fem.angle[fem.angle.size() / 3 - 1], 0.3) << "fatigue drifts the top angle (not a vacuous test)";
+  EXPECT_LE(with_softened, 0.06);
+  EXPECT_LE(with_softened, 0.6 * plain) << "plain basis " << plain << " deg";
+  for (std::size_t i = 0; i < rom.angle.size(); ++i)
+    if (std::abs(fem.angle[i]) < 0.01) EXPECT_GE(rom.angle[i], -0.01) << "report " << i << " at rest after a vent";
+}
+
+// The softened equilibria are static solves of the reference: none for no levels, and the option's
+// range is checked with the others.
+TEST(ReducedModel, SoftenedStatesAreEquilibriaOfTheSoftenedReference) {
+  const Offline& o = offline();
+  EXPECT_TRUE(softened_states(o.ref->model, o.trace, {10}, 0, 0.9).empty());
+  const std::vector<Eigen::VectorXd> s = softened_states(o.ref->model, o.trace, {10}, 2, 0.6);
+  ASSERT_FALSE(s.empty());
+  // Softer walls bend further at the same pressure: every state's angle exceeds the path's there.
+  const double path_angle = bending_angle(o.ref->model, o.trace.u[10]).angle_deg;
+  for (const Eigen::VectorXd& u : s) EXPECT_GT(bending_angle(o.ref->model, u).angle_deg, path_angle);
+}
+
 // ---- An effect the reduced model has never heard of: registered only through damage/registry.h.
 
 /// Peak-energy softening: P = eta(W_max) P_base with eta = 1 - a W_max / (W_max + c), W_max the
@@ -365,18 +419,18 @@ void register_peak_energy_softening() {
 }
 
 // The effect softens the walls ~12 % from the first loading on, which pushes the 45 kPa step of
-// this actuator towards its limit point (14.0 deg against the elastic 9.2 deg). Measured: every
-// level below 45 kPa within 0.035 deg, the 45 kPa step 0.23 deg under the FEM, so the trials' NRMSE
-// 0.81 and 0.82 points under the FEM's (16.8 %, 18.1 %); independent of the basis size (8-64 modes),
-// of the mode samples (6, 12), clusters (48, 96) and of the hyper-reduction (all elements: 0.91).
-// The issue's 0.5 points is NOT met here (issue 28): the tolerance is the measured error with a
-// 20 % margin, so a regression still fails.
+// this actuator towards its limit point (14.0 deg against the elastic 9.2 deg). With the linear
+// responses alone (the plain basis): every level below 45 kPa within 0.035 deg, the 45 kPa step
+// 0.23 deg under the FEM, the trials' NRMSE 0.81 and 0.82 points under the FEM's (16.8 %, 18.1 %),
+// whatever the basis size (8-64 modes), mode samples, clusters or hyper-reduction. With the softened
+// equilibria (the scenes' default basis) measured 0.090 deg and 0.28 / 0.23 points: the issue's
+// targets (0.5 deg, 0.5 points) hold, and are the tolerances.
 TEST(ReducedModel, FollowsTheFemForAnEffectKnownOnlyToTheRegistry) {
   register_peak_energy_softening();
   expect_follows_fem({"load.trials=2", "materials.silicone.viscoelastic.enabled=false", "materials.silicone.mullins.enabled=false",
                       "materials.silicone.fatigue.enabled=false", "materials.silicone.peak_energy_softening.enabled=true",
                       "materials.silicone.peak_energy_softening.a=0.15"},
-                     0.5, 1.0, 0.25);
+                     0.5, 0.5, 0.25, &softened_basis());
 }
 
 // ------------------------------------------------------------------ Jacobian, storage, bad input
