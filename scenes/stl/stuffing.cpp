@@ -1,0 +1,374 @@
+#include "scenes/stl/stuffing.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+
+#include "core/errors.h"
+#include "core/number_text.h"
+
+namespace pneufem {
+
+namespace {
+
+constexpr double kMaxCells = 5e6;  // as the built-in mesher (scenes/pneunet.cpp)
+
+struct Plane {
+  double at;
+  double weight;  ///< facet area; forced planes: infinity
+  int cells = 0;  ///< cells of the interval above it; 0 = from h
+};
+
+double axis_h(const StuffingOptions& o, int d) { return d == 2 && o.h_z > 0.0 ? o.h_z : o.h; }
+
+/// Axis-aligned planes carrying facets of the surface: (axis, coordinate) -> area.
+std::array<std::map<double, double>, 3> facet_planes(const TriSurface& s) {
+  std::array<std::map<double, double>, 3> out;
+  for (int f = 0; f < static_cast<int>(s.F.size()); ++f) {
+    const auto& t = s.F[f];
+    for (int d = 0; d < 3; ++d)
+      if (s.V[t[0]][d] == s.V[t[1]][d] && s.V[t[1]][d] == s.V[t[2]][d]) out[d][s.V[t[0]][d]] += s.area(f);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const StuffingOptions& o) {
+  Eigen::Vector3d lo = s.V.front(), hi = s.V.front();
+  for (const auto& p : s.V) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double size = (hi - lo).norm();
+  if (o.half) {
+    if (!(lo.x() < 0.0 && hi.x() > 0.0) || std::abs(lo.x() + hi.x()) > 1e-6 * size)
+      throw InputError(s.path + ": mesh.half = true models x >= 0 of an actuator mirror-symmetric about x = 0, but the "
+                       "surface spans x = " + short_num(lo.x() / s.unit_m) + " to " + short_num(hi.x() / s.unit_m) +
+                       " (file units); centre the actuator's width on x = 0 in CAD or set mesh.half = false");
+    lo.x() = 0.0;
+  }
+  const auto facets = facet_planes(s);
+  std::array<std::vector<double>, 3> lines;
+  for (int d = 0; d < 3; ++d) {
+    const double h = axis_h(o, d);
+    std::vector<Plane> planes{{lo[d], std::numeric_limits<double>::infinity()},
+                              {hi[d], std::numeric_limits<double>::infinity()}};
+    if (d == 2 && o.has_slab) {
+      if (!(o.slab_z0 > lo.z() && o.slab_z1 < hi.z() && o.slab_z0 < o.slab_z1))
+        throw InputError("mesh.fabric_slab_mm = [" + short_num(o.slab_z0 * 1e3) + ", " + short_num(o.slab_z1 * 1e3) +
+                         "] must be an increasing z range strictly inside the actuator's z extent [" +
+                         short_num(lo.z() * 1e3) + ", " + short_num(hi.z() * 1e3) +
+                         "] mm; give the fabric layer's bottom and top, or [] for no fabric layer");
+      planes.push_back({o.slab_z0, std::numeric_limits<double>::infinity()});
+      planes.push_back({o.slab_z1, std::numeric_limits<double>::infinity()});
+    }
+    if (o.feature_planes) {
+      // Heaviest planes first; one closer than h/4 to a kept plane would make thin cells and is
+      // left to the cut (step 3).
+      std::vector<std::pair<double, double>> cand;
+      for (const auto& [at, area] : facets[d])
+        if (at > lo[d] && at < hi[d]) cand.emplace_back(area, at);
+      std::sort(cand.begin(), cand.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+      for (const auto& [area, at] : cand) {
+        bool near = false;
+        for (const Plane& p : planes) near = near || std::abs(p.at - at) < 0.25 * h;
+        if (!near) planes.push_back({at, area});
+      }
+    }
+    std::sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) { return a.at < b.at; });
+    auto& L = lines[d];
+    const bool pad_low = !(d == 0 && o.half);
+    if (pad_low) L.push_back(planes.front().at - h);
+    for (std::size_t m = 0; m + 1 < planes.size(); ++m) {
+      const double a = planes[m].at, b = planes[m + 1].at;
+      const bool slab = d == 2 && o.has_slab && a == o.slab_z0 && b == o.slab_z1;
+      const int n = slab ? o.slab_cells : static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
+      for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+    }
+    L.push_back(planes.back().at);
+    L.push_back(planes.back().at + h);
+  }
+  const double cells = static_cast<double>(lines[0].size() - 1) * (lines[1].size() - 1) * (lines[2].size() - 1);
+  if (cells > kMaxCells)
+    throw InputError(s.path + ": mesh.h_mm = " + short_num(o.h * 1e3) + " gives " + short_num(std::round(cells / 1e5) / 10) +
+                     " million background cells (limit " + short_num(kMaxCells / 1e6) +
+                     " million); use a larger mesh.h_mm, or check mesh.length_unit (a model in metres read as mm is "
+                     "1000 times too large)");
+  return lines;
+}
+
+namespace {
+
+/// The 5-tetrahedron split of a cell with alternating parity (scenes/pneunet.cpp explains it):
+/// corner c = a + 2 b + 4 c' for local offsets (a, b, c') in {0,1}^3.
+std::array<std::array<std::array<int, 4>, 5>, 2> cell_splits() {
+  std::array<std::array<std::array<int, 4>, 5>, 2> s{};
+  for (int q = 0; q < 2; ++q) {
+    int t = 1;
+    int n = 0;
+    for (int c = 0; c < 8; ++c) {
+      if ((std::popcount(static_cast<unsigned>(c)) + q) % 2 == 0)
+        s[q][0][n++] = c;
+      else
+        s[q][t++] = {c, c ^ 1, c ^ 2, c ^ 4};
+    }
+  }
+  return s;
+}
+
+struct EdgeHash {
+  std::size_t operator()(std::uint64_t k) const { return std::hash<std::uint64_t>()(k); }
+};
+std::uint64_t edge_key(int a, int b) {
+  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+}
+
+/// Splits a prism (a0, a1, a2 | b0, b1, b2; lateral edges ai-bi) into 3 tetrahedra, every
+/// quadrilateral cut on the diagonal through its lowest-numbered vertex (Dompierre et al. 1999).
+void split_prism(std::array<int, 3> a, std::array<int, 3> b, std::vector<std::array<int, 4>>& out) {
+  int m = 0;
+  for (int i = 1; i < 6; ++i)
+    if ((i < 3 ? a[i] : b[i - 3]) < (m < 3 ? a[m] : b[m - 3])) m = i;
+  if (m >= 3) {
+    std::swap(a, b);
+    m -= 3;
+  }
+  std::rotate(a.begin(), a.begin() + m, a.end());
+  std::rotate(b.begin(), b.begin() + m, b.end());
+  out.push_back({a[0], b[0], b[1], b[2]});
+  // Pyramid apex a0 on the quad (a1, a2, b2, b1).
+  if (std::min(a[1], b[2]) < std::min(a[2], b[1])) {
+    out.push_back({a[0], a[1], a[2], b[2]});
+    out.push_back({a[0], a[1], b[2], b[1]});
+  } else {
+    out.push_back({a[0], a[1], a[2], b[1]});
+    out.push_back({a[0], a[2], b[2], b[1]});
+  }
+}
+
+/// A pyramid with apex `apex` on the quadrilateral q (cyclic), cut on its lowest vertex's diagonal.
+void split_pyramid(int apex, std::array<int, 4> q, std::vector<std::array<int, 4>>& out) {
+  const int m = static_cast<int>(std::min_element(q.begin(), q.end()) - q.begin());
+  std::rotate(q.begin(), q.begin() + m, q.end());
+  out.push_back({apex, q[0], q[1], q[2]});
+  out.push_back({apex, q[0], q[2], q[3]});
+}
+
+}  // namespace
+
+StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt) {
+  StuffedTets out;
+  out.lines = stuffing_grid(surface, opt);
+  const auto& gx = out.lines[0];
+  const auto& gy = out.lines[1];
+  const auto& gz = out.lines[2];
+  const int NX = static_cast<int>(gx.size()), NY = static_cast<int>(gy.size()), NZ = static_cast<int>(gz.size());
+  auto vid = [&](int i, int j, int k) { return (j * NZ + k) * NX + i; };
+  const int nv = NX * NY * NZ;
+  std::vector<Eigen::Vector3d> X(nv);
+  for (int j = 0; j < NY; ++j)
+    for (int k = 0; k < NZ; ++k)
+      for (int i = 0; i < NX; ++i) X[vid(i, j, k)] = Eigen::Vector3d(gx[i], gy[j], gz[k]);
+  const double h_min = std::min(opt.h, axis_h(opt, 2));
+  const double zero_tol = 1e-9 * h_min;  // round-off of a distance to a facet the vertex lies on
+
+  // Step 2: phi at the vertices; far ones by flood fill along grid edges.
+  std::vector<double> phi(nv, std::numeric_limits<double>::quiet_NaN());
+  double band_phi = 0.0;
+  for (int v = 0; v < nv; ++v) {
+    SurfacePoint sp;
+    if (dist.nearest(X[v], sp)) {
+      phi[v] = std::abs(sp.distance) <= zero_tol ? 0.0 : sp.distance;
+      band_phi = std::max(band_phi, std::abs(sp.distance));
+    }
+  }
+  {
+    std::vector<int> queue;
+    for (int v = 0; v < nv; ++v)
+      if (!std::isnan(phi[v])) queue.push_back(v);
+    if (queue.empty()) throw InputError(surface.path + ": internal: no grid vertex lies near the surface");
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int v = queue[q];
+      const int i = v % NX, k = (v / NX) % NZ, j = v / (NX * NZ);
+      const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+      for (const auto& n : nb) {
+        if (n[0] < 0 || n[0] >= NX || n[1] < 0 || n[1] >= NY || n[2] < 0 || n[2] >= NZ) continue;
+        const int w = vid(n[0], n[1], n[2]);
+        if (!std::isnan(phi[w])) continue;
+        phi[w] = phi[v] < 0.0 ? -2.0 * band_phi - 1.0 : 2.0 * band_phi + 1.0;  // only the sign is used
+        queue.push_back(w);
+      }
+    }
+  }
+
+  // Background tetrahedra (cells ordered along y, as the built-in mesher's elements).
+  const auto splits = cell_splits();
+  std::vector<std::array<int, 4>> bg;
+  bg.reserve(static_cast<std::size_t>(NX - 1) * (NY - 1) * (NZ - 1) * 5);
+  for (int j = 0; j + 1 < NY; ++j)
+    for (int k = 0; k + 1 < NZ; ++k)
+      for (int i = 0; i + 1 < NX; ++i) {
+        // Cells entirely outside (every corner phi > 0) contribute nothing.
+        bool any = false;
+        for (int c = 0; c < 8; ++c) any = any || phi[vid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] <= 0.0;
+        if (!any) continue;
+        for (const auto& t : splits[(i + j + k) % 2]) {
+          std::array<int, 4> tet;
+          for (int m = 0; m < 4; ++m) tet[m] = vid(i + (t[m] & 1), j + ((t[m] >> 1) & 1), k + ((t[m] >> 2) & 1));
+          bg.push_back(tet);
+        }
+      }
+
+  // Step 3: cut points on edges with a strict sign change.
+  std::unordered_map<std::uint64_t, int, EdgeHash> cut_of;  // edge -> index into cut_pos
+  std::vector<Eigen::Vector3d> cut_pos;
+  std::vector<std::array<int, 2>> cut_edge;
+  std::vector<double> cut_t;  // along the edge from its lower vertex id
+  for (const auto& t : bg)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const int u = std::min(t[a], t[b]), w = std::max(t[a], t[b]);
+        if (!(phi[u] * phi[w] < 0.0)) continue;
+        if (!cut_of.try_emplace(edge_key(u, w), static_cast<int>(cut_pos.size())).second) continue;
+        // Regula falsi (Illinois) on the exact distance along the edge.
+        double t0 = 0.0, t1 = 1.0, f0 = phi[u], f1 = phi[w], tc = f0 / (f0 - f1);
+        int side = 0;
+        for (int it = 0; it < 60; ++it) {
+          tc = (t0 * f1 - t1 * f0) / (f1 - f0);
+          SurfacePoint sp;
+          if (!dist.nearest(X[u] + tc * (X[w] - X[u]), sp)) break;  // cannot happen within the band
+          const double fc = sp.distance;
+          if (std::abs(fc) <= zero_tol) break;
+          if ((fc < 0.0) == (f0 < 0.0)) {
+            t0 = tc, f0 = fc;
+            if (side == -1) f1 *= 0.5;
+            side = -1;
+          } else {
+            t1 = tc, f1 = fc;
+            if (side == 1) f0 *= 0.5;
+            side = 1;
+          }
+        }
+        cut_pos.push_back(X[u] + tc * (X[w] - X[u]));
+        cut_edge.push_back({u, w});
+        cut_t.push_back(tc);
+      }
+  out.cut_points = static_cast<int>(cut_pos.size());
+
+  // Step 4: warping. Vertices on a forced plane (x = 0 of a half model, the slab's faces) move
+  // only along edges within it.
+  auto on_forced = [&](int v, int d) {
+    if (d == 0) return opt.half && X[v].x() == 0.0;
+    if (d == 2) return opt.has_slab && (X[v].z() == opt.slab_z0 || X[v].z() == opt.slab_z1);
+    return false;
+  };
+  std::vector<std::vector<int>> cuts_at(nv);
+  for (int c = 0; c < static_cast<int>(cut_edge.size()); ++c) {
+    cuts_at[cut_edge[c][0]].push_back(c);
+    cuts_at[cut_edge[c][1]].push_back(c);
+  }
+  std::vector<char> forced(nv, 0);
+  for (int v = 0; v < nv; ++v) forced[v] = static_cast<char>((on_forced(v, 0) ? 1 : 0) | (on_forced(v, 2) ? 4 : 0));
+  for (int v = 0; v < nv; ++v) {
+    if (phi[v] == 0.0 || cuts_at[v].empty()) continue;
+    int best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (int c : cuts_at[v]) {
+      const int u = cut_edge[c][0], w = cut_edge[c][1];
+      if (phi[u] == 0.0 || phi[w] == 0.0) continue;  // dropped by an earlier warp
+      const int other = u == v ? w : u;
+      bool allowed = true;
+      for (int d : {0, 2})
+        if ((forced[v] >> d) & 1) allowed = allowed && X[other][d] == X[v][d];
+      if (!allowed) continue;
+      const double len = (X[w] - X[u]).norm();
+      const double dv = (u == v ? cut_t[c] : 1.0 - cut_t[c]) * len;
+      if (dv < opt.alpha * len && dv < best_d) best = c, best_d = dv;
+    }
+    if (best < 0) continue;
+    X[v] = cut_pos[best];
+    phi[v] = 0.0;
+    ++out.warped;
+  }
+
+  // Step 5: stencils. Node ids: grid vertex v, or nv + cut index.
+  auto cut_node = [&](int a, int b) { return nv + cut_of.at(edge_key(a, b)); };
+  std::vector<std::array<int, 4>> tets;
+  for (const auto& t : bg) {
+    std::array<int, 4> neg{}, zer{}, pos{};
+    int nn = 0, nz = 0, np = 0;
+    for (int v : t) {
+      if (phi[v] < 0.0)
+        neg[nn++] = v;
+      else if (phi[v] > 0.0)
+        pos[np++] = v;
+      else
+        zer[nz++] = v;
+    }
+    if (nn == 0) {
+      if (nz == 4) {
+        const Eigen::Vector3d c = 0.25 * (X[t[0]] + X[t[1]] + X[t[2]] + X[t[3]]);
+        SurfacePoint sp;
+        if (dist.nearest(c, sp) && sp.distance < 0.0) tets.push_back(t);
+      }
+      continue;
+    }
+    if (np == 0) {
+      tets.push_back(t);
+    } else if (nn == 1) {
+      std::array<int, 4> e{neg[0], 0, 0, 0};
+      int m = 1;
+      for (int z = 0; z < nz; ++z) e[m++] = zer[z];
+      for (int p = 0; p < np; ++p) e[m++] = cut_node(neg[0], pos[p]);
+      tets.push_back(e);
+    } else if (nn == 2 && np == 2) {
+      split_prism({neg[0], cut_node(neg[0], pos[0]), cut_node(neg[0], pos[1])},
+                  {neg[1], cut_node(neg[1], pos[0]), cut_node(neg[1], pos[1])}, tets);
+    } else if (nn == 2) {  // one zero, one positive
+      split_pyramid(zer[0], {neg[0], neg[1], cut_node(neg[1], pos[0]), cut_node(neg[0], pos[0])}, tets);
+    } else {  // three negative, one positive
+      split_prism({neg[0], neg[1], neg[2]},
+                  {cut_node(neg[0], pos[0]), cut_node(neg[1], pos[0]), cut_node(neg[2], pos[0])}, tets);
+    }
+  }
+
+  // Orient every tetrahedron positively; drop the flat ones (counted, reported), then compact the
+  // nodes by first use.
+  auto pos_of = [&](int v) -> const Eigen::Vector3d& { return v < nv ? X[v] : cut_pos[v - nv]; };
+  const double vol_tol = 1e-12 * opt.h * opt.h * axis_h(opt, 2);
+  std::vector<std::array<int, 4>> kept;
+  kept.reserve(tets.size());
+  for (auto t : tets) {
+    const double v6 = (pos_of(t[1]) - pos_of(t[0])).cross(pos_of(t[2]) - pos_of(t[0])).dot(pos_of(t[3]) - pos_of(t[0]));
+    if (v6 < 0.0) std::swap(t[1], t[2]);
+    if (std::abs(v6) > vol_tol)
+      kept.push_back(t);
+    else
+      ++out.flat_dropped;
+  }
+  std::vector<int> new_id(nv + cut_pos.size(), -1);
+  for (auto& t : kept)
+    for (int& v : t) {
+      if (new_id[v] < 0) {
+        new_id[v] = static_cast<int>(out.X.size());
+        out.X.push_back(pos_of(v));
+        out.on_surface.push_back(v >= nv || phi[v] == 0.0 ? 1 : 0);
+        out.on_symmetry.push_back(opt.half && out.X.back().x() == 0.0 ? 1 : 0);
+      }
+      v = new_id[v];
+    }
+  out.tets = std::move(kept);
+  if (out.tets.empty())
+    throw InputError(surface.path + ": no tetrahedron lies inside the surface at mesh.h_mm = " + short_num(opt.h * 1e3) +
+                     "; the solid is thinner than the element size everywhere: use a smaller mesh.h_mm");
+  return out;
+}
+
+}  // namespace pneufem
