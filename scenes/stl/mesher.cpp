@@ -134,7 +134,8 @@ void curve_boundary(Mesh& m, const std::vector<char>& corner_on_surface, const s
       if (!dist.nearest(m.X[mid], sp)) continue;
       Eigen::Vector3d q = sp.point;
       if (on_symmetry[a] && on_symmetry[b]) q.x() = 0.0;
-      if ((q - m.X[mid]).norm() > 0.25 * (m.X[a] - m.X[b]).norm() || (q - m.X[mid]).norm() == 0.0) continue;
+      const double len = (m.X[a] - m.X[b]).norm(), move = (q - m.X[mid]).norm();
+      if (move > 0.25 * len || move <= 1e-9 * len) continue;  // too far to be this edge's surface; or already on it
       m.X[mid] = q;
       moved[mid] = 1;
     }

@@ -174,8 +174,14 @@ std::string lower_ext(const std::string& path) {
 /// A point in the file's units, for messages: "(1.5, 2, 0) mm".
 std::string where_text(const TriSurface& s, const Eigen::Vector3d& p) {
   const Eigen::Vector3d q = p / s.unit_m;
-  const std::string u = s.unit_m == 1e-3 ? " mm" : s.unit_m == 1.0 ? " m" : " file units";
-  return "(" + short_num(q.x()) + ", " + short_num(q.y()) + ", " + short_num(q.z()) + ")" + u;
+  std::string out = "(";  // appended piece by piece: GCC 12 warns (-Wrestrict) on a + chain here
+  out += short_num(q.x());
+  out += ", ";
+  out += short_num(q.y());
+  out += ", ";
+  out += short_num(q.z());
+  out += s.unit_m == 1e-3 ? ") mm" : s.unit_m == 1.0 ? ") m" : ") file units";
+  return out;
 }
 
 using EdgeKey = std::pair<int, int>;
@@ -217,11 +223,16 @@ void check_manifold(const TriSurface& s, const EdgeMap& edges) {
   }
   if (open == 0 && nonmanifold == 0) return;
   std::string msg = s.path + ": the surface is not a closed solid:";
-  if (open > 0)
-    msg += " " + std::to_string(open) + " open edge(s) (used by one triangle only: a hole), the first " + first_open + ";";
-  if (nonmanifold > 0)
-    msg += " " + std::to_string(nonmanifold) + " non-manifold edge(s) (shared by more than two triangles), the first " +
-           first_nm + ";";
+  if (open > 0) {
+    msg += ' ';
+    msg += std::to_string(open);
+    msg += " open edge(s) (used by one triangle only: a hole), the first " + first_open + ";";
+  }
+  if (nonmanifold > 0) {
+    msg += ' ';
+    msg += std::to_string(nonmanifold);
+    msg += " non-manifold edge(s) (shared by more than two triangles), the first " + first_nm + ";";
+  }
   throw InputError(msg + " pneufem needs a watertight, manifold surface to tell inside from outside: " + kRepairHint);
 }
 
