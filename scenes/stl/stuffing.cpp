@@ -161,6 +161,42 @@ void split_pyramid(int apex, std::array<int, 4> q, std::vector<std::array<int, 4
   out.push_back({apex, q[0], q[2], q[3]});
 }
 
+/// Step 4b (see stuff_surface). Returns the vertices moved.
+int snap_to_creases(std::vector<Eigen::Vector3d>& X, const std::vector<double>& phi,
+                    const std::vector<std::vector<int>>& nb, const std::vector<char>& forced,
+                    const SurfaceDistance& dist, double alpha, double zero_tol) {
+  const int nv = static_cast<int>(X.size());
+  auto on_surface = [&](const Eigen::Vector3d& p) {
+    SurfacePoint sp;
+    return dist.nearest(p, sp) && std::abs(sp.distance) <= zero_tol;
+  };
+  constexpr double kMinT = 0.01;  // below: the edge leaves the surface at once (a curved surface's chord)
+  int moved = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (phi[v] != 0.0) continue;
+    double best_t = 1.0;
+    int best_w = -1;
+    for (int w : nb[v]) {
+      if (phi[w] == 0.0) continue;
+      bool allowed = true;
+      for (int d : {0, 2})
+        if ((forced[v] >> d) & 1) allowed = allowed && X[w][d] == X[v][d];
+      const Eigen::Vector3d e = X[w] - X[v];
+      if (!allowed || !on_surface(X[v] + kMinT * e) || on_surface(X[v] + alpha * e)) continue;
+      double lo = kMinT, hi = alpha;  // on the surface at lo, off it at hi
+      for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (on_surface(X[v] + mid * e) ? lo : hi) = mid;
+      }
+      if (lo < best_t) best_t = lo, best_w = w;
+    }
+    if (best_w < 0) continue;
+    X[v] += best_t * (X[best_w] - X[v]);
+    ++moved;
+  }
+  return moved;
+}
+
 }  // namespace
 
 StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt) {
@@ -263,40 +299,69 @@ StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist
   out.cut_points = static_cast<int>(cut_pos.size());
 
   // Step 4: warping. Vertices on a forced plane (x = 0 of a half model, the slab's faces) move
-  // only along edges within it.
+  // only along edges within it. Besides L&S's cut points, an edge towards a vertex on the surface
+  // offers the point where it first reaches the surface (its "entry"), when that comes before the
+  // end: the edge then runs on along the surface (a vertex just inside a roof, above a chamber's
+  // side wall, reaches the roof's crease this way; no cut point lies there, phi does not change sign).
   auto on_forced = [&](int v, int d) {
     if (d == 0) return opt.half && X[v].x() == 0.0;
     if (d == 2) return opt.has_slab && (X[v].z() == opt.slab_z0 || X[v].z() == opt.slab_z1);
     return false;
   };
-  std::vector<std::vector<int>> cuts_at(nv);
-  for (int c = 0; c < static_cast<int>(cut_edge.size()); ++c) {
-    cuts_at[cut_edge[c][0]].push_back(c);
-    cuts_at[cut_edge[c][1]].push_back(c);
-  }
   std::vector<char> forced(nv, 0);
   for (int v = 0; v < nv; ++v) forced[v] = static_cast<char>((on_forced(v, 0) ? 1 : 0) | (on_forced(v, 2) ? 4 : 0));
+  std::vector<std::vector<int>> nbr(nv);
+  for (const auto& t : bg)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        if (b != a && std::find(nbr[t[a]].begin(), nbr[t[a]].end(), t[b]) == nbr[t[a]].end()) nbr[t[a]].push_back(t[b]);
+  auto in_plane = [&](int v, int w) {
+    for (int d : {0, 2})
+      if (((forced[v] >> d) & 1) && X[w][d] != X[v][d]) return false;
+    return true;
+  };
+  auto off_surface = [&](const Eigen::Vector3d& p) {
+    SurfacePoint sp;
+    return !dist.nearest(p, sp) || std::abs(sp.distance) > zero_tol;
+  };
   for (int v = 0; v < nv; ++v) {
-    if (phi[v] == 0.0 || cuts_at[v].empty()) continue;
-    int best = -1;
-    double best_d = std::numeric_limits<double>::infinity();
-    for (int c : cuts_at[v]) {
-      const int u = cut_edge[c][0], w = cut_edge[c][1];
-      if (phi[u] == 0.0 || phi[w] == 0.0) continue;  // dropped by an earlier warp
-      const int other = u == v ? w : u;
-      bool allowed = true;
-      for (int d : {0, 2})
-        if ((forced[v] >> d) & 1) allowed = allowed && X[other][d] == X[v][d];
-      if (!allowed) continue;
-      const double len = (X[w] - X[u]).norm();
-      const double dv = (u == v ? cut_t[c] : 1.0 - cut_t[c]) * len;
-      if (dv < opt.alpha * len && dv < best_d) best = c, best_d = dv;
+    if (phi[v] == 0.0) continue;
+    double best_t = 2.0, best_len = 0.0;
+    int best_w = -1;
+    Eigen::Vector3d best_p;
+    for (int w : nbr[v]) {
+      if (!in_plane(v, w)) continue;
+      const double len = (X[w] - X[v]).norm();
+      double t = 2.0;
+      Eigen::Vector3d p;
+      if (phi[v] * phi[w] < 0.0) {  // a cut point of step 3
+        const int c = cut_of.at(edge_key(v, w));
+        t = cut_edge[c][0] == v ? cut_t[c] : 1.0 - cut_t[c];
+        p = cut_pos[c];
+      } else if (phi[w] == 0.0 && !off_surface(X[v] + opt.alpha * (X[w] - X[v]))) {
+        double lo = 0.0, hi = opt.alpha;  // off the surface at lo, on it at hi
+        for (int it = 0; it < 50; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          (off_surface(X[v] + mid * (X[w] - X[v])) ? lo : hi) = mid;
+        }
+        t = hi;
+        p = X[v] + hi * (X[w] - X[v]);
+      }
+      if (t < opt.alpha && t * len < best_t * best_len + (best_w < 0 ? 1e300 : 0.0))
+        best_t = t, best_len = len, best_w = w, best_p = p;
     }
-    if (best < 0) continue;
-    X[v] = cut_pos[best];
+    if (best_w < 0) continue;
+    X[v] = best_p;
     phi[v] = 0.0;
     ++out.warped;
   }
+
+  // Step 4b: creases. A vertex on the surface whose edge runs on along the surface and leaves it
+  // within alpha of the edge (a vertex on a chamber's side wall just above its floor) moves to
+  // where the edge leaves it: onto the crease, which the warping of step 4 cannot reach (phi
+  // does not change sign along that edge). Without it the one-cell band along every concave edge
+  // of a CAD part would be a slanted fillet of solid (test_stl_scene.cpp measures the effect).
+  out.creased = snap_to_creases(X, phi, nbr, forced, dist, opt.alpha, zero_tol);
 
   // Step 5: stencils. Node ids: grid vertex v, or nv + cut index.
   auto cut_node = [&](int a, int b) { return nv + cut_of.at(edge_key(a, b)); };

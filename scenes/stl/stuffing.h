@@ -17,6 +17,8 @@
 // 4. Warping (L&S sec. 3): a vertex closer to a cut point on one of its edges than alpha times
 //    that edge's length moves onto the closest such cut point and gets phi = 0; cut points on its
 //    edges are dropped. Vertices on a forced plane only move within it.
+// 4b. Creases (an addition for CAD parts): a vertex on the surface whose edge runs along the
+//    surface and leaves it within alpha of the edge moves to where it leaves (onto the crease).
 // 5. Stencils (L&S fig. 3): each background tetrahedron keeps its part with phi <= 0: a whole
 //    tetrahedron, one tetrahedron, a pyramid (2 tetrahedra) or a prism (3). A tetrahedron whose
 //    four vertices all have phi = 0 is kept when its centroid is inside.
@@ -56,6 +58,7 @@ struct StuffedTets {
   std::array<std::vector<double>, 3> lines;  ///< the grid lines
   int warped = 0;                            ///< vertices moved onto the surface
   int cut_points = 0;
+  int creased = 0;                           ///< surface vertices moved onto a crease (step 4b)
   int flat_dropped = 0;                      ///< stencil tetrahedra of no volume, left out
 };
 

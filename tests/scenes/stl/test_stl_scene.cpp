@@ -1,0 +1,160 @@
+// mesh.source = "stl" end to end: the default actuator written as an STL from the built-in
+// geometry's dimensions, meshed through the scene keys, bends as the built-in mesh does; a second,
+// curved actuator (a capped tube with a strain-limiting strip) runs; bad inputs name their key.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "engine/assembly.h"
+#include "engine/quasi_static.h"
+#include "scenes/build_model.h"
+#include "scenes/pneunet.h"
+#include "scenes/stl_scene.h"
+#include "tests/scenes/stl/test_shapes.h"
+#include "tests/support/input_error.h"
+
+namespace pneufem {
+namespace {
+
+namespace fs = std::filesystem;
+using test::error_of;
+
+fs::path tmp(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "pneufem_test_stl_scene";
+  fs::create_directories(d);
+  return d / name;
+}
+
+/// The built-in actuator of `p`, as an STL in mm; returns its path.
+std::string pneunet_stl(const PneuNetParams& p, const std::string& name) {
+  const fs::path f = tmp(name);
+  write_stl(f.string(), test::pneunet_surface(p), 1e-3);
+  return f.string();
+}
+
+/// Bending angle (deg) at each pressure level (> 0) of the scene's staircase, in pressure order
+/// (the model is elastic: loading and unloading reports of a level agree).
+std::vector<double> staircase_angles(const Scene& s) {
+  auto bm = build_model(s);
+  Assembler A(bm->model);
+  QuasiStaticRun run(A, bm->solver.quasi_static);
+  std::map<double, double> by_pressure;
+  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
+    if (r.pressure_Pa > 0.0) by_pressure[r.pressure_Pa] = r.angle_deg;
+  });
+  std::vector<double> angles;
+  for (const auto& [p, a] : by_pressure) angles.push_back(a);
+  return angles;
+}
+
+std::vector<std::string> stl_sets(const std::string& file, std::vector<std::string> more = {}) {
+  std::vector<std::string> s{"mesh.source=\"stl\"", "mesh.file=\"" + file + "\""};
+  s.insert(s.end(), more.begin(), more.end());
+  return s;
+}
+
+// One loading: 0 -> 20 kPa in 5 kPa levels, one report per level (the default staircase's first
+// trial, shortened to keep the test at a few seconds per model).
+const std::vector<std::string> kLoad = {"load.max_kPa=20.0", "load.trials=1", "load.output_every_s=0.0"};
+
+TEST(StlScene, DefaultActuatorFromStlBendsAsTheBuiltInMesh) {
+  PneuNetParams p;  // the default actuator
+  const std::string file = pneunet_stl(p, "default_actuator.stl");
+  std::vector<std::string> common = kLoad;
+  common.push_back("mesh.h_mm=2.0");
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<double> built_in = staircase_angles(Scene::load("", common));
+  const auto t1 = std::chrono::steady_clock::now();
+  const std::vector<double> from_stl = staircase_angles(Scene::load("", stl_sets(file, common)));
+  const auto t2 = std::chrono::steady_clock::now();
+  ASSERT_EQ(built_in.size(), from_stl.size());
+  ASSERT_FALSE(built_in.empty());
+  for (std::size_t i = 0; i < built_in.size(); ++i) {
+    std::printf("level %zu: built-in %.4f deg, STL %.4f deg\n", i, built_in[i], from_stl[i]);
+    // The same grid and split (test_mesher.cpp): the same discrete problem up to node numbering,
+    // so the angles agree to the solver's tolerance (rel_tol 1e-8), far inside the 2 % target.
+    EXPECT_NEAR(from_stl[i], built_in[i], 1e-6 * std::abs(built_in[i]) + 1e-9);
+  }
+  std::printf("built-in %.1f s, STL %.1f s\n", std::chrono::duration<double>(t1 - t0).count(),
+              std::chrono::duration<double>(t2 - t1).count());
+}
+
+TEST(StlScene, UniformLatticeStaysWithinTwoPercentOfTheBuiltInMesh) {
+  // The general path: a grid that ignores the CAD faces, every wall cut and warped onto the
+  // surface. A shorter actuator (4 chambers) at h = 1 mm keeps the test at tens of seconds.
+  PneuNetParams p;
+  p.chambers = 4;
+  const std::string file = pneunet_stl(p, "four_chambers.stl");
+  std::vector<std::string> common = kLoad;
+  common.insert(common.end(), {"geometry.chambers=4", "mesh.h_mm=1.0"});
+  const std::vector<double> built_in = staircase_angles(Scene::load("", common));
+  common.push_back("mesh.feature_planes=false");
+  const std::vector<double> cut = staircase_angles(Scene::load("", stl_sets(file, common)));
+  ASSERT_EQ(built_in.size(), cut.size());
+  for (std::size_t i = 0; i < built_in.size(); ++i) {
+    std::printf("level %zu: built-in %.4f deg, uniform lattice %.4f deg (%+.2f %%)\n", i, built_in[i], cut[i],
+                100.0 * (cut[i] / built_in[i] - 1.0));
+    // The target: the bending curve within 2 % of the built-in mesh at the same h.
+    EXPECT_NEAR(cut[i], built_in[i], 0.02 * std::abs(built_in[i]));
+  }
+}
+
+TEST(StlScene, CurvedTubeActuatorRunsEndToEnd) {
+  // A second geometry: a capped silicone tube (outer radius 6 mm, closed bore 3.5 mm, 40 mm long)
+  // with a strain-limiting strip z in [-5.8, -5] mm along its bottom; it is round, so every
+  // surface is cut and warped and the mid-nodes are curved onto it.
+  TriSurface t = test::tube_surface(0.006, 0.0035, 0.04, 0.003, 48);
+  write_stl(tmp("tube.stl").string(), t, 1e-3);
+  std::vector<std::string> sets = kLoad;
+  sets.insert(sets.end(), {"mesh.h_mm=1.5", "mesh.fabric_slab_mm=[-5.8, -5.0]", "mesh.cavity_inlet_mm=[0.0, 20.0, 0.0]",
+                           "load.max_kPa=10.0"});
+  const Scene s = Scene::load("", stl_sets(tmp("tube.stl").string(), sets));
+  std::vector<std::string> notes;
+  StlMeshReport rep;
+  const Mesh m = stl_scene_mesh(s, &notes, &rep);
+  std::printf("%s", describe(rep).c_str());
+  ASSERT_EQ(notes.size(), 1u);  // the bore was written facing out: turned, with a note
+  EXPECT_NE(notes[0].find("were reversed"), std::string::npos);
+  const std::vector<double> a = staircase_angles(s);
+  ASSERT_EQ(a.size(), 2u);
+  for (double v : a) std::printf("tube: %.4f deg\n", v);
+  // The strip is on the -z side: the tube curls towards it (positive angle), more at 10 kPa.
+  EXPECT_GT(a[0], 0.1);
+  EXPECT_GT(a[1], a[0]);
+}
+
+TEST(StlScene, BadInputsNameTheirKey) {
+  PneuNetParams p;
+  p.chambers = 2;
+  const std::string file = pneunet_stl(p, "two_chambers.stl");
+  // An open surface: the last triangle cut off.
+  {
+    TriSurface s = test::pneunet_surface(p);
+    s.F.pop_back();
+    write_stl(tmp("open.stl").string(), s, 1e-3);
+  }
+  const std::string open = error_of([&] { build_mesh(Scene::load("", stl_sets(tmp("open.stl").string()))); });
+  EXPECT_NE(open.find("key 'mesh.file'"), std::string::npos) << open;
+  EXPECT_NE(open.find("3 open edge(s)"), std::string::npos) << open;
+  const std::string cav = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.cavity_inlet_mm=[0.0, 1.0, 1.0]"}))); });
+  EXPECT_NE(cav.find("key 'mesh.cavity_inlet_mm': cavity not found"), std::string::npos) << cav;
+  const std::string fixed = error_of([&] {
+    build_mesh(Scene::load("", stl_sets(file, {"mesh.fixed_face=\"plane\"", "mesh.fixed_point_mm=[0.0, 5.0, 0.0]"})));
+  });
+  EXPECT_NE(fixed.find("key 'mesh.fixed_face'"), std::string::npos) << fixed;
+  EXPECT_NE(fixed.find("fixed face not found"), std::string::npos) << fixed;
+  const std::string none = error_of([&] { build_mesh(Scene::load("", {"mesh.source=\"stl\""})); });
+  EXPECT_NE(none.find("key 'mesh.file'"), std::string::npos) << none;
+  const std::string slab = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.fabric_slab_mm=[2.0]"}))); });
+  EXPECT_NE(slab.find("key 'mesh.fabric_slab_mm'"), std::string::npos) << slab;
+  const std::string unit = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.length_unit=\"m\""}))); });
+  EXPECT_NE(unit.find("mesh.length_unit"), std::string::npos) << unit;  // 1000x too large: the size limits say so
+}
+
+}  // namespace
+}  // namespace pneufem
