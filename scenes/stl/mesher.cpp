@@ -224,6 +224,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   const StuffedTets st = stuff_surface(surface, dist, opt);
   rep.warped = st.warped;
   rep.creased = st.creased;
+  rep.on_sharp_edges = st.on_sharp_edges;
   rep.cut_points = st.cut_points;
   rep.flat_dropped = st.flat_dropped;
 
@@ -311,9 +312,9 @@ std::string describe(const StlMeshReport& r) {
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "background grid %d x %d x %d lines; OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
-                "onto the surface, %d onto creases, %d flat stencil tets dropped\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
+                "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
                 "min radius ratio %.3f; %d mid-nodes on the surface, %d kept straight; %.2f s\n",
-                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased,
+                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
                 r.flat_dropped, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
                 r.midnodes_on_surface, r.midnodes_kept_straight, r.seconds);
   std::string s = buf;

@@ -58,23 +58,24 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
   std::array<std::vector<double>, 3> lines;
   for (int d = 0; d < 3; ++d) {
     const double h = axis_h(o, d);
-    std::vector<Plane> planes{{lo[d], std::numeric_limits<double>::infinity()},
-                              {hi[d], std::numeric_limits<double>::infinity()}};
+    constexpr double kForced = std::numeric_limits<double>::infinity();
+    std::vector<Plane> planes;
+    if (d == 0 && o.half) planes.push_back({0.0, kForced});
     if (d == 2 && o.has_slab) {
       if (!(o.slab_z0 > lo.z() && o.slab_z1 < hi.z() && o.slab_z0 < o.slab_z1))
         throw InputError("mesh.fabric_slab_mm = [" + short_num(o.slab_z0 * 1e3) + ", " + short_num(o.slab_z1 * 1e3) +
                          "] must be an increasing z range strictly inside the actuator's z extent [" +
                          short_num(lo.z() * 1e3) + ", " + short_num(hi.z() * 1e3) +
                          "] mm; give the fabric layer's bottom and top, or [] for no fabric layer");
-      planes.push_back({o.slab_z0, std::numeric_limits<double>::infinity()});
-      planes.push_back({o.slab_z1, std::numeric_limits<double>::infinity()});
+      planes.push_back({o.slab_z0, kForced});
+      planes.push_back({o.slab_z1, kForced});
     }
     if (o.feature_planes) {
       // Heaviest planes first; one closer than h/4 to a kept plane would make thin cells and is
       // left to the cut (step 3).
       std::vector<std::pair<double, double>> cand;
       for (const auto& [at, area] : facets[d])
-        if (at > lo[d] && at < hi[d]) cand.emplace_back(area, at);
+        if (at >= lo[d] && at <= hi[d]) cand.emplace_back(area, at);
       std::sort(cand.begin(), cand.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
       for (const auto& [area, at] : cand) {
         bool near = false;
@@ -83,17 +84,20 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
       }
     }
     std::sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) { return a.at < b.at; });
+    // The ends: one cell beyond an extreme face that is a grid plane, else half a cell beyond the
+    // surface (a plane only touching it, as below a cylinder, would make a sliver layer of cells).
+    std::vector<double> at;
+    if (!(d == 0 && o.half)) at.push_back(!planes.empty() && planes.front().at <= lo[d] ? planes.front().at - h : lo[d] - 0.5 * h);
+    for (const Plane& p : planes) at.push_back(p.at);
+    at.push_back(!planes.empty() && planes.back().at >= hi[d] ? planes.back().at + h : hi[d] + 0.5 * h);
     auto& L = lines[d];
-    const bool pad_low = !(d == 0 && o.half);
-    if (pad_low) L.push_back(planes.front().at - h);
-    for (std::size_t m = 0; m + 1 < planes.size(); ++m) {
-      const double a = planes[m].at, b = planes[m + 1].at;
+    for (std::size_t m = 0; m + 1 < at.size(); ++m) {
+      const double a = at[m], b = at[m + 1];
       const bool slab = d == 2 && o.has_slab && a == o.slab_z0 && b == o.slab_z1;
       const int n = slab ? o.slab_cells : static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
       for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
     }
-    L.push_back(planes.back().at);
-    L.push_back(planes.back().at + h);
+    L.push_back(at.back());
   }
   const double cells = static_cast<double>(lines[0].size() - 1) * (lines[1].size() - 1) * (lines[2].size() - 1);
   if (cells > kMaxCells)
@@ -193,6 +197,104 @@ int snap_to_creases(std::vector<Eigen::Vector3d>& X, const std::vector<double>& 
     if (best_w < 0) continue;
     X[v] += best_t * (X[best_w] - X[v]);
     ++moved;
+  }
+  return moved;
+}
+
+/// Smallest dihedral angle (degrees) of tetrahedron (a, b, c, d); 0 when it is flat or inverted.
+double min_dihedral_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                        const Eigen::Vector3d& d) {
+  if ((b - a).cross(c - a).dot(d - a) <= 0.0) return 0.0;
+  const Eigen::Vector3d p[4] = {a, b, c, d};
+  static constexpr int kPairs[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
+  double lo = 180.0;
+  for (const auto& q : kPairs) {
+    const Eigen::Vector3d e = (p[q[1]] - p[q[0]]).normalized();
+    Eigen::Vector3d u = p[q[2]] - p[q[0]], w = p[q[3]] - p[q[0]];
+    u -= u.dot(e) * e;
+    w -= w.dot(e) * e;
+    lo = std::min(lo, std::acos(std::clamp(u.normalized().dot(w.normalized()), -1.0, 1.0)) * 180.0 / 3.141592653589793);
+  }
+  return lo;
+}
+
+/// Step 6: sharp edges. Stencils cut a sharp edge of the surface (two facets meeting at more than
+/// 30 degrees: a box's edge, a chamber's) with a chamfer about a cell wide. Each surface node within
+/// `reach` of a sharp edge and on a boundary face that leaves the surface (a chamfer: its centroid
+/// off the surface by more than 1e-3 reach), nearest first, moves onto it, unless a tetrahedron
+/// around it would then have a dihedral angle below 5 degrees (or below its own, if that is
+/// smaller): then it stays. Nodes of a mesh that already follows the surface do not move.
+int snap_to_sharp_edges(StuffedTets& out, const TriSurface& s, const SurfaceDistance& dist, double reach) {
+  std::map<std::pair<int, int>, std::vector<int>> faces_of;
+  for (int f = 0; f < static_cast<int>(s.F.size()); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = s.F[f][k], b = s.F[f][(k + 1) % 3];
+      faces_of[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  const double cos_sharp = std::cos(30.0 * 3.141592653589793 / 180.0);
+  std::vector<std::array<Eigen::Vector3d, 2>> sharp;
+  for (const auto& [e, fs] : faces_of)
+    if (fs.size() == 2 && s.normal(fs[0]).dot(s.normal(fs[1])) < cos_sharp) sharp.push_back({s.V[e.first], s.V[e.second]});
+  if (sharp.empty()) return 0;
+  const int nn = static_cast<int>(out.X.size());
+  std::vector<std::vector<int>> tets_of(nn);
+  for (int t = 0; t < static_cast<int>(out.tets.size()); ++t)
+    for (int v : out.tets[t]) tets_of[v].push_back(t);
+  // Nodes of chamfer faces: boundary faces (used by one tetrahedron) whose centroid is off the surface.
+  std::vector<char> on_chamfer(nn, 0);
+  {
+    std::map<std::array<int, 3>, int> count;
+    for (const auto& t : out.tets)
+      for (int k = 0; k < 4; ++k) {
+        std::array<int, 3> f{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+        std::sort(f.begin(), f.end());
+        ++count[f];
+      }
+    for (const auto& [f, n] : count) {
+      if (n != 1) continue;
+      SurfacePoint sp;
+      const Eigen::Vector3d c = (out.X[f[0]] + out.X[f[1]] + out.X[f[2]]) / 3.0;
+      if (dist.nearest(c, sp) && std::abs(sp.distance) > 1e-3 * reach)
+        for (int v : f) on_chamfer[v] = 1;
+    }
+  }
+  // Nearest sharp-edge point of each surface node within reach (brute force over the sharp edges,
+  // culled by the reach box: CAD surfaces have hundreds to thousands of them).
+  std::vector<std::pair<double, int>> order;
+  std::vector<Eigen::Vector3d> target(nn);
+  for (int v = 0; v < nn; ++v) {
+    if (!out.on_surface[v] || !on_chamfer[v]) continue;
+    double best = reach;
+    for (const auto& e : sharp) {
+      const Eigen::Vector3d lo = e[0].cwiseMin(e[1]).array() - reach, hi = e[0].cwiseMax(e[1]).array() + reach;
+      if ((out.X[v].array() < lo.array()).any() || (out.X[v].array() > hi.array()).any()) continue;
+      const Eigen::Vector3d d = e[1] - e[0];
+      const double t = std::clamp((out.X[v] - e[0]).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      const Eigen::Vector3d q = e[0] + t * d;
+      const double gap = (q - out.X[v]).norm();
+      if (gap < best && !(out.on_symmetry[v] && q.x() != 0.0)) best = gap, target[v] = q;
+    }
+    if (best < reach && best > 0.0) order.emplace_back(best, v);
+  }
+  std::sort(order.begin(), order.end());
+  int moved = 0;
+  for (const auto& [gap, v] : order) {
+    const Eigen::Vector3d old = out.X[v];
+    std::vector<double> before;
+    for (int t : tets_of[v]) {
+      const auto& q = out.tets[t];
+      before.push_back(min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]));
+    }
+    out.X[v] = target[v];
+    bool ok = true;
+    for (std::size_t i = 0; i < tets_of[v].size() && ok; ++i) {
+      const auto& q = out.tets[tets_of[v][i]];
+      ok = min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]) >= std::min(5.0, before[i]);
+    }
+    if (ok)
+      ++moved;
+    else
+      out.X[v] = old;
   }
   return moved;
 }
@@ -328,7 +430,7 @@ StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist
     if (phi[v] == 0.0) continue;
     double best_t = 2.0, best_len = 0.0;
     int best_w = -1;
-    Eigen::Vector3d best_p;
+    Eigen::Vector3d best_p = X[v];
     for (int w : nbr[v]) {
       if (!in_plane(v, w)) continue;
       const double len = (X[w] - X[v]).norm();
@@ -433,6 +535,7 @@ StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist
   if (out.tets.empty())
     throw InputError(surface.path + ": no tetrahedron lies inside the surface at mesh.h_mm = " + short_num(opt.h * 1e3) +
                      "; the solid is thinner than the element size everywhere: use a smaller mesh.h_mm");
+  out.on_sharp_edges = snap_to_sharp_edges(out, surface, dist, 0.9 * h_min);
   return out;
 }
 

@@ -23,6 +23,11 @@
 //    tetrahedron, one tetrahedron, a pyramid (2 tetrahedra) or a prism (3). A tetrahedron whose
 //    four vertices all have phi = 0 is kept when its centroid is inside.
 //
+// 6. Sharp edges (an addition for CAD parts): surface nodes within 0.9 h of an edge where facets
+//    meet at more than 30 degrees move onto it, nearest first, unless that would leave a
+//    tetrahedron around them with a dihedral angle below 5 degrees. Stencils alone cut such edges
+//    with a chamfer about a cell wide.
+//
 // What is simplified (and so not proven): L&S's grid is the body-centred cubic lattice, with
 // alpha_long = 0.24999 and alpha_short = 0.41189 and a parity rule for the prisms' diagonals, which
 // together bound every dihedral angle to [10.7, 164.8] degrees. Here the grid is rectilinear (to
@@ -58,6 +63,7 @@ struct StuffedTets {
   std::array<std::vector<double>, 3> lines;  ///< the grid lines
   int warped = 0;                            ///< vertices moved onto the surface
   int cut_points = 0;
+  int on_sharp_edges = 0;                    ///< surface nodes moved onto a sharp edge (step 6)
   int creased = 0;                           ///< surface vertices moved onto a crease (step 4b)
   int flat_dropped = 0;                      ///< stencil tetrahedra of no volume, left out
 };
