@@ -52,6 +52,7 @@ struct SurfaceDistance::Impl {
   std::vector<Eigen::Vector3d> face_n;    ///< unit face normals
   std::vector<Eigen::Vector3d> edge_n;    ///< per face edge k (F[k] -> F[k+1]): n_f + n_neighbour
   std::vector<Eigen::Vector3d> vertex_n;  ///< angle-weighted vertex pseudonormals
+  std::vector<std::vector<int>> vertex_faces;
   openvdb::Int32Grid::Ptr index;
   long voxel_count = 0;
 
@@ -61,6 +62,9 @@ struct SurfaceDistance::Impl {
     const int nf = static_cast<int>(s.F.size());
     face_n.resize(nf);
     vertex_n.assign(s.V.size(), Eigen::Vector3d::Zero());
+    vertex_faces.assign(s.V.size(), {});
+    for (int f = 0; f < nf; ++f)
+      for (int v : s.F[f]) vertex_faces[v].push_back(f);
     std::map<std::pair<int, int>, Eigen::Vector3d> edge_sum;
     for (int f = 0; f < nf; ++f) {
       face_n[f] = s.normal(f);
@@ -136,17 +140,25 @@ bool SurfaceDistance::nearest(const Eigen::Vector3d& p, SurfacePoint& out) const
   double best = std::numeric_limits<double>::infinity();
   int best_f = -1, best_feature = 0;
   Eigen::Vector3d best_q = Eigen::Vector3d::Zero();
-  for (int i = 0; i < n; ++i) {
-    const auto& t = m.s.F[cand[i]];
+  auto consider = [&](int f) {
+    const auto& t = m.s.F[f];
     int feature = 0;
     const Eigen::Vector3d q = closest_on_triangle(p, m.s.V[t[0]], m.s.V[t[1]], m.s.V[t[2]], feature);
     const double d2 = (p - q).squaredNorm();
-    if (d2 < best) {
-      best = d2;
-      best_f = cand[i];
-      best_feature = feature;
-      best_q = q;
-    }
+    if (d2 >= best) return false;
+    best = d2, best_f = f, best_feature = feature, best_q = q;
+    return true;
+  };
+  for (int i = 0; i < n; ++i) consider(cand[i]);
+  // Each voxel stores one closest triangle, that of its centre: when triangles are smaller than
+  // voxels, p's own may be missing. Walk to triangles sharing a corner while one is closer (the
+  // distance to a closed surface has no local minimum over a connected fan of its triangles).
+  for (int step = 0; step < 64; ++step) {
+    bool better = false;
+    const auto t = m.s.F[best_f];
+    for (int v : t)
+      for (int f : m.vertex_faces[v]) better = consider(f) || better;
+    if (!better) break;
   }
   const auto& t = m.s.F[best_f];
   Eigen::Vector3d pn;

@@ -71,15 +71,15 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
       planes.push_back({o.slab_z1, kForced});
     }
     if (o.feature_planes) {
-      // Heaviest planes first; one closer than h/4 to a kept plane would make thin cells and is
-      // left to the cut (step 3).
+      // Heaviest planes first; one closer than h/10 to a kept plane would make cells ten times thinner
+      // than wide and is left to the cut (step 3). (The built-in mesher keeps every feature plane.)
       std::vector<std::pair<double, double>> cand;
       for (const auto& [at, area] : facets[d])
         if (at >= lo[d] && at <= hi[d]) cand.emplace_back(area, at);
       std::sort(cand.begin(), cand.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
       for (const auto& [area, at] : cand) {
         bool near = false;
-        for (const Plane& p : planes) near = near || std::abs(p.at - at) < 0.25 * h;
+        for (const Plane& p : planes) near = near || std::abs(p.at - at) < 0.1 * h;
         if (!near) planes.push_back({at, area});
       }
     }
@@ -251,7 +251,7 @@ int snap_to_sharp_edges(StuffedTets& out, const TriSurface& s, const SurfaceDist
         ++count[f];
       }
     for (const auto& [f, n] : count) {
-      if (n != 1) continue;
+      if (n != 1 || (out.on_symmetry[f[0]] && out.on_symmetry[f[1]] && out.on_symmetry[f[2]])) continue;
       SurfacePoint sp;
       const Eigen::Vector3d c = (out.X[f[0]] + out.X[f[1]] + out.X[f[2]]) / 3.0;
       if (dist.nearest(c, sp) && std::abs(sp.distance) > 1e-3 * reach)
@@ -435,7 +435,7 @@ StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist
       if (!in_plane(v, w)) continue;
       const double len = (X[w] - X[v]).norm();
       double t = 2.0;
-      Eigen::Vector3d p;
+      Eigen::Vector3d p = X[v];
       if (phi[v] * phi[w] < 0.0) {  // a cut point of step 3
         const int c = cut_of.at(edge_key(v, w));
         t = cut_edge[c][0] == v ? cut_t[c] : 1.0 - cut_t[c];
