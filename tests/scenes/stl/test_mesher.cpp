@@ -49,23 +49,31 @@ TriSurface closed(TriSurface s) {
 }
 
 TEST(StlMesher, PneuNetSurfaceGivesTheBuiltInSolid) {
-  PneuNetParams p;  // the default actuator, h = 2 mm, half model, Tet10
-  const Mesh built_in = build_pneunet(p);
-  StlMeshReport rep;
-  const Mesh m = mesh_closed_surface(closed(test::pneunet_surface(p)), default_spec(p), &rep);
-  std::printf("%s", describe(rep).c_str());
-  // Every face of this actuator is an axis-aligned plane that carries facets, so the background
-  // grid is the built-in mesher's grid and nothing is cut: the same cells, the same 5-tet split.
-  EXPECT_EQ(m.num_elements(), built_in.num_elements());
-  EXPECT_EQ(m.num_nodes(), built_in.num_nodes());
-  EXPECT_EQ(rep.cut_points, 0);
-  // Volumes exact up to round-off of the sum (1e-12 relative).
-  EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 1e-12 * mesh_volume(built_in));
-  EXPECT_NEAR(set_volume(m, "FABRIC"), set_volume(built_in, "FABRIC"), 1e-12 * mesh_volume(built_in));
-  EXPECT_EQ(m.surfaces.at("CAVITY").size(), built_in.surfaces.at("CAVITY").size());
-  EXPECT_EQ(m.node_sets.at("FIXED").size(), built_in.node_sets.at("FIXED").size());
-  EXPECT_EQ(m.node_sets.at("TIP").size(), built_in.node_sets.at("TIP").size());
-  EXPECT_EQ(m.node_sets.at("SYMMETRY").size(), built_in.node_sets.at("SYMMETRY").size());
+  for (double h : {2e-3, 4e-3, 6e-3}) {
+    PneuNetParams p;  // the default actuator, half model, Tet10
+    p.h = h;
+    const Mesh built_in = build_pneunet(p);
+    StlMeshReport rep;
+    const Mesh m = mesh_closed_surface(closed(test::pneunet_surface(p)), default_spec(p), &rep);
+    std::printf("h = %g mm: %s", h * 1e3, describe(rep).c_str());
+    // Every face of this actuator is an axis-aligned plane carrying facets, at least h/10 from the
+    // next, so the background grid is the built-in mesher's grid and nothing is cut or moved: the
+    // same cells, the same 5-tet split, the same nodes (numbered alike: both by first use).
+    EXPECT_EQ(m.num_elements(), built_in.num_elements()) << h;
+    ASSERT_EQ(m.num_nodes(), built_in.num_nodes()) << h;
+    EXPECT_EQ(rep.cut_points + rep.warped + rep.creased + rep.on_sharp_edges, 0) << h;
+    double max_dx = 0.0;
+    for (int n = 0; n < m.num_nodes(); ++n) max_dx = std::max(max_dx, (m.X[n] - built_in.X[n]).norm());
+    EXPECT_EQ(max_dx, 0.0) << h;  // grid lines computed by the same formula from the same planes
+    EXPECT_EQ(m.conn, built_in.conn) << h;
+    // Volumes exact up to round-off of the sum (1e-12 relative).
+    EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 1e-12 * mesh_volume(built_in));
+    EXPECT_NEAR(set_volume(m, "FABRIC"), set_volume(built_in, "FABRIC"), 1e-12 * mesh_volume(built_in));
+    EXPECT_EQ(m.surfaces.at("CAVITY").size(), built_in.surfaces.at("CAVITY").size());
+    EXPECT_EQ(m.node_sets.at("FIXED"), built_in.node_sets.at("FIXED"));
+    EXPECT_EQ(m.node_sets.at("TIP"), built_in.node_sets.at("TIP"));
+    EXPECT_EQ(m.node_sets.at("SYMMETRY"), built_in.node_sets.at("SYMMETRY"));
+  }
 }
 
 TEST(StlMesher, UniformLatticeCutsTheBoxesToTheSurface) {
