@@ -12,6 +12,8 @@
 //  * FIXED: the nodes of the boundary faces on the fixed plane, the extreme face of the surface
 //    along an axis ("y-": lowest y) or a plane through a point; TIP: the opposite end face.
 //  * FABRIC: the elements whose centroid lies in the slab z0 < z < z1 (its faces are grid planes).
+//  * Thin features: a meshed volume more than 5 % off the surface's is an error (walls or chambers
+//    thinner than the elements were lost), more than 1 % a note.
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +46,7 @@ struct StlMeshReport {
   int tets = 0, nodes = 0;
   double min_dihedral_deg = 0.0, max_dihedral_deg = 0.0;
   std::vector<int> dihedral_histogram;  ///< counts per 10 degrees, 0-10 ... 170-180 (corner tetrahedra)
+  double volume_error = 0.0;            ///< meshed (straight-sided) / enclosed volume - 1
   double min_radius_ratio = 0.0;        ///< normalised (1 = regular), as MeshStats::min_quality
   int midnodes_on_surface = 0, midnodes_kept_straight = 0;
   double seconds = 0.0;
