@@ -137,6 +137,18 @@ TEST(StlMesher, BadInputsAreClearErrors) {
   spec.fixed_normal = Eigen::Vector3d(0.0, -1.0, 0.0);
   const std::string e = error_of([&] { mesh_closed_surface(s, spec); });
   EXPECT_NE(e.find("fixed face not found"), std::string::npos) << e;
+  // A wall thinner than the cells: a hollow box whose 0.3 mm lid lies between grid planes of a
+  // uniform 2 mm grid is lost or thickened by the stencils, which moves the volume by far more than 5 %.
+  {
+    std::array<std::vector<double>, 3> l{{{-0.01, -0.008, 0.008, 0.01}, {0.0, 0.002, 0.018, 0.02}, {0.0, 0.002, 0.0057, 0.006}}};
+    const TriSurface hollow = closed(test::grid_solid_surface(
+        l, [](const Eigen::Vector3d& x) { return !(std::abs(x.x()) < 0.008 && x.y() > 0.002 && x.y() < 0.018 && x.z() > 0.002 && x.z() < 0.0057); }));
+    StlMeshSpec thin;
+    thin.stuffing.h = 2e-3;
+    thin.stuffing.feature_planes = false;
+    const std::string lost = error_of([&] { mesh_closed_surface(hollow, thin); });
+    EXPECT_NE(lost.find("walls, chambers or channels thinner than about one element"), std::string::npos) << lost;
+  }
   spec.fixed_face = "w+";
   EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("mesh.fixed_face must be"), std::string::npos);
 }
