@@ -157,6 +157,20 @@ TEST(StlScene, BadInputsNameTheirKey) {
   EXPECT_NE(none.find("key 'mesh.file'"), std::string::npos) << none;
   const std::string slab = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.fabric_slab_mm=[2.0]"}))); });
   EXPECT_NE(slab.find("key 'mesh.fabric_slab_mm'"), std::string::npos) << slab;
+  {
+    TriSurface shifted = test::pneunet_surface(p);
+    for (auto& v : shifted.V) v.x() += 0.011;  // x in [0, 22] mm: not mirror-symmetric about x = 0
+    write_stl(tmp("shifted.stl").string(), shifted, 1e-3);
+  }
+  const std::string half = error_of([&] { build_mesh(Scene::load("", stl_sets(tmp("shifted.stl").string()))); });
+  EXPECT_NE(half.find("key 'mesh.half'"), std::string::npos) << half;
+  EXPECT_NE(half.find("set mesh.half = false"), std::string::npos) << half;
+  EXPECT_EQ(error_of([&] {
+              build_mesh(Scene::load("", stl_sets(tmp("shifted.stl").string(), {"mesh.half=false", "mesh.h_mm=4.0"})));
+            }),
+            "(no error)");
+  const std::string range = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.fabric_slab_mm=[1.8, 2000.0]"}))); });
+  EXPECT_NE(range.find("key 'mesh.fabric_slab_mm'"), std::string::npos) << range;
   const std::string unit = error_of([&] { build_mesh(Scene::load("", stl_sets(file, {"mesh.length_unit=\"m\""}))); });
   EXPECT_NE(unit.find("mesh.length_unit"), std::string::npos) << unit;  // 1000x too large: the size limits say so
 }
