@@ -301,242 +301,296 @@ int snap_to_sharp_edges(StuffedTets& out, const TriSurface& s, const SurfaceDist
 
 }  // namespace
 
-StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt) {
-  StuffedTets out;
-  out.lines = stuffing_grid(surface, opt);
-  const auto& gx = out.lines[0];
-  const auto& gy = out.lines[1];
-  const auto& gz = out.lines[2];
-  const int NX = static_cast<int>(gx.size()), NY = static_cast<int>(gy.size()), NZ = static_cast<int>(gz.size());
-  auto vid = [&](int i, int j, int k) { return (j * NZ + k) * NX + i; };
-  const int nv = NX * NY * NZ;
-  std::vector<Eigen::Vector3d> X(nv);
-  for (int j = 0; j < NY; ++j)
-    for (int k = 0; k < NZ; ++k)
-      for (int i = 0; i < NX; ++i) X[vid(i, j, k)] = Eigen::Vector3d(gx[i], gy[j], gz[k]);
-  const double h_min = std::min(opt.h, axis_h(opt, 2));
-  const double zero_tol = 1e-9 * h_min;  // round-off of a distance to a facet the vertex lies on
+namespace {
+
+/// The state of one stuffing, step by step (stuff_surface lists the steps). Node ids: grid vertex
+/// v < nv, or nv + index of a cut point.
+class Stuffing {
+ public:
+  Stuffing(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt)
+      : s_(surface), dist_(dist), opt_(opt) {
+    out_.lines = stuffing_grid(surface, opt);
+    for (int d = 0; d < 3; ++d) n_[d] = static_cast<int>(out_.lines[d].size());
+    nv_ = n_[0] * n_[1] * n_[2];
+    X_.resize(nv_);
+    for (int j = 0; j < n_[1]; ++j)
+      for (int k = 0; k < n_[2]; ++k)
+        for (int i = 0; i < n_[0]; ++i) X_[vid(i, j, k)] = Eigen::Vector3d(out_.lines[0][i], out_.lines[1][j], out_.lines[2][k]);
+    h_min_ = std::min(opt.h, axis_h(opt, 2));
+    zero_tol_ = 1e-9 * h_min_;  // round-off of a distance to a facet the vertex lies on
+  }
+
+  StuffedTets run() {
+    vertex_phi();
+    background_tets();
+    cut_points();
+    neighbours_and_forced_planes();
+    warp();
+    // Step 4b: creases. A vertex on the surface whose edge runs on along the surface and leaves it
+    // within alpha of the edge (a vertex on a chamber's side wall just above its floor) moves to
+    // where the edge leaves it: onto the crease, which the warping of step 4 cannot reach (phi
+    // does not change sign along that edge). Without it the one-cell band along every concave edge
+    // of a CAD part would be a slanted fillet of solid.
+    out_.creased = snap_to_creases(X_, phi_, nbr_, forced_, dist_, opt_.alpha, zero_tol_);
+    compact(stencils());
+    out_.on_sharp_edges = snap_to_sharp_edges(out_, s_, dist_, 0.9 * h_min_);
+    return std::move(out_);
+  }
+
+ private:
+  int vid(int i, int j, int k) const { return (j * n_[2] + k) * n_[0] + i; }
 
   // Step 2: phi at the vertices; far ones by flood fill along grid edges.
-  std::vector<double> phi(nv, std::numeric_limits<double>::quiet_NaN());
-  double band_phi = 0.0;
-  for (int v = 0; v < nv; ++v) {
-    SurfacePoint sp;
-    if (dist.nearest(X[v], sp)) {
-      phi[v] = std::abs(sp.distance) <= zero_tol ? 0.0 : sp.distance;
-      band_phi = std::max(band_phi, std::abs(sp.distance));
+  void vertex_phi() {
+    phi_.assign(nv_, std::numeric_limits<double>::quiet_NaN());
+    double band_phi = 0.0;
+    for (int v = 0; v < nv_; ++v) {
+      SurfacePoint sp;
+      if (dist_.nearest(X_[v], sp)) {
+        phi_[v] = std::abs(sp.distance) <= zero_tol_ ? 0.0 : sp.distance;
+        band_phi = std::max(band_phi, std::abs(sp.distance));
+      }
     }
-  }
-  {
     std::vector<int> queue;
-    for (int v = 0; v < nv; ++v)
-      if (!std::isnan(phi[v])) queue.push_back(v);
-    if (queue.empty()) throw InputError(surface.path + ": internal: no grid vertex lies near the surface");
+    for (int v = 0; v < nv_; ++v)
+      if (!std::isnan(phi_[v])) queue.push_back(v);
+    if (queue.empty()) throw InputError(s_.path + ": internal: no grid vertex lies near the surface");
     for (std::size_t q = 0; q < queue.size(); ++q) {
       const int v = queue[q];
-      const int i = v % NX, k = (v / NX) % NZ, j = v / (NX * NZ);
+      const int i = v % n_[0], k = (v / n_[0]) % n_[2], j = v / (n_[0] * n_[2]);
       const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
       for (const auto& n : nb) {
-        if (n[0] < 0 || n[0] >= NX || n[1] < 0 || n[1] >= NY || n[2] < 0 || n[2] >= NZ) continue;
+        if (n[0] < 0 || n[0] >= n_[0] || n[1] < 0 || n[1] >= n_[1] || n[2] < 0 || n[2] >= n_[2]) continue;
         const int w = vid(n[0], n[1], n[2]);
-        if (!std::isnan(phi[w])) continue;
-        phi[w] = phi[v] < 0.0 ? -2.0 * band_phi - 1.0 : 2.0 * band_phi + 1.0;  // only the sign is used
+        if (!std::isnan(phi_[w])) continue;
+        phi_[w] = phi_[v] < 0.0 ? -2.0 * band_phi - 1.0 : 2.0 * band_phi + 1.0;  // only the sign is used
         queue.push_back(w);
       }
     }
   }
 
-  // Background tetrahedra (cells ordered along y, as the built-in mesher's elements).
-  const auto splits = cell_splits();
-  std::vector<std::array<int, 4>> bg;
-  bg.reserve(static_cast<std::size_t>(NX - 1) * (NY - 1) * (NZ - 1) * 5);
-  for (int j = 0; j + 1 < NY; ++j)
-    for (int k = 0; k + 1 < NZ; ++k)
-      for (int i = 0; i + 1 < NX; ++i) {
-        // Cells entirely outside (every corner phi > 0) contribute nothing.
-        bool any = false;
-        for (int c = 0; c < 8; ++c) any = any || phi[vid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] <= 0.0;
-        if (!any) continue;
-        for (const auto& t : splits[(i + j + k) % 2]) {
-          std::array<int, 4> tet;
-          for (int m = 0; m < 4; ++m) tet[m] = vid(i + (t[m] & 1), j + ((t[m] >> 1) & 1), k + ((t[m] >> 2) & 1));
-          bg.push_back(tet);
-        }
-      }
-
-  // Step 3: cut points on edges with a strict sign change.
-  std::unordered_map<std::uint64_t, int, EdgeHash> cut_of;  // edge -> index into cut_pos
-  std::vector<Eigen::Vector3d> cut_pos;
-  std::vector<std::array<int, 2>> cut_edge;
-  std::vector<double> cut_t;  // along the edge from its lower vertex id
-  for (const auto& t : bg)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        const int u = std::min(t[a], t[b]), w = std::max(t[a], t[b]);
-        if (!(phi[u] * phi[w] < 0.0)) continue;
-        if (!cut_of.try_emplace(edge_key(u, w), static_cast<int>(cut_pos.size())).second) continue;
-        // Regula falsi (Illinois) on the exact distance along the edge.
-        double t0 = 0.0, t1 = 1.0, f0 = phi[u], f1 = phi[w], tc = f0 / (f0 - f1);
-        int side = 0;
-        for (int it = 0; it < 60; ++it) {
-          tc = (t0 * f1 - t1 * f0) / (f1 - f0);
-          SurfacePoint sp;
-          if (!dist.nearest(X[u] + tc * (X[w] - X[u]), sp)) break;  // cannot happen within the band
-          const double fc = sp.distance;
-          if (std::abs(fc) <= zero_tol) break;
-          if ((fc < 0.0) == (f0 < 0.0)) {
-            t0 = tc, f0 = fc;
-            if (side == -1) f1 *= 0.5;
-            side = -1;
-          } else {
-            t1 = tc, f1 = fc;
-            if (side == 1) f0 *= 0.5;
-            side = 1;
+  // Background tetrahedra of the cells with a corner inside (cells ordered along y, as the
+  // built-in mesher's elements).
+  void background_tets() {
+    const auto splits = cell_splits();
+    for (int j = 0; j + 1 < n_[1]; ++j)
+      for (int k = 0; k + 1 < n_[2]; ++k)
+        for (int i = 0; i + 1 < n_[0]; ++i) {
+          bool any = false;
+          for (int c = 0; c < 8; ++c) any = any || phi_[vid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] <= 0.0;
+          if (!any) continue;
+          for (const auto& t : splits[(i + j + k) % 2]) {
+            std::array<int, 4> tet;
+            for (int m = 0; m < 4; ++m) tet[m] = vid(i + (t[m] & 1), j + ((t[m] >> 1) & 1), k + ((t[m] >> 2) & 1));
+            bg_.push_back(tet);
           }
         }
-        cut_pos.push_back(X[u] + tc * (X[w] - X[u]));
-        cut_edge.push_back({u, w});
-        cut_t.push_back(tc);
+  }
+
+  // Step 3: cut points on edges with a strict sign change, by regula falsi (Illinois) on the
+  // exact distance along the edge.
+  void cut_points() {
+    for (const auto& t : bg_)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          const int u = std::min(t[a], t[b]), w = std::max(t[a], t[b]);
+          if (!(phi_[u] * phi_[w] < 0.0)) continue;
+          if (!cut_of_.try_emplace(edge_key(u, w), static_cast<int>(cut_pos_.size())).second) continue;
+          const double tc = edge_root(u, w);
+          cut_pos_.push_back(X_[u] + tc * (X_[w] - X_[u]));
+          cut_edge_.push_back({u, w});
+          cut_t_.push_back(tc);
+        }
+    out_.cut_points = static_cast<int>(cut_pos_.size());
+  }
+
+  /// Where phi = 0 on edge u -> w (fraction from u); phi changes sign along it.
+  double edge_root(int u, int w) const {
+    double t0 = 0.0, t1 = 1.0, f0 = phi_[u], f1 = phi_[w], tc = f0 / (f0 - f1);
+    int side = 0;
+    for (int it = 0; it < 60; ++it) {
+      tc = (t0 * f1 - t1 * f0) / (f1 - f0);
+      SurfacePoint sp;
+      if (!dist_.nearest(X_[u] + tc * (X_[w] - X_[u]), sp)) break;  // cannot happen within the band
+      const double fc = sp.distance;
+      if (std::abs(fc) <= zero_tol_) break;
+      if ((fc < 0.0) == (f0 < 0.0)) {
+        t0 = tc, f0 = fc;
+        if (side == -1) f1 *= 0.5;
+        side = -1;
+      } else {
+        t1 = tc, f1 = fc;
+        if (side == 1) f0 *= 0.5;
+        side = 1;
       }
-  out.cut_points = static_cast<int>(cut_pos.size());
+    }
+    return tc;
+  }
+
+  // Grid neighbours (tetrahedron edges) and the forced planes each vertex lies on (bit 0: x = 0
+  // of a half model, bit 2: a face of the slab).
+  void neighbours_and_forced_planes() {
+    forced_.assign(nv_, 0);
+    for (int v = 0; v < nv_; ++v) {
+      const bool on_x = opt_.half && X_[v].x() == 0.0;
+      const bool on_z = opt_.has_slab && (X_[v].z() == opt_.slab_z0 || X_[v].z() == opt_.slab_z1);
+      forced_[v] = static_cast<char>((on_x ? 1 : 0) | (on_z ? 4 : 0));
+    }
+    nbr_.assign(nv_, {});
+    for (const auto& t : bg_)
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          if (b != a && std::find(nbr_[t[a]].begin(), nbr_[t[a]].end(), t[b]) == nbr_[t[a]].end()) nbr_[t[a]].push_back(t[b]);
+  }
+
+  bool in_plane(int v, int w) const {
+    for (int d : {0, 2})
+      if (((forced_[v] >> d) & 1) && X_[w][d] != X_[v][d]) return false;
+    return true;
+  }
+
+  bool off_surface(const Eigen::Vector3d& p) const {
+    SurfacePoint sp;
+    return !dist_.nearest(p, sp) || std::abs(sp.distance) > zero_tol_;
+  }
 
   // Step 4: warping. Vertices on a forced plane (x = 0 of a half model, the slab's faces) move
   // only along edges within it. Besides L&S's cut points, an edge towards a vertex on the surface
   // offers the point where it first reaches the surface (its "entry"), when that comes before the
   // end: the edge then runs on along the surface (a vertex just inside a roof, above a chamber's
   // side wall, reaches the roof's crease this way; no cut point lies there, phi does not change sign).
-  auto on_forced = [&](int v, int d) {
-    if (d == 0) return opt.half && X[v].x() == 0.0;
-    if (d == 2) return opt.has_slab && (X[v].z() == opt.slab_z0 || X[v].z() == opt.slab_z1);
-    return false;
-  };
-  std::vector<char> forced(nv, 0);
-  for (int v = 0; v < nv; ++v) forced[v] = static_cast<char>((on_forced(v, 0) ? 1 : 0) | (on_forced(v, 2) ? 4 : 0));
-  std::vector<std::vector<int>> nbr(nv);
-  for (const auto& t : bg)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        if (b != a && std::find(nbr[t[a]].begin(), nbr[t[a]].end(), t[b]) == nbr[t[a]].end()) nbr[t[a]].push_back(t[b]);
-  auto in_plane = [&](int v, int w) {
-    for (int d : {0, 2})
-      if (((forced[v] >> d) & 1) && X[w][d] != X[v][d]) return false;
-    return true;
-  };
-  auto off_surface = [&](const Eigen::Vector3d& p) {
-    SurfacePoint sp;
-    return !dist.nearest(p, sp) || std::abs(sp.distance) > zero_tol;
-  };
-  for (int v = 0; v < nv; ++v) {
-    if (phi[v] == 0.0) continue;
-    double best_t = 2.0, best_len = 0.0;
-    int best_w = -1;
-    Eigen::Vector3d best_p = X[v];
-    for (int w : nbr[v]) {
-      if (!in_plane(v, w)) continue;
-      const double len = (X[w] - X[v]).norm();
-      double t = 2.0;
-      Eigen::Vector3d p = X[v];
-      if (phi[v] * phi[w] < 0.0) {  // a cut point of step 3
-        const int c = cut_of.at(edge_key(v, w));
-        t = cut_edge[c][0] == v ? cut_t[c] : 1.0 - cut_t[c];
-        p = cut_pos[c];
-      } else if (phi[w] == 0.0 && !off_surface(X[v] + opt.alpha * (X[w] - X[v]))) {
-        double lo = 0.0, hi = opt.alpha;  // off the surface at lo, on it at hi
-        for (int it = 0; it < 50; ++it) {
-          const double mid = 0.5 * (lo + hi);
-          (off_surface(X[v] + mid * (X[w] - X[v])) ? lo : hi) = mid;
+  void warp() {
+    for (int v = 0; v < nv_; ++v) {
+      if (phi_[v] == 0.0) continue;
+      double best_d = std::numeric_limits<double>::infinity();
+      Eigen::Vector3d best_p = X_[v];
+      for (int w : nbr_[v]) {
+        if (!in_plane(v, w)) continue;
+        double t = 2.0;
+        Eigen::Vector3d p = X_[v];
+        if (phi_[v] * phi_[w] < 0.0) {  // a cut point of step 3
+          const int c = cut_of_.at(edge_key(v, w));
+          t = cut_edge_[c][0] == v ? cut_t_[c] : 1.0 - cut_t_[c];
+          p = cut_pos_[c];
+        } else if (phi_[w] == 0.0 && !off_surface(X_[v] + opt_.alpha * (X_[w] - X_[v]))) {
+          double lo = 0.0, hi = opt_.alpha;  // off the surface at lo, on it at hi
+          for (int it = 0; it < 50; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (off_surface(X_[v] + mid * (X_[w] - X_[v])) ? lo : hi) = mid;
+          }
+          t = hi;
+          p = X_[v] + hi * (X_[w] - X_[v]);
         }
-        t = hi;
-        p = X[v] + hi * (X[w] - X[v]);
+        const double d = t * (X_[w] - X_[v]).norm();
+        if (t < opt_.alpha && d < best_d) best_d = d, best_p = p;
       }
-      if (t < opt.alpha && t * len < best_t * best_len + (best_w < 0 ? 1e300 : 0.0))
-        best_t = t, best_len = len, best_w = w, best_p = p;
+      if (!(best_d < std::numeric_limits<double>::infinity())) continue;
+      X_[v] = best_p;
+      phi_[v] = 0.0;
+      ++out_.warped;
     }
-    if (best_w < 0) continue;
-    X[v] = best_p;
-    phi[v] = 0.0;
-    ++out.warped;
   }
 
-  // Step 4b: creases. A vertex on the surface whose edge runs on along the surface and leaves it
-  // within alpha of the edge (a vertex on a chamber's side wall just above its floor) moves to
-  // where the edge leaves it: onto the crease, which the warping of step 4 cannot reach (phi
-  // does not change sign along that edge). Without it the one-cell band along every concave edge
-  // of a CAD part would be a slanted fillet of solid (test_stl_scene.cpp measures the effect).
-  out.creased = snap_to_creases(X, phi, nbr, forced, dist, opt.alpha, zero_tol);
+  int cut_node(int a, int b) const { return nv_ + cut_of_.at(edge_key(a, b)); }
 
-  // Step 5: stencils. Node ids: grid vertex v, or nv + cut index.
-  auto cut_node = [&](int a, int b) { return nv + cut_of.at(edge_key(a, b)); };
-  std::vector<std::array<int, 4>> tets;
-  for (const auto& t : bg) {
-    std::array<int, 4> neg{}, zer{}, pos{};
-    int nn = 0, nz = 0, np = 0;
-    for (int v : t) {
-      if (phi[v] < 0.0)
-        neg[nn++] = v;
-      else if (phi[v] > 0.0)
-        pos[np++] = v;
+  // Step 5: stencils, the part of each background tetrahedron with phi <= 0.
+  std::vector<std::array<int, 4>> stencils() const {
+    std::vector<std::array<int, 4>> tets;
+    for (const auto& t : bg_) {
+      std::array<int, 4> neg{}, zer{}, pos{};
+      int nn = 0, nz = 0, np = 0;
+      for (int v : t) {
+        if (phi_[v] < 0.0)
+          neg[nn++] = v;
+        else if (phi_[v] > 0.0)
+          pos[np++] = v;
+        else
+          zer[nz++] = v;
+      }
+      if (nn == 0) {
+        if (nz == 4) {
+          const Eigen::Vector3d c = 0.25 * (X_[t[0]] + X_[t[1]] + X_[t[2]] + X_[t[3]]);
+          SurfacePoint sp;
+          if (dist_.nearest(c, sp) && sp.distance < 0.0) tets.push_back(t);
+        }
+        continue;
+      }
+      if (np == 0) {
+        tets.push_back(t);
+      } else if (nn == 1) {
+        std::array<int, 4> e{neg[0], 0, 0, 0};
+        int m = 1;
+        for (int z = 0; z < nz; ++z) e[m++] = zer[z];
+        for (int p = 0; p < np; ++p) e[m++] = cut_node(neg[0], pos[p]);
+        tets.push_back(e);
+      } else if (nn == 2 && np == 2) {
+        split_prism({neg[0], cut_node(neg[0], pos[0]), cut_node(neg[0], pos[1])},
+                    {neg[1], cut_node(neg[1], pos[0]), cut_node(neg[1], pos[1])}, tets);
+      } else if (nn == 2) {  // one zero, one positive
+        split_pyramid(zer[0], {neg[0], neg[1], cut_node(neg[1], pos[0]), cut_node(neg[0], pos[0])}, tets);
+      } else {  // three negative, one positive
+        split_prism({neg[0], neg[1], neg[2]},
+                    {cut_node(neg[0], pos[0]), cut_node(neg[1], pos[0]), cut_node(neg[2], pos[0])}, tets);
+      }
+    }
+    return tets;
+  }
+
+  const Eigen::Vector3d& pos_of(int v) const { return v < nv_ ? X_[v] : cut_pos_[v - nv_]; }
+
+  // Every tetrahedron oriented positively, the flat ones dropped (counted, reported), the nodes
+  // compacted by first use.
+  void compact(const std::vector<std::array<int, 4>>& tets) {
+    const double vol_tol = 1e-12 * opt_.h * opt_.h * axis_h(opt_, 2);
+    std::vector<std::array<int, 4>> kept;
+    kept.reserve(tets.size());
+    for (auto t : tets) {
+      const double v6 = (pos_of(t[1]) - pos_of(t[0])).cross(pos_of(t[2]) - pos_of(t[0])).dot(pos_of(t[3]) - pos_of(t[0]));
+      if (v6 < 0.0) std::swap(t[1], t[2]);
+      if (std::abs(v6) > vol_tol)
+        kept.push_back(t);
       else
-        zer[nz++] = v;
+        ++out_.flat_dropped;
     }
-    if (nn == 0) {
-      if (nz == 4) {
-        const Eigen::Vector3d c = 0.25 * (X[t[0]] + X[t[1]] + X[t[2]] + X[t[3]]);
-        SurfacePoint sp;
-        if (dist.nearest(c, sp) && sp.distance < 0.0) tets.push_back(t);
+    std::vector<int> new_id(nv_ + cut_pos_.size(), -1);
+    for (auto& t : kept)
+      for (int& v : t) {
+        if (new_id[v] < 0) {
+          new_id[v] = static_cast<int>(out_.X.size());
+          out_.X.push_back(pos_of(v));
+          out_.on_surface.push_back(v >= nv_ || phi_[v] == 0.0 ? 1 : 0);
+          out_.on_symmetry.push_back(opt_.half && out_.X.back().x() == 0.0 ? 1 : 0);
+        }
+        v = new_id[v];
       }
-      continue;
-    }
-    if (np == 0) {
-      tets.push_back(t);
-    } else if (nn == 1) {
-      std::array<int, 4> e{neg[0], 0, 0, 0};
-      int m = 1;
-      for (int z = 0; z < nz; ++z) e[m++] = zer[z];
-      for (int p = 0; p < np; ++p) e[m++] = cut_node(neg[0], pos[p]);
-      tets.push_back(e);
-    } else if (nn == 2 && np == 2) {
-      split_prism({neg[0], cut_node(neg[0], pos[0]), cut_node(neg[0], pos[1])},
-                  {neg[1], cut_node(neg[1], pos[0]), cut_node(neg[1], pos[1])}, tets);
-    } else if (nn == 2) {  // one zero, one positive
-      split_pyramid(zer[0], {neg[0], neg[1], cut_node(neg[1], pos[0]), cut_node(neg[0], pos[0])}, tets);
-    } else {  // three negative, one positive
-      split_prism({neg[0], neg[1], neg[2]},
-                  {cut_node(neg[0], pos[0]), cut_node(neg[1], pos[0]), cut_node(neg[2], pos[0])}, tets);
-    }
+    out_.tets = std::move(kept);
+    if (out_.tets.empty())
+      throw InputError(s_.path + ": no tetrahedron lies inside the surface at mesh.h_mm = " + short_num(opt_.h * 1e3) +
+                       "; the solid is thinner than the element size everywhere: use a smaller mesh.h_mm");
   }
 
-  // Orient every tetrahedron positively; drop the flat ones (counted, reported), then compact the
-  // nodes by first use.
-  auto pos_of = [&](int v) -> const Eigen::Vector3d& { return v < nv ? X[v] : cut_pos[v - nv]; };
-  const double vol_tol = 1e-12 * opt.h * opt.h * axis_h(opt, 2);
-  std::vector<std::array<int, 4>> kept;
-  kept.reserve(tets.size());
-  for (auto t : tets) {
-    const double v6 = (pos_of(t[1]) - pos_of(t[0])).cross(pos_of(t[2]) - pos_of(t[0])).dot(pos_of(t[3]) - pos_of(t[0]));
-    if (v6 < 0.0) std::swap(t[1], t[2]);
-    if (std::abs(v6) > vol_tol)
-      kept.push_back(t);
-    else
-      ++out.flat_dropped;
-  }
-  std::vector<int> new_id(nv + cut_pos.size(), -1);
-  for (auto& t : kept)
-    for (int& v : t) {
-      if (new_id[v] < 0) {
-        new_id[v] = static_cast<int>(out.X.size());
-        out.X.push_back(pos_of(v));
-        out.on_surface.push_back(v >= nv || phi[v] == 0.0 ? 1 : 0);
-        out.on_symmetry.push_back(opt.half && out.X.back().x() == 0.0 ? 1 : 0);
-      }
-      v = new_id[v];
-    }
-  out.tets = std::move(kept);
-  if (out.tets.empty())
-    throw InputError(surface.path + ": no tetrahedron lies inside the surface at mesh.h_mm = " + short_num(opt.h * 1e3) +
-                     "; the solid is thinner than the element size everywhere: use a smaller mesh.h_mm");
-  out.on_sharp_edges = snap_to_sharp_edges(out, surface, dist, 0.9 * h_min);
-  return out;
+  const TriSurface& s_;
+  const SurfaceDistance& dist_;
+  const StuffingOptions& opt_;
+  StuffedTets out_;
+  int n_[3] = {0, 0, 0};
+  int nv_ = 0;
+  double h_min_ = 0.0, zero_tol_ = 0.0;
+  std::vector<Eigen::Vector3d> X_;
+  std::vector<double> phi_;
+  std::vector<std::array<int, 4>> bg_;
+  std::unordered_map<std::uint64_t, int, EdgeHash> cut_of_;  // edge -> index into cut_pos_
+  std::vector<Eigen::Vector3d> cut_pos_;
+  std::vector<std::array<int, 2>> cut_edge_;
+  std::vector<double> cut_t_;  // along the edge from its lower vertex id
+  std::vector<char> forced_;
+  std::vector<std::vector<int>> nbr_;
+};
+
+}  // namespace
+
+StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt) {
+  return Stuffing(surface, dist, opt).run();
 }
 
 }  // namespace pneufem
