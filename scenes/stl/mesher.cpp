@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -217,16 +218,11 @@ std::pair<double, double> dihedral_range_deg(const Mesh& m, int e) {
   return {lo, hi};
 }
 
-Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, StlMeshReport* report) {
-  const auto t0 = std::chrono::steady_clock::now();
-  StlMeshReport rep;
-  rep.notes = surface.notes;
-  const StuffingOptions& opt = spec.stuffing;
-  if (!(opt.h > 0.0 && std::isfinite(opt.h))) throw InputError("mesh.h_mm must be a positive element size");
-  const std::vector<char> cavity = cavity_shells(surface, spec);
-  const auto [fixed_plane, tip_plane] = end_planes(surface, spec);
+namespace {
 
-  // The band must hold every background edge that can cross the surface: the longest cell diagonal.
+/// The OpenVDB band must hold every background edge that can cross the surface: the longest cell
+/// diagonal of the grid, plus a margin of voxels. Voxels of h/3.
+std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const StuffingOptions& opt, StlMeshReport& rep) {
   const auto lines = stuffing_grid(surface, opt);
   double diag2 = 0.0;
   for (int d = 0; d < 3; ++d) {
@@ -236,16 +232,14 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     rep.grid_lines[d] = static_cast<int>(lines[d].size());
   }
   rep.voxel_m = std::min(opt.h, opt.h_z > 0.0 ? opt.h_z : opt.h) / 3.0;
-  const SurfaceDistance dist(surface, rep.voxel_m, std::sqrt(diag2) + 3.0 * rep.voxel_m);
-  rep.band_voxels = dist.voxels();
+  auto dist = std::make_unique<SurfaceDistance>(surface, rep.voxel_m, std::sqrt(diag2) + 3.0 * rep.voxel_m);
+  rep.band_voxels = dist->voxels();
+  return dist;
+}
 
-  const StuffedTets st = stuff_surface(surface, dist, opt);
-  rep.warped = st.warped;
-  rep.creased = st.creased;
-  rep.on_sharp_edges = st.on_sharp_edges;
-  rep.cut_points = st.cut_points;
-  rep.flat_dropped = st.flat_dropped;
-
+/// The Tet4 mesh of the stuffed tetrahedra with regions "body" and "fabric" (centroid in the slab)
+/// and element sets SILICONE and FABRIC; its dihedral angles into the report.
+Mesh tagged_tet4(const StuffedTets& st, const StuffingOptions& opt, StlMeshReport& rep) {
   Mesh m;
   m.type = ElementType::Tet4;
   m.X = st.X;
@@ -255,7 +249,6 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     const double zc = 0.25 * (st.X[t[0]].z() + st.X[t[1]].z() + st.X[t[2]].z() + st.X[t[3]].z());
     m.region.push_back(opt.has_slab && zc > opt.slab_z0 && zc < opt.slab_z1 ? r_fabric : r_body);
   }
-  check_volume(surface, m, opt, rep);
   m.element_sets["FABRIC"];
   for (int e = 0; e < m.num_elements(); ++e) m.element_sets[m.region[e] == r_fabric ? "FABRIC" : "SILICONE"].push_back(e);
   rep.dihedral_histogram.assign(18, 0);
@@ -266,9 +259,13 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     rep.max_dihedral_deg = std::max(rep.max_dihedral_deg, hi);
     ++rep.dihedral_histogram[std::min(17, static_cast<int>(lo / 10.0))];
   }
+  return m;
+}
 
-  // Sets: cavity faces, ends, symmetry plane.
-  const std::vector<FaceRef> boundary = boundary_faces(m);
+/// Surface CAVITY: boundary faces on the surface (not on the symmetry plane) whose closest
+/// triangle belongs to a cavity shell.
+void cavity_faces(Mesh& m, const StuffedTets& st, const TriSurface& surface, const std::vector<char>& cavity,
+                  const SurfaceDistance& dist, const std::vector<FaceRef>& boundary, double h) {
   auto& cav = m.surfaces["CAVITY"];
   for (const FaceRef& fr : boundary) {
     const int* fn = face_local_nodes(m.type, fr.local_face);
@@ -285,15 +282,16 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   }
   if (cav.empty())
     throw InputError(surface.path + ": cavity not found in the mesh: no element face lies on the chamber surface at "
-                     "mesh.h_mm = " + short_num(opt.h * 1e3) +
+                     "mesh.h_mm = " + short_num(h * 1e3) +
                      " (the chambers are smaller than the elements); use a smaller mesh.h_mm");
-  double size = 0.0;
-  {
-    Eigen::Vector3d lo = m.X.front(), hi = m.X.front();
-    for (const auto& p : m.X) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    size = (hi - lo).norm();
-  }
-  const double tol = 1e-9 * size;
+}
+
+/// Node sets FIXED and TIP (the boundary faces on the two end planes) and SYMMETRY.
+void end_and_symmetry_sets(Mesh& m, const StuffedTets& st, const StlMeshSpec& spec, const FacePlane& fixed_plane,
+                           const FacePlane& tip_plane, const std::vector<FaceRef>& boundary) {
+  Eigen::Vector3d lo = m.X.front(), hi = m.X.front();
+  for (const auto& p : m.X) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const double tol = 1e-9 * (hi - lo).norm();
   m.node_sets["FIXED"] = nodes_on_plane(m, boundary, fixed_plane, tol);
   if (m.node_sets["FIXED"].empty())
     throw InputError("mesh.fixed_face = \"" + spec.fixed_face + "\": fixed face not found: no face of the mesh lies on " +
@@ -305,16 +303,40 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     throw InputError("mesh.fixed_face = \"" + spec.fixed_face + "\": the tip (the end opposite the fixed face) is not a "
                      "flat face: no face of the mesh lies on " + plane_text(tip_plane, spec) +
                      "; the bending angle is measured on a flat free end: flatten it in CAD");
-  if (opt.half) {
+  if (spec.stuffing.half) {
     auto& sym = m.node_sets["SYMMETRY"];
     for (int n = 0; n < m.num_nodes(); ++n)
       if (st.on_symmetry[n]) sym.push_back(n);
   }
+}
 
+}  // namespace
+
+Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, StlMeshReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  StlMeshReport rep;
+  rep.notes = surface.notes;
+  const StuffingOptions& opt = spec.stuffing;
+  if (!(opt.h > 0.0 && std::isfinite(opt.h))) throw InputError("mesh.h_mm must be a positive element size");
+  const std::vector<char> cavity = cavity_shells(surface, spec);
+  const auto [fixed_plane, tip_plane] = end_planes(surface, spec);
+  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, opt, rep);
+
+  const StuffedTets st = stuff_surface(surface, *dist, opt);
+  rep.warped = st.warped;
+  rep.creased = st.creased;
+  rep.on_sharp_edges = st.on_sharp_edges;
+  rep.cut_points = st.cut_points;
+  rep.flat_dropped = st.flat_dropped;
+
+  Mesh m = tagged_tet4(st, opt, rep);
+  check_volume(surface, m, opt, rep);
+  const std::vector<FaceRef> boundary = boundary_faces(m);
+  cavity_faces(m, st, surface, cavity, *dist, boundary, opt.h);
+  end_and_symmetry_sets(m, st, spec, fixed_plane, tip_plane, boundary);
   if (spec.element == ElementType::Tet10) {
     m = promote_to_tet10(m);
-    std::vector<char> sym_all(st.on_symmetry);
-    curve_boundary(m, st.on_surface, sym_all, dist, rep);
+    curve_boundary(m, st.on_surface, st.on_symmetry, *dist, rep);
   }
   renumber_by_first_use(m);
   m.ensure_ids();
