@@ -9,6 +9,7 @@
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <Eigen/Geometry>
 
@@ -375,6 +376,80 @@ TriSurface read_surface(const std::string& path, double unit_m) {
   return s;
 }
 
+namespace {
+
+/// Does segment p -> q cross triangle (a, b, c) (Moeller-Trumbore, 0 < t < 1)?
+bool segment_hits(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                  const Eigen::Vector3d& c) {
+  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a, h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return false;  // parallel: coplanar overlaps are not detected
+  const Eigen::Vector3d t = p - a;
+  const double u = t.dot(h) / det;
+  if (u < 0.0 || u > 1.0) return false;
+  const Eigen::Vector3d w = t.cross(e1);
+  const double v = d.dot(w) / det;
+  if (v < 0.0 || u + v > 1.0) return false;
+  const double at = e2.dot(w) / det;
+  return at > 0.0 && at < 1.0;
+}
+
+bool triangles_cross(const TriSurface& s, int f, int g) {
+  for (int k = 0; k < 3; ++k) {
+    if (segment_hits(s.V[s.F[f][k]], s.V[s.F[f][(k + 1) % 3]], s.V[s.F[g][0]], s.V[s.F[g][1]], s.V[s.F[g][2]])) return true;
+    if (segment_hits(s.V[s.F[g][k]], s.V[s.F[g][(k + 1) % 3]], s.V[s.F[f][0]], s.V[s.F[f][1]], s.V[s.F[f][2]])) return true;
+  }
+  return false;
+}
+
+/// Pairs of triangles without a common corner whose edges cross each other's interior: a surface
+/// through itself (two bodies exported unmerged, a chamber poking through a wall). Candidates from
+/// a uniform hash of the triangles' bounding boxes (cells of twice the mean edge length).
+void check_self_intersections(const TriSurface& s) {
+  const int nf = static_cast<int>(s.F.size());
+  double mean = 0.0;
+  for (const auto& t : s.F) mean += (s.V[t[1]] - s.V[t[0]]).norm();
+  const double cell = 2.0 * mean / nf;
+  std::unordered_map<std::uint64_t, std::vector<int>> grid;
+  auto key = [](long i, long j, long k) {
+    return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
+           static_cast<std::uint64_t>(k & 0x1fffff);
+  };
+  for (int f = 0; f < nf; ++f) {
+    Eigen::Vector3d lo = s.V[s.F[f][0]], hi = lo;
+    for (int v : s.F[f]) lo = lo.cwiseMin(s.V[v]), hi = hi.cwiseMax(s.V[v]);
+    const Eigen::Vector3d a = (lo / cell).array().floor(), b = (hi / cell).array().floor();
+    if ((b - a).prod() > 1e6) continue;  // a sliver spanning the part: left unchecked
+    for (long i = static_cast<long>(a.x()); i <= static_cast<long>(b.x()); ++i)
+      for (long j = static_cast<long>(a.y()); j <= static_cast<long>(b.y()); ++j)
+        for (long k = static_cast<long>(a.z()); k <= static_cast<long>(b.z()); ++k) grid[key(i, j, k)].push_back(f);
+  }
+  std::unordered_set<std::uint64_t> tested;
+  long crossings = 0;
+  int first_f = -1;
+  for (const auto& [c, fs] : grid)
+    for (std::size_t x = 0; x < fs.size(); ++x)
+      for (std::size_t y = x + 1; y < fs.size(); ++y) {
+        const int f = std::min(fs[x], fs[y]), g = std::max(fs[x], fs[y]);
+        bool shared = false;
+        for (int u : s.F[f])
+          for (int w : s.F[g]) shared = shared || u == w;
+        if (shared || !tested.insert((static_cast<std::uint64_t>(f) << 32) | static_cast<std::uint32_t>(g)).second) continue;
+        if (triangles_cross(s, f, g)) {
+          ++crossings;
+          if (first_f < 0 || f < first_f) first_f = f;
+        }
+      }
+  if (crossings == 0) return;
+  const auto& t = s.F[first_f];
+  throw InputError(s.path + ": the surface intersects itself: " + std::to_string(crossings) +
+                   " pair(s) of triangles cross, the first near " + where_text(s, (s.V[t[0]] + s.V[t[1]] + s.V[t[2]]) / 3.0) +
+                   "; inside and outside are then not defined: merge the bodies in CAD (a Boolean union) before "
+                   "exporting, or find the faces in MeshLab (Filters > Select > Select Self Intersecting Faces)");
+}
+
+}  // namespace
+
 bool shell_encloses(const TriSurface& s, int shell, const Eigen::Vector3d& p) {
   int hits = 0;
   for (int f = 0; f < static_cast<int>(s.F.size()); ++f)
@@ -389,6 +464,7 @@ void close_and_orient(TriSurface& s) {
                 s.notes.end());
   const EdgeMap edges = edge_map(s);
   check_manifold(s, edges);
+  check_self_intersections(s);
   const long flipped = orient_shells(s, edges);
   if (flipped > 0) {
     // Which half is "wrong" is decided per shell below; report the minority flipped here.

@@ -13,7 +13,8 @@
 // volume (divergence theorem, sum of signed tetrahedra to the origin) must be negative; an outer
 // shell's positive. Each flip is reported as a note; nothing is silently changed.
 //
-// Self-intersections are not detected (see docs/scenes.md, "Meshing your own actuator").
+// Self-intersections: pairs of triangles (without a common corner) whose edges cross each other's
+// interior are an error with their count and a location; coplanar overlaps are not detected.
 #include <array>
 #include <string>
 #include <vector>
@@ -42,8 +43,9 @@ struct TriSurface {
 /// close_and_orient().
 TriSurface read_surface(const std::string& path, double unit_m);
 
-/// The watertight and manifold check, then the orientation (see above). Throws InputError with the
-/// count and a location of open edges and of non-manifold edges, and what to do.
+/// The watertight, manifold and self-intersection checks, then the orientation (see above). Throws
+/// InputError with the count and a location of open edges, non-manifold edges or crossing
+/// triangles, and what to do.
 void close_and_orient(TriSurface& s);
 
 /// read_surface + close_and_orient.

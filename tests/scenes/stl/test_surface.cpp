@@ -97,6 +97,22 @@ TEST(StlReader, NonManifoldEdgesAreRefused) {
   EXPECT_NE(e.find("shared by 3 triangles"), std::string::npos) << e;
 }
 
+TEST(StlReader, SelfIntersectingSurfacesAreRefused) {
+  // Two closed boxes exported as one body, overlapping: each is watertight, the union is not a
+  // surface of one solid.
+  TriSurface a = box(0.004, 0.004, 0.004);
+  TriSurface b = box(0.004, 0.004, 0.004);
+  for (auto& v : b.V) v += Eigen::Vector3d(0.002, 0.001, 0.0015);
+  append_surface(a, b);
+  const std::string e = error_of([&] { close_and_orient(a); });
+  EXPECT_NE(e.find("the surface intersects itself"), std::string::npos) << e;
+  EXPECT_NE(e.find("pair(s) of triangles cross, the first near ("), std::string::npos) << e;
+  EXPECT_NE(e.find("Boolean union"), std::string::npos) << e;
+  // Nested without touching (a void in a solid) is no intersection.
+  TriSurface t = test::tube_surface(0.006, 0.0035, 0.04, 0.003, 24);
+  EXPECT_EQ(error_of([&] { close_and_orient(t); }), "(no error)");
+}
+
 TEST(StlReader, InvertedNormalsAreFixedWithANote) {
   // The box written inside out, and one triangle of it turned back: both repaired.
   TriSurface b = box(0.002, 0.002, 0.002);
