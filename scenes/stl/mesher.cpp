@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <cmath>
 #include <cstdio>
@@ -237,17 +238,43 @@ std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const S
   return dist;
 }
 
-/// The Tet4 mesh of the stuffed tetrahedra with regions "body" and "fabric" (centroid in the slab)
-/// and element sets SILICONE and FABRIC; its dihedral angles into the report.
-Mesh tagged_tet4(const StuffedTets& st, const StuffingOptions& opt, StlMeshReport& rep) {
+/// The Tet4 mesh of the stuffed tetrahedra with region tags, element sets SILICONE and FABRIC,
+/// and its dihedral angles in the report. Tags, by the element's centroid against the bounding
+/// box of the cavity (the built-in pneu-net's rules, scenes/pneunet.cpp, when the actuator lies
+/// as it does: along y, fixed face "y-" or "y+"): fabric (in the slab), base (below the cavity),
+/// end_cap (beyond it along y), roof (above it), side_wall (beside it in x), interior_wall (the
+/// walls between chambers); another frame tags all but the fabric "body".
+Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::vector<char>& cavity, const StlMeshSpec& spec,
+                 StlMeshReport& rep) {
+  const StuffingOptions& opt = spec.stuffing;
   Mesh m;
   m.type = ElementType::Tet4;
   m.X = st.X;
-  const std::uint16_t r_body = m.region_id("body"), r_fabric = m.region_id(regions::kFabric);
+  Eigen::Vector3d clo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), chi = -clo;
+  for (int f = 0; f < static_cast<int>(surface.F.size()); ++f)
+    if (cavity[surface.face_shell[f]])
+      for (int v : surface.F[f]) clo = clo.cwiseMin(surface.V[v]), chi = chi.cwiseMax(surface.V[v]);
+  const bool along_y = spec.fixed_face == "y-" || spec.fixed_face == "y+";
+  const std::uint16_t r_base = m.region_id(regions::kBase), r_fabric = m.region_id(regions::kFabric);
+  std::uint16_t r_cap = 0, r_side = 0, r_roof = 0, r_wall = 0, r_body = 0;
+  if (along_y) {
+    r_cap = m.region_id(regions::kEndCap), r_side = m.region_id(regions::kSideWall);
+    r_roof = m.region_id(regions::kRoof), r_wall = m.region_id(regions::kInteriorWall);
+  } else {
+    r_body = m.region_id("body");
+  }
+  auto region_of = [&](const Eigen::Vector3d& c) {
+    if (opt.has_slab && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
+    if (!along_y) return r_body;
+    if (c.z() < clo.z()) return r_base;
+    if (c.y() < clo.y() || c.y() > chi.y()) return r_cap;
+    if (c.z() > chi.z()) return r_roof;
+    if (c.x() < clo.x() || c.x() > chi.x()) return r_side;
+    return r_wall;
+  };
   for (const auto& t : st.tets) {
     m.conn.insert(m.conn.end(), t.begin(), t.end());
-    const double zc = 0.25 * (st.X[t[0]].z() + st.X[t[1]].z() + st.X[t[2]].z() + st.X[t[3]].z());
-    m.region.push_back(opt.has_slab && zc > opt.slab_z0 && zc < opt.slab_z1 ? r_fabric : r_body);
+    m.region.push_back(region_of(0.25 * (st.X[t[0]] + st.X[t[1]] + st.X[t[2]] + st.X[t[3]])));
   }
   m.element_sets["FABRIC"];
   for (int e = 0; e < m.num_elements(); ++e) m.element_sets[m.region[e] == r_fabric ? "FABRIC" : "SILICONE"].push_back(e);
@@ -329,7 +356,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   rep.cut_points = st.cut_points;
   rep.flat_dropped = st.flat_dropped;
 
-  Mesh m = tagged_tet4(st, opt, rep);
+  Mesh m = tagged_tet4(st, surface, cavity, spec, rep);
   check_volume(surface, m, opt, rep);
   const std::vector<FaceRef> boundary = boundary_faces(m);
   cavity_faces(m, st, surface, cavity, *dist, boundary, opt.h);

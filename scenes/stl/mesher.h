@@ -1,7 +1,9 @@
 #pragma once
 // A closed surface (scenes/stl/surface.h) to the engine's mesh, with the structure the built-in
-// pneu-net mesher gives (scenes/pneunet.h): element sets SILICONE and FABRIC (region tags "body"
-// and "fabric"), node sets FIXED, TIP and, for a half model, SYMMETRY, and the surface CAVITY.
+// pneu-net mesher gives (scenes/pneunet.h): element sets SILICONE and FABRIC, node sets FIXED, TIP
+// and, for a half model, SYMMETRY, the surface CAVITY, and region tags (fabric, base, end_cap,
+// roof, side_wall, interior_wall, by the built-in mesher's rules against the cavity's bounding box,
+// when the actuator lies along y; else fabric and body).
 //
 //  * Tetrahedra: isosurface stuffing of the solid (scenes/stl/stuffing.h), promoted to Tet10 with
 //    the mid-nodes of boundary edges moved onto the surface (closest point); a mid-node whose move

@@ -66,6 +66,8 @@ TEST(StlMesher, PneuNetSurfaceGivesTheBuiltInSolid) {
     for (int n = 0; n < m.num_nodes(); ++n) max_dx = std::max(max_dx, (m.X[n] - built_in.X[n]).norm());
     EXPECT_EQ(max_dx, 0.0) << h;  // grid lines computed by the same formula from the same planes
     EXPECT_EQ(m.conn, built_in.conn) << h;
+    EXPECT_EQ(m.region_names, built_in.region_names) << h;  // the same tags by the same rules
+    EXPECT_EQ(m.region, built_in.region) << h;
     // Volumes exact up to round-off of the sum (1e-12 relative).
     EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 1e-12 * mesh_volume(built_in));
     EXPECT_NEAR(set_volume(m, "FABRIC"), set_volume(built_in, "FABRIC"), 1e-12 * mesh_volume(built_in));
