@@ -78,7 +78,7 @@ Mesh stl_scene_mesh(const Scene& s, std::vector<std::string>* warnings, StlMeshR
                                      "shells are the cavity)");
     const TriSurface cavity = surface_of(s, "mesh.cavity_file", unit);
     spec.cavity_first_shell = surface.shells();
-    append_surface(surface, cavity);
+    append_surface(surface, cavity, true);  // its shells bound voids of the solid
     try {
       close_and_orient(surface);
     } catch (const InputError& e) {

@@ -308,7 +308,7 @@ bool ray_hits(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::V
 }
 
 /// Nesting depth of each shell (by ray parity from a point of it against every other shell), then
-/// each shell turned so that its normals leave the solid. Returns the notes of turned shells.
+/// each shell turned so that its normals leave the solid, with a note for each one turned.
 void orient_outward(TriSurface& s) {
   const int ns = s.shells();
   std::vector<double> volume(ns, 0.0);
@@ -458,10 +458,6 @@ bool shell_encloses(const TriSurface& s, int shell, const Eigen::Vector3d& p) {
 }
 
 void close_and_orient(TriSurface& s) {
-  s.notes.erase(std::remove_if(s.notes.begin(), s.notes.end(),
-                               [](const std::string& n) { return n.find("pointed into the solid") != std::string::npos ||
-                                                                 n.find("disagreed with their neighbours") != std::string::npos; }),
-                s.notes.end());
   const EdgeMap edges = edge_map(s);
   check_manifold(s, edges);
   check_self_intersections(s);
@@ -480,10 +476,13 @@ TriSurface read_closed_surface(const std::string& path, double unit_m) {
   return s;
 }
 
-void append_surface(TriSurface& a, const TriSurface& b) {
+void append_surface(TriSurface& a, const TriSurface& b, bool as_voids) {
   const int off = static_cast<int>(a.V.size());
   a.V.insert(a.V.end(), b.V.begin(), b.V.end());
-  for (auto t : b.F) a.F.push_back({t[0] + off, t[1] + off, t[2] + off});
+  for (auto t : b.F) {
+    if (as_voids) std::swap(t[1], t[2]);
+    a.F.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
   a.notes.insert(a.notes.end(), b.notes.begin(), b.notes.end());
 }
 

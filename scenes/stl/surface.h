@@ -57,7 +57,9 @@ bool shell_encloses(const TriSurface& s, int shell, const Eigen::Vector3d& p);
 /// Writes `s` as a binary STL, coordinates divided by `unit_m` (1e-3: the file in mm).
 void write_stl(const std::string& path, const TriSurface& s, double unit_m);
 
-/// Appends the shells of `b` to `a` (a cavity given as its own file): vertices are not shared.
-void append_surface(TriSurface& a, const TriSurface& b);
+/// Appends the shells of `b` to `a` (a cavity given as its own file): vertices are not shared; with
+/// `as_voids` every triangle of `b` is turned (a closed surface oriented as a solid becomes a void's
+/// boundary). Call close_and_orient(a) again afterwards.
+void append_surface(TriSurface& a, const TriSurface& b, bool as_voids = false);
 
 }  // namespace pneufem

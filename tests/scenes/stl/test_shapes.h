@@ -9,6 +9,7 @@
 #include <map>
 #include <numbers>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "scenes/pneunet.h"
@@ -82,6 +83,37 @@ inline TriSurface pneunet_surface(const PneuNetParams& p) {
   TriSurface s = grid_solid_surface(lines, solid);
   s.path = "pneunet.stl";
   return s;
+}
+
+/// The built-in pneu-net's chambers and channel alone, as a closed surface of their own (normals
+/// out of the chambers), and the actuator's outer block without them: the two files of a scene with
+/// mesh.cavity_file.
+inline std::pair<TriSurface, TriSurface> pneunet_block_and_chambers(const PneuNetParams& p) {
+  const TriSurface whole = pneunet_surface(p);
+  Eigen::Vector3d lo = whole.V.front(), hi = lo;
+  for (const auto& v : whole.V) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  std::array<std::vector<double>, 3> box{{{lo.x(), hi.x()}, {lo.y(), hi.y()}, {lo.z(), hi.z()}}};
+  TriSurface block = grid_solid_surface(box, [](const Eigen::Vector3d&) { return true; });
+  block.path = "block.stl";
+  // The void cells of the pneu-net's grid, as a solid of their own.
+  const double hw = 0.5 * p.width, hc = hw - p.side_wall, hch = 0.5 * p.channel_width;
+  const double hb = p.base_thickness, top = hb + p.body_height;
+  std::array<std::vector<double>, 3> lines;
+  lines[0] = {-hw, -hc, -hch, hch, hc, hw};
+  lines[1].push_back(0.0);
+  auto y0 = [&](int i) { return p.end_cap + i * (p.chamber_length + p.interior_wall); };
+  for (int i = 0; i < p.chambers; ++i) lines[1].push_back(y0(i)), lines[1].push_back(y0(i) + p.chamber_length);
+  lines[1].push_back(p.length());
+  lines[2] = {0.0, hb, hb + p.channel_height, top - p.roof, top};
+  TriSurface chambers = grid_solid_surface(lines, [&](const Eigen::Vector3d& x) {
+    for (int i = 0; i < p.chambers; ++i)
+      if (std::abs(x.x()) < hc && x.y() > y0(i) && x.y() < y0(i) + p.chamber_length && x.z() > hb && x.z() < top - p.roof)
+        return true;
+    return std::abs(x.x()) < hch && x.y() > y0(0) && x.y() < y0(p.chambers - 1) + p.chamber_length && x.z() > hb &&
+           x.z() < hb + p.channel_height;
+  });
+  chambers.path = "chambers.stl";
+  return {block, chambers};
 }
 
 /// A closed cylinder along y (radius r, y in [y0, y1]) with `segments` facets around, normals out.

@@ -133,6 +133,33 @@ TEST(StlScene, CurvedTubeActuatorRunsEndToEnd) {
   EXPECT_GT(a[1], a[0]);
 }
 
+TEST(StlScene, ChambersAsASecondFileGiveTheSameMesh) {
+  // mesh.cavity_file: the outer block and the chambers as two closed surfaces (the chambers'
+  // normals pointing out of them, as CAD writes a solid) mesh as the one file with the voids.
+  PneuNetParams p;
+  p.chambers = 3;
+  const std::string one = pneunet_stl(p, "three_chambers.stl");
+  const auto [block, chambers] = test::pneunet_block_and_chambers(p);
+  write_stl(tmp("block.stl").string(), block, 1e-3);
+  write_stl(tmp("chambers.stl").string(), chambers, 1e-3);
+  const Mesh a = build_mesh(Scene::load("", stl_sets(one)));
+  std::vector<std::string> notes;
+  const Mesh b = build_mesh(
+      Scene::load("", stl_sets(tmp("block.stl").string(), {"mesh.cavity_file=\"" + tmp("chambers.stl").string() + "\""})),
+      &notes);
+  EXPECT_EQ(a.num_elements(), b.num_elements());
+  EXPECT_EQ(a.num_nodes(), b.num_nodes());
+  EXPECT_EQ(a.surfaces.at("CAVITY").size(), b.surfaces.at("CAVITY").size());
+  EXPECT_EQ(a.region, b.region);
+  EXPECT_TRUE(notes.empty()) << notes.front();  // nothing was repaired: no note
+  // Both a point and a file: refused; a cavity file outside the block: refused.
+  const std::string both = error_of([&] {
+    build_mesh(Scene::load("", stl_sets(tmp("block.stl").string(), {"mesh.cavity_file=\"" + tmp("chambers.stl").string() + "\"",
+                                                                     "mesh.cavity_inlet_mm=[0.0, 7.0, 8.0]"})));
+  });
+  EXPECT_NE(both.find("not both"), std::string::npos) << both;
+}
+
 TEST(StlScene, BadInputsNameTheirKey) {
   PneuNetParams p;
   p.chambers = 2;
