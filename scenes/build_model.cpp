@@ -25,6 +25,7 @@
 #include "scenes/pneunet.h"
 #include "scenes/pressure_lag.h"
 #include "scenes/scene_keys.h"
+#include "scenes/stl_scene.h"
 
 namespace pneufem {
 
@@ -193,9 +194,9 @@ Mesh built_in_mesh(const Scene& s) {
   return build_pneunet(p);
 }
 
-/// The deck of mesh.file, as read (mesh.source must be "inp" when it is not "pneunet").
+/// The deck of mesh.file, as read (mesh.source must be "inp" when it is not "pneunet" or "stl").
 InpDeck scene_deck(const Scene& s, const std::string& source) {
-  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\" or \"inp\", got \"" + source + "\"");
+  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\", \"inp\" or \"stl\", got \"" + source + "\"");
   const std::string file = s.string("mesh.file");
   if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
   return read_inp(s.resolve_path(file), length_unit(s));
@@ -207,6 +208,7 @@ InpDeck scene_deck(const Scene& s, const std::string& source) {
 /// the deck's *BOUNDARY dofs to the new mid-edge nodes.
 Mesh read_model_mesh(const Scene& s, const std::string& source, InpDeck& deck, std::vector<std::string>& warnings) {
   if (source == "pneunet") return built_in_mesh(s);
+  if (source == "stl") return stl_scene_mesh(s, &warnings);
   deck = scene_deck(s, source);
   warnings = deck.warnings;
   if (deck.solid_instances.size() > 1)
@@ -441,6 +443,7 @@ Scene elastic_reference_scene(const Scene& scene) {
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   const std::string source = s.string("mesh.source");
   if (source == "pneunet") return built_in_mesh(s);
+  if (source == "stl") return stl_scene_mesh(s, warnings);
   InpDeck deck = scene_deck(s, source);
   if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
   Mesh mesh = std::move(deck.mesh);
@@ -528,7 +531,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
   if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
-  resolve_angle_frame(s, model, is_inp, out->warnings);
+  resolve_angle_frame(s, model, is_inp || source == "stl", out->warnings);
   if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
     s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
   set_rig_gravity(s, model);

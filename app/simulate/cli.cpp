@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +16,7 @@
 #include "scenes/calculix_deck.h"
 #include "scenes/scene.h"
 #include "scenes/scene_reference.h"
+#include "scenes/stl_scene.h"
 #include "viz/vtk_output.h"
 
 namespace pneufem {
@@ -77,29 +80,52 @@ int run_simulate_command(SimulateCommand& c, const std::string& command_line) {
 
 std::unique_ptr<MeshCommand> add_mesh_command(CLI::App& app) {
   auto c = std::make_unique<MeshCommand>();
-  CLI::App* mesh = c->cmd =
-      app.add_subcommand("mesh", "Write the scene's mesh as .vtu (ParaView) or a runnable CalculiX deck .inp");
-  mesh->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")->check(CLI::ExistingFile);
+  CLI::App* mesh = c->cmd = app.add_subcommand(
+      "mesh", "Write the scene's mesh as .vtu (ParaView) or a runnable CalculiX deck .inp; or mesh your own actuator's "
+              "closed surface: pneufem mesh model.stl --out mesh.vtu");
+  mesh->add_option("scene", c->scene_path,
+                   "Scene file (TOML), or an actuator's closed surface (.stl, .obj: the default scene with "
+                   "mesh.source = \"stl\" and mesh.file = it); omit for the built-in default pneu-net")
+      ->check(CLI::ExistingFile);
   mesh->add_option("--out", c->out, "Output file: FILE.vtu or FILE.inp")->required();
   mesh->add_option("--set", c->sets, "Override a scene key (repeatable)");
   return c;
 }
 
+namespace {
+
+/// The mesh command's scene: a TOML file, or the default scene meshing a surface file.
+Scene mesh_command_scene(const MeshCommand& c) {
+  std::string ext = fs::path(c.scene_path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  if (ext != ".stl" && ext != ".obj") return Scene::load(c.scene_path, c.sets);
+  std::vector<std::string> sets{"mesh.source=\"stl\"", "mesh.file=\"" + fs::absolute(c.scene_path).string() + "\""};
+  sets.insert(sets.end(), c.sets.begin(), c.sets.end());
+  return Scene::load("", sets);
+}
+
+}  // namespace
+
 int run_mesh_command(const MeshCommand& c) {
-  const Scene scene = Scene::load(c.scene_path, c.sets);
   const std::string ext = fs::path(c.out).extension().string();
+  if (ext != ".inp" && ext != ".vtu")
+    throw InputError("--out " + c.out + ": the mesh file must end in .vtu (ParaView) or .inp (Abaqus/CalculiX)");
+  const Scene scene = mesh_command_scene(c);
+  std::unique_ptr<BuiltModel> bm = build_model(scene);
   if (ext == ".inp") {
-    std::unique_ptr<BuiltModel> bm = build_model(scene);
     write_file_atomic(c.out, calculix_deck(scene, *bm));
-  } else if (ext == ".vtu") {
-    std::unique_ptr<BuiltModel> bm = build_model(scene);
+  } else {
     const Assembler asmb(bm->model);
     const Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
     write_vtu(c.out, bm->model, compute_fields(asmb, u, asmb.initial_state()), 0.0, 0, 0.0, 0.0);
-  } else {
-    throw InputError("--out " + c.out + ": the mesh file must end in .vtu (ParaView) or .inp (Abaqus/CalculiX)");
   }
-  const MeshStats st = compute_stats(build_mesh(scene));
+  for (const std::string& w : bm->warnings) std::printf("note: %s\n", w.c_str());
+  if (scene.string("mesh.source") == "stl") {
+    StlMeshReport rep;
+    (void)stl_scene_mesh(scene, nullptr, &rep);  // the report of the same (deterministic) mesh
+    std::printf("%s", describe(rep).c_str());
+  }
+  const MeshStats& st = bm->stats;
   std::printf("wrote %s: %d nodes, %d %s elements\n", c.out.c_str(), st.nodes, st.elements, st.element_type.c_str());
   return 0;
 }

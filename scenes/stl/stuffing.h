@@ -1,0 +1,77 @@
+#pragma once
+// Tetrahedra of the solid bounded by a closed surface: a background grid of tetrahedra cut to
+// the surface by isosurface stuffing (Labelle & Shewchuk, "Isosurface stuffing: fast tetrahedral
+// meshes with good dihedral angles", ACM TOG 26(3), 2007), simplified.
+//
+// 1. Background grid: a rectilinear grid over the surface's bounding box (one padding cell beyond
+//    it), whose lines include every axis-aligned plane that carries facets of the surface (CAD
+//    actuators are mostly boxes: those faces are then meshed exactly, as the built-in mesher
+//    does) and the forced planes (fabric slab, symmetry plane x = 0); each interval between
+//    planes gets ceil(length / h) cells. Each cell is split into 5 tetrahedra with alternating
+//    parity (as scenes/pneunet.cpp), which conform across cells.
+// 2. phi at the grid vertices: the exact signed distance (scenes/stl/distance.h) within the band,
+//    its sign carried to the far vertices by a flood fill along grid edges (an edge longer than
+//    its distance to the surface cannot cross it).
+// 3. Cut points: where phi changes sign strictly along a tetrahedron edge, found by regula falsi
+//    on the exact distance.
+// 4. Warping (L&S sec. 3): a vertex closer to a cut point on one of its edges than alpha times
+//    that edge's length moves onto the closest such cut point and gets phi = 0; cut points on its
+//    edges are dropped. Vertices on a forced plane only move within it.
+// 4b. Creases (an addition for CAD parts): a vertex on the surface whose edge runs along the
+//    surface and leaves it within alpha of the edge moves to where it leaves (onto the crease).
+// 5. Stencils (L&S fig. 3): each background tetrahedron keeps its part with phi <= 0: a whole
+//    tetrahedron, one tetrahedron, a pyramid (2 tetrahedra) or a prism (3). A tetrahedron whose
+//    four vertices all have phi = 0 is kept when its centroid is inside.
+//
+// 6. Sharp edges (an addition for CAD parts): surface nodes within 0.9 h of an edge where facets
+//    meet at more than 30 degrees move onto it, nearest first, unless that would leave a
+//    tetrahedron around them with a dihedral angle below 5 degrees. Stencils alone cut such edges
+//    with a chamfer about a cell wide.
+//
+// What is simplified (and so not proven): L&S's grid is the body-centred cubic lattice, with
+// alpha_long = 0.24999 and alpha_short = 0.41189 and a parity rule for the prisms' diagonals, which
+// together bound every dihedral angle to [10.7, 164.8] degrees. Here the grid is rectilinear (to
+// conform to CAD faces and the fabric slab), alpha is one number for all edges, and the quadrilateral
+// faces of pyramids and prisms are split on the diagonal through their lowest-numbered vertex
+// (Dompierre et al., 8th International Meshing Roundtable, 1999), which keeps neighbours
+// conforming. The dihedral angles reached are measured and reported instead (docs/verification.md).
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "scenes/stl/distance.h"
+
+namespace pneufem {
+
+struct StuffingOptions {
+  double h = 2e-3;                   ///< target cell size in x and y (m)
+  double h_z = 0.0;                  ///< along z (m); 0 = h
+  bool feature_planes = true;        ///< grid lines through the axis-aligned faces of the surface
+  bool half = false;                 ///< only x >= 0 (the grid starts at the plane x = 0)
+  bool has_slab = false;             ///< a slab z0 < z < z1 whose faces are grid planes
+  double slab_z0 = 0.0, slab_z1 = 0.0;
+  int slab_cells = 1;                ///< grid cells through the slab
+  double alpha = 0.25;               ///< warping threshold, a fraction of the edge length
+};
+
+struct StuffedTets {
+  std::vector<Eigen::Vector3d> X;            ///< nodes (m)
+  std::vector<std::array<int, 4>> tets;      ///< positive volume
+  std::vector<char> on_surface;              ///< per node: phi = 0 (a cut point or a warped vertex)
+  std::vector<char> on_symmetry;             ///< per node: on the plane x = 0 (half)
+  std::array<std::vector<double>, 3> lines;  ///< the grid lines
+  int warped = 0;                            ///< vertices moved onto the surface
+  int cut_points = 0;
+  int on_sharp_edges = 0;                    ///< surface nodes moved onto a sharp edge (step 6)
+  int creased = 0;                           ///< surface vertices moved onto a crease (step 4b)
+  int flat_dropped = 0;                      ///< stencil tetrahedra of no volume, left out
+};
+
+/// Steps 1-5 above. `dist` must answer within a band of at least max_cell_diagonal(opt, surface).
+StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist, const StuffingOptions& opt);
+
+/// The grid lines of step 1 (for the band the distance needs: the longest cell diagonal).
+std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& surface, const StuffingOptions& opt);
+
+}  // namespace pneufem

@@ -1,0 +1,112 @@
+#include "scenes/stl_scene.h"
+
+#include "core/errors.h"
+#include "scenes/scene_keys.h"
+
+namespace pneufem {
+
+namespace {
+
+using detail::kmm;
+
+double length_unit_of(const Scene& s) {
+  const std::string u = s.string("mesh.length_unit");
+  if (u == "mm") return 1e-3;
+  if (u == "m") return 1.0;
+  s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
+}
+
+/// The surface of `key` (mesh.file or mesh.cavity_file), read and checked; an error of the file
+/// is prefixed with the key and where it was set.
+TriSurface surface_of(const Scene& s, const std::string& key, double unit) {
+  const std::string file = s.string(key);
+  try {
+    return read_closed_surface(s.resolve_path(file), unit);
+  } catch (const SceneKeyError&) {
+    throw;
+  } catch (const InputError& e) {
+    s.fail(key, e.what());
+  }
+}
+
+StlMeshSpec stl_spec(const Scene& s) {
+  StlMeshSpec spec;
+  StuffingOptions& o = spec.stuffing;
+  o.h = detail::positive(s, "mesh.h_mm") * kmm;
+  o.h_z = s.number("mesh.h_z_mm") * kmm;
+  if (o.h_z < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
+  o.half = s.boolean("mesh.half");
+  o.feature_planes = s.boolean("mesh.feature_planes");
+  const std::vector<double> slab = s.numbers("mesh.fabric_slab_mm");
+  if (!slab.empty()) {
+    if (slab.size() != 2 || !(slab[0] < slab[1]))
+      s.fail("mesh.fabric_slab_mm", "must be [z_bottom, z_top] with z_bottom < z_top (mm), or [] for no fabric layer");
+    o.has_slab = true;
+    o.slab_z0 = slab[0] * kmm;
+    o.slab_z1 = slab[1] * kmm;
+    o.slab_cells = s.integer("mesh.fabric_layers");
+  }
+  const std::string el = s.string("mesh.element");
+  if (el != "tet10" && el != "tet4") s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
+  spec.element = el == "tet10" ? ElementType::Tet10 : ElementType::Tet4;
+  const std::vector<double> inlet = s.numbers("mesh.cavity_inlet_mm");
+  if (inlet.size() == 3)
+    spec.cavity_inlet = Eigen::Vector3d(inlet[0], inlet[1], inlet[2]) * kmm;
+  else if (!inlet.empty())
+    s.fail("mesh.cavity_inlet_mm", "must be [x, y, z] (mm), a point inside the chamber the inlet feeds, or [] for every "
+                                   "interior void");
+  spec.fixed_face = s.string("mesh.fixed_face");
+  spec.fixed_point = s.vec3("mesh.fixed_point_mm") * kmm;
+  spec.fixed_normal = s.vec3("mesh.fixed_normal");
+  if (s.string("mesh.fabric_model") != "solid")
+    s.fail("mesh.fabric_model", "must be \"solid\" with mesh.source = \"stl\" (the fabric is the slab "
+                                "mesh.fabric_slab_mm; a membrane needs a surface the STL mesher does not make)");
+  return spec;
+}
+
+}  // namespace
+
+Mesh stl_scene_mesh(const Scene& s, std::vector<std::string>* warnings, StlMeshReport* report) {
+  const std::string file = s.string("mesh.file");
+  if (file.empty()) s.fail("mesh.file", "mesh.source = \"stl\" needs the path of the actuator's .stl or .obj in mesh.file");
+  const double unit = length_unit_of(s);
+  StlMeshSpec spec = stl_spec(s);
+  TriSurface surface = surface_of(s, "mesh.file", unit);
+  if (!s.string("mesh.cavity_file").empty()) {
+    if (spec.cavity_inlet)
+      s.fail("mesh.cavity_inlet_mm", "give either mesh.cavity_inlet_mm or mesh.cavity_file, not both (the cavity file's "
+                                     "shells are the cavity)");
+    const TriSurface cavity = surface_of(s, "mesh.cavity_file", unit);
+    spec.cavity_first_shell = surface.shells();
+    append_surface(surface, cavity, true);  // its shells bound voids of the solid
+    try {
+      close_and_orient(surface);
+    } catch (const InputError& e) {
+      s.fail("mesh.cavity_file", e.what());
+    }
+    for (int sh = spec.cavity_first_shell; sh < surface.shells(); ++sh)
+      if (surface.shell_depth[sh] % 2 == 0)
+        s.fail("mesh.cavity_file", "shell " + std::to_string(sh - spec.cavity_first_shell + 1) +
+                                       " of the cavity surface does not lie inside the actuator's solid (mesh.file); "
+                                       "the two files must be in the same frame and unit");
+  }
+  StlMeshReport rep;
+  Mesh m;
+  try {
+    m = mesh_closed_surface(surface, spec, &rep);
+  } catch (const SceneKeyError&) {
+    throw;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    // The mesher names the key it refuses; others are the file's.
+    for (const char* key : {"mesh.cavity_inlet_mm", "mesh.fixed_face", "mesh.fabric_slab_mm", "mesh.half", "mesh.h_mm"})
+      if (what.find(key) != std::string::npos)
+        s.fail(key, what.rfind(std::string(key) + ": ", 0) == 0 ? what.substr(std::string(key).size() + 2) : what);
+    s.fail("mesh.file", what);
+  }
+  if (warnings) warnings->insert(warnings->end(), rep.notes.begin(), rep.notes.end());
+  if (report) *report = rep;
+  return m;
+}
+
+}  // namespace pneufem

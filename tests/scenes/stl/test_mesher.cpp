@@ -1,0 +1,159 @@
+// Closed surfaces to tetrahedra (scenes/stl/mesher.h): the built-in pneu-net's own surface gives
+// the built-in mesh's solid, a curved tube is meshed by the cut-and-warp path, and the sets
+// (CAVITY, FIXED, TIP, SYMMETRY, FABRIC) are the ones the engine needs.
+#include <cstdio>
+#include <numbers>
+#include <set>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "engine/tet_element.h"
+#include "scenes/pneunet.h"
+#include "scenes/stl/mesher.h"
+#include "tests/scenes/stl/test_shapes.h"
+#include "tests/support/input_error.h"
+
+namespace pneufem {
+namespace {
+
+using test::error_of;
+
+double mesh_volume(const Mesh& m) {
+  double v = 0.0;
+  for (int e = 0; e < m.num_elements(); ++e) v += corner_volume(m, e);
+  return v;
+}
+
+double set_volume(const Mesh& m, const std::string& set) {
+  double v = 0.0;
+  for (int e : m.element_sets.at(set)) v += corner_volume(m, e);
+  return v;
+}
+
+/// The spec the scene gives for the default actuator: slab = the fabric layer, half model.
+StlMeshSpec default_spec(const PneuNetParams& p) {
+  StlMeshSpec s;
+  s.stuffing.h = p.h;
+  s.stuffing.half = p.half;
+  s.stuffing.has_slab = true;
+  s.stuffing.slab_z0 = p.fabric_z0;
+  s.stuffing.slab_z1 = p.fabric_z0 + p.fabric_thickness;
+  s.stuffing.slab_cells = p.fabric_layers;
+  return s;
+}
+
+TriSurface closed(TriSurface s) {
+  close_and_orient(s);
+  return s;
+}
+
+TEST(StlMesher, PneuNetSurfaceGivesTheBuiltInSolid) {
+  for (double h : {2e-3, 4e-3, 6e-3}) {
+    PneuNetParams p;  // the default actuator, half model, Tet10
+    p.h = h;
+    const Mesh built_in = build_pneunet(p);
+    StlMeshReport rep;
+    const Mesh m = mesh_closed_surface(closed(test::pneunet_surface(p)), default_spec(p), &rep);
+    std::printf("h = %g mm: %s", h * 1e3, describe(rep).c_str());
+    // Every face of this actuator is an axis-aligned plane carrying facets, at least h/10 from the
+    // next, so the background grid is the built-in mesher's grid and nothing is cut or moved: the
+    // same cells, the same 5-tet split, the same nodes (numbered alike: both by first use).
+    EXPECT_EQ(m.num_elements(), built_in.num_elements()) << h;
+    ASSERT_EQ(m.num_nodes(), built_in.num_nodes()) << h;
+    EXPECT_EQ(rep.cut_points + rep.warped + rep.creased + rep.on_sharp_edges, 0) << h;
+    double max_dx = 0.0;
+    for (int n = 0; n < m.num_nodes(); ++n) max_dx = std::max(max_dx, (m.X[n] - built_in.X[n]).norm());
+    EXPECT_EQ(max_dx, 0.0) << h;  // grid lines computed by the same formula from the same planes
+    EXPECT_EQ(m.conn, built_in.conn) << h;
+    EXPECT_EQ(m.region_names, built_in.region_names) << h;  // the same tags by the same rules
+    EXPECT_EQ(m.region, built_in.region) << h;
+    // Volumes exact up to round-off of the sum (1e-12 relative).
+    EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 1e-12 * mesh_volume(built_in));
+    EXPECT_NEAR(set_volume(m, "FABRIC"), set_volume(built_in, "FABRIC"), 1e-12 * mesh_volume(built_in));
+    EXPECT_EQ(m.surfaces.at("CAVITY").size(), built_in.surfaces.at("CAVITY").size());
+    EXPECT_EQ(m.node_sets.at("FIXED"), built_in.node_sets.at("FIXED"));
+    EXPECT_EQ(m.node_sets.at("TIP"), built_in.node_sets.at("TIP"));
+    EXPECT_EQ(m.node_sets.at("SYMMETRY"), built_in.node_sets.at("SYMMETRY"));
+  }
+}
+
+TEST(StlMesher, UniformLatticeCutsTheBoxesToTheSurface) {
+  // Without feature planes the grid ignores the CAD faces: every chamber wall is cut and warped.
+  PneuNetParams p;
+  p.chambers = 4;
+  p.h = 1e-3;
+  StlMeshSpec spec = default_spec(p);
+  spec.stuffing.feature_planes = false;
+  StlMeshReport rep;
+  const Mesh m = mesh_closed_surface(closed(test::pneunet_surface(p)), spec, &rep);
+  std::printf("%s", describe(rep).c_str());
+  const Mesh built_in = build_pneunet(p);
+  EXPECT_GT(rep.warped, 0);
+  // Warped vertices lie on the surface; corner tets of the stencils only cut the box corners, so
+  // the volume is within 2 % (a cut corner at h = 1 mm loses at most h^3/6 per corner).
+  EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 0.02 * mesh_volume(built_in));
+  EXPECT_GT(rep.min_dihedral_deg, 1.0);
+  for (int e = 0; e < m.num_elements(); ++e) ASSERT_GT(tet10_distortion(m, e).min_scaled_jacobian, 0.1) << e;
+}
+
+TEST(StlMesher, CurvedTubeIsMeshedWithMidNodesOnTheSurface) {
+  const TriSurface t = closed(test::tube_surface(0.006, 0.0035, 0.04, 0.003, 48));
+  StlMeshSpec spec;
+  spec.stuffing.h = 1.5e-3;
+  spec.stuffing.has_slab = true;
+  spec.stuffing.slab_z0 = -0.0058;
+  spec.stuffing.slab_z1 = -0.005;
+  StlMeshReport rep;
+  const Mesh m = mesh_closed_surface(t, spec, &rep);
+  std::printf("%s", describe(rep).c_str());
+  const double poly = 24.0 * std::sin(2.0 * std::numbers::pi / 48.0);
+  const double exact = poly * (0.006 * 0.006 * 0.04 - 0.0035 * 0.0035 * 0.034);
+  // Straight-sided corner volume: chords of the curved walls lose O(h^2 / R) per unit area.
+  EXPECT_NEAR(mesh_volume(m), exact, 0.03 * exact);
+  EXPECT_GT(rep.midnodes_on_surface, 0);
+  EXPECT_FALSE(m.surfaces.at("CAVITY").empty());
+  EXPECT_FALSE(m.element_sets.at("FABRIC").empty());
+  EXPECT_FALSE(m.node_sets.at("FIXED").empty());
+  EXPECT_FALSE(m.node_sets.at("TIP").empty());
+}
+
+TEST(StlMesher, BadInputsAreClearErrors) {
+  PneuNetParams p;
+  p.chambers = 2;
+  const TriSurface s = closed(test::pneunet_surface(p));
+  StlMeshSpec spec = default_spec(p);
+  // An inlet point in the silicone (the base), in the air, and a solid with no void.
+  spec.cavity_inlet = Eigen::Vector3d(0.0, 0.005, 0.001);
+  EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("lies in the solid"), std::string::npos);
+  spec.cavity_inlet = Eigen::Vector3d(0.0, -0.005, 0.001);
+  EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("lies outside the actuator"), std::string::npos);
+  spec.cavity_inlet.reset();
+  std::array<std::vector<double>, 3> lines{{{-0.01, 0.01}, {0.0, 0.02}, {0.0, 0.01}}};
+  const TriSurface block = closed(test::grid_solid_surface(lines, [](const Eigen::Vector3d&) { return true; }));
+  EXPECT_NE(error_of([&] { mesh_closed_surface(block, spec); }).find("cavity not found: the surface has no closed interior void"),
+            std::string::npos);
+  // A fixed plane that is no face of the actuator.
+  spec.fixed_face = "plane";
+  spec.fixed_point = Eigen::Vector3d(0.0, 0.003, 0.0);
+  spec.fixed_normal = Eigen::Vector3d(0.0, -1.0, 0.0);
+  const std::string e = error_of([&] { mesh_closed_surface(s, spec); });
+  EXPECT_NE(e.find("fixed face not found"), std::string::npos) << e;
+  // A wall thinner than the cells: a hollow box whose 0.3 mm lid lies between grid planes of a
+  // uniform 2 mm grid is lost or thickened by the stencils, which moves the volume by far more than 5 %.
+  {
+    std::array<std::vector<double>, 3> l{{{-0.01, -0.008, 0.008, 0.01}, {0.0, 0.002, 0.018, 0.02}, {0.0, 0.002, 0.0057, 0.006}}};
+    const TriSurface hollow = closed(test::grid_solid_surface(
+        l, [](const Eigen::Vector3d& x) { return !(std::abs(x.x()) < 0.008 && x.y() > 0.002 && x.y() < 0.018 && x.z() > 0.002 && x.z() < 0.0057); }));
+    StlMeshSpec thin;
+    thin.stuffing.h = 2e-3;
+    thin.stuffing.feature_planes = false;
+    const std::string lost = error_of([&] { mesh_closed_surface(hollow, thin); });
+    EXPECT_NE(lost.find("walls, chambers or channels thinner than about one element"), std::string::npos) << lost;
+  }
+  spec.fixed_face = "w+";
+  EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("mesh.fixed_face must be"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pneufem
