@@ -280,15 +280,15 @@ RECORDINGS = {
 # DIR): one effect at a time, at growing sizes, on one protocol and rig (A: 0.05 deg tracking noise).
 DETECTION_PROTOCOL = staircase(3, 30, 10, 3.0)
 DETECTION = {}
-for g in (0.02, 0.05, 0.1):
+for g in (0.01, 0.02, 0.05, 0.1):
     DETECTION["det_creep_g%g" % g] = {"effects": {"creep": dict(KWW, g=g)}}
-for a in (0.005, 0.01, 0.02):
+for a in (0.0025, 0.005, 0.01, 0.02):
     DETECTION["det_fatigue_a%g" % a] = {"effects": {"fatigue": dict(FATIGUE_POWER, a=a)},
                                         "protocol": staircase(6, 30, 10, 3.0)}
-for A in (0.05, 0.1, 0.2):
+for A in (0.05, 0.07, 0.1, 0.2):
     DETECTION["det_mullins_A%g" % A] = {"effects": {"mullins": dict(MULLINS, A=A)},
                                         "protocol": staircase(3, 30, 10, 3.0, peaks=[30, 20, 30])}
-for tau in (0.05, 0.1, 0.2):
+for tau in (0.02, 0.03, 0.05, 0.1, 0.2):
     DETECTION["det_lag_tau%g" % tau] = {"effects": {"lag": {"form": "first_order", "tau_s": tau}}}
 for name, d in DETECTION.items():
     d.setdefault("protocol", DETECTION_PROTOCOL)
