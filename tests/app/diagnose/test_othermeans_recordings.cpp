@@ -133,6 +133,14 @@ TEST(OtherMeansRecording, DISABLED_SofterReloadBelowThePeakIsMullins) {
   expect_found(diagnose("mullins_reload"), {"mullins"});
 }
 TEST(OtherMeansRecording, DISABLED_FirstOrderLagIsNamed) { expect_found(diagnose("lag_first_order"), {"lag"}); }
+// FAILS (measured 2026-11-27, candidates stiffness, pressure_lag, viscoelastic_instantaneous,
+// mullins): pressure_lag is named alone (tau 0.35 s for a 0.6 Hz, zeta 0.45 chamber response), but
+// NRMSE 0.0939 -> 0.0386 is 0.41x the baseline, not <= 0.4x, at a 0.0092 floor: 82 % of what is left
+// changes within the holds (0.0352 beyond a static misfit). The catalog's lag is first order; an
+// under-damped chamber overshoots, which no first-order filter of the inlet can. In round 2 creep
+// (delta AIC -9.8, tau at its bound) and stiffness (-9.3) just miss the AIC test: nothing spurious.
+// The fix is a second-order lag (load.pressure_lag_s plus a natural frequency, scenes/pressure_lag.h)
+// as a second constant of the candidate, outside app/diagnose. 200 s of one core.
 TEST(OtherMeansRecording, DISABLED_UnderDampedSecondOrderLagIsNamed) {
   expect_found(diagnose("lag_second_order"), {"lag"});
 }
