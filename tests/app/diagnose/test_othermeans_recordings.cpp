@@ -112,6 +112,19 @@ TEST(OtherMeansNull, AnotherMeshsCurveIsNamedAsStiffnessWithTheRestStatic) {
   EXPECT_GT(r.static_share, 0.9);
 }
 
+// ---- Item 5 in CI: the first-order lag against the candidates that could stand in for it (a static
+// misfit, creep in a hold, softening). Measured: pressure_lag named alone, NRMSE 0.1046 -> 0.0080
+// (0.08x) at a 0.0082 floor, tau 0.396 s for the truth's 0.4 s (the regulator's overshoot is in the
+// recorded inlet pressure, so the lag is seen behind it); round 2 skipped at the noise floor. 30 s
+// of one core.
+TEST(OtherMeansRecording, FirstOrderLagIsNamedWithItsTimeConstant) {
+  const DiagnosisResult r = diagnose("lag_first_order", {"stiffness", "pressure_lag", "viscoelastic_instantaneous", "mullins"});
+  expect_found(r, {"lag"});
+  ASSERT_FALSE(r.candidates.empty());
+  ASSERT_EQ(r.candidates.front().effect, "pressure_lag");
+  EXPECT_NEAR(r.candidates.front().params.at(0), 0.4, 0.02);  // 5 %: the CalculiX recording's tolerance
+}
+
 // ---- Item 5: the whole catalog, as a user runs it. Too slow for CI on one core (a whole-catalog
 // diagnosis of a 3-10 trial recording with two rounds: 3.5-15 min of one core, measured on a shared
 // machine); run with --gtest_also_run_disabled_tests. Each comment gives what was measured (the CLI,
@@ -125,13 +138,21 @@ TEST(OtherMeansNull, AnotherMeshsCurveIsNamedAsStiffnessWithTheRestStatic) {
 TEST(OtherMeansRecording, DISABLED_StretchedExponentialCreepIsNamed) { expect_found(diagnose("creep_kww"), {"creep"}); }
 // Measured: viscoelastic_instantaneous alone, 0.1049 -> 0.0250 (0.24x), floor 0.0042; 319 s.
 TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose("creep_powerlaw"), {"creep"}); }
+// Not measured in time (10 trials: ~15 min of one core with two rounds).
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
   expect_found(diagnose("fatigue_powerlaw"), {"fatigue"});
 }
+// Not measured in time.
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
+// Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
+// mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
+// softening of this recording is larger at low pressure than Ogden-Roxburgh's with any r); creep
+// and fatigue also passed round 1 but with constants at their bounds, and nothing passed round 2.
+// 73 s of one core.
 TEST(OtherMeansRecording, DISABLED_SofterReloadBelowThePeakIsMullins) {
   expect_found(diagnose("mullins_reload"), {"mullins"});
 }
+// The CI test FirstOrderLagIsNamedWithItsTimeConstant runs this recording on four candidates.
 TEST(OtherMeansRecording, DISABLED_FirstOrderLagIsNamed) { expect_found(diagnose("lag_first_order"), {"lag"}); }
 // FAILS (measured 2026-11-27, candidates stiffness, pressure_lag, viscoelastic_instantaneous,
 // mullins): pressure_lag is named alone (tau 0.35 s for a 0.6 Hz, zeta 0.45 chamber response), but
@@ -147,10 +168,20 @@ TEST(OtherMeansRecording, DISABLED_UnderDampedSecondOrderLagIsNamed) {
 TEST(OtherMeansRecording, DISABLED_CreepAndFatigueOverTenTrialsAreBothNamed) {
   expect_found(diagnose("creep_fatigue"), {"creep", "fatigue"});
 }
+// Not measured in time.
 TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(diagnose("mullins_lag"), {"mullins", "lag"}); }
+// FAILS (measured 2026-11-27, whole catalog, max_effects 4): creep (viscoelastic_instantaneous) in
+// round 1 (NRMSE 0.1534 -> 0.0771, floor 0.0059), the lag in round 2 (-> 0.0136, tau 0.31 s for the
+// truth's 0.3; creep re-fitted jointly to gamma 0.35, tau 10.5 s), and round 3 names nothing: fatigue
+// takes 0.0136 -> 0.0135 (delta AIC -0.5). Final 0.09x the baseline, nothing spurious, fatigue not
+// found. The power-law creep of this recording (n 0.35) never recovers between trials, so it too
+// drifts upward over the six trials; the long Prony term (tau 10.5 s, re-fitted in round 2) takes
+// that drift, and the log-law fatigue's own growth (D 0.02 -> 0.05) is left below the tests. 813 s
+// of one core.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
+// Not measured in time with the whole catalog (the CI tests above run the stiffness candidate).
 TEST(OtherMeansNull, DISABLED_StaticMisfitsNameNothingWithTheWholeCatalog) {
   for (const std::string name : {"null_stiffness_3pc_stiffer", "null_stiffness_2pc", "null_geometry_wall"})
     EXPECT_TRUE(diagnose(name).selected.empty()) << name;
