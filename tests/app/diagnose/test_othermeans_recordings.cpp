@@ -142,7 +142,11 @@ TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
   expect_found(diagnose("fatigue_powerlaw"), {"fatigue"});
 }
-// Not measured in time.
+// FAILS the 0.4x bound only (measured with the candidates stiffness, fatigue, viscoelastic_instantaneous,
+// mullins, max 2): fatigue named alone, NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor (1.2x the
+// floor; this effect is small, the baseline only 2.8x the floor, so 0.4x leaves 0.002 above it);
+// W_th 4.8 kPa, tau 289 s. Round 2: creep passes the raw tests with gamma at its bound, not selected.
+// 131 s of one core.
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
 // Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
 // mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
