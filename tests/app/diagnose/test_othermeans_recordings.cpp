@@ -169,6 +169,11 @@ TEST(OtherMeansRecording, DISABLED_FirstOrderLagIsNamed) { expect_found(diagnose
 TEST(OtherMeansRecording, DISABLED_UnderDampedSecondOrderLagIsNamed) {
   expect_found(diagnose("lag_second_order"), {"lag"});
 }
+// Incomplete measurement (whole catalog, max_effects 4; over 75 min of wall time on a shared machine,
+// not finished by the deadline): creep was selected in round 1 in the instantaneous convention
+// (round 2's long-term candidate was refused as switching it), most likely fatigue in round 2 (the
+// lowest error beyond a static misfit: 37 deg^2 against Mullins' 53), and round 3 selected a third
+// effect, since round 4 ran: spurious unless it was neither Mullins, stiffness, lag nor gravity.
 TEST(OtherMeansRecording, DISABLED_CreepAndFatigueOverTenTrialsAreBothNamed) {
   expect_found(diagnose("creep_fatigue"), {"creep", "fatigue"});
 }
