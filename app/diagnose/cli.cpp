@@ -24,7 +24,9 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       ->required();
   c->cmd->add_option("--set", c->sets, "Override a scene key, e.g. --set mesh.h_mm=4 (repeatable)");
   c->cmd->add_option("--candidates", c->candidates, "Comma-separated candidate effects to try (default: all)");
-  c->cmd->add_option("--max-effects", c->options.max_effects, "Greedy forward selection: at most this many effects")
+  c->cmd->add_option("--max-effects", c->options.max_effects,
+                     "Greedy forward selection: the rounds go on while an effect passes the tests, at most this many "
+                     "(each round costs about what round 1 did)")
       ->check(CLI::Range(1, 6))
       ->capture_default_str();
   c->cmd->add_option("--evaluations", c->options.max_evaluations, "Reduced-model runs per candidate calibration")
@@ -34,6 +36,12 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       ->capture_default_str();
   c->cmd->add_option("--min-removed", c->options.min_removed,
                      "... and remove at least this fraction of the squared error above the noise floor")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  c->cmd->add_option("--min-static-change", c->options.min_static_change,
+                     "An effect without history (stiffness, gravity) is named only when it moves the model's angle by at "
+                     "least this fraction of the angle range (RMS): a smaller static misfit is the elastic model's accuracy, "
+                     "to calibrate, not a missing effect (ignored with --trust-elastic-model)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   c->cmd->add_flag_callback(
@@ -106,6 +114,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
                 k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
   }
   if (const std::string k = selected_constants_text(r); !k.empty()) std::printf("constants of the selected effects:\n%s", k.c_str());
+  for (const std::string& e : r.equivalents) std::printf("equally good: %s\n", e.c_str());
   if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);

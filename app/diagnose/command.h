@@ -61,11 +61,20 @@ struct DiagnoseOptions {
   std::string data_path;
   std::string out_dir;
   std::vector<std::string> candidates;  ///< names to try (empty = the whole catalog)
-  int max_effects = 2;                  ///< greedy forward selection depth
+  /// Greedy forward selection depth: the rounds go on while an effect passes the tests, at most this
+  /// many (each round calibrates every candidate left: its cost is that of round 1 again).
+  int max_effects = 4;
   int max_evaluations = 60;             ///< reduced-model runs per candidate calibration
   double aic_threshold = -10.0;
   double min_removed = 0.25;            ///< fraction of the excess squared NRMSE a candidate must remove
   double min_gain_of_floor = 0.1;       ///< ... and NRMSE gain of at least this times the noise floor
+  /// An effect without history (stiffness, gravity: a change of the static angle curve) is named only
+  /// when it changes the model's angle by at least this much (RMS over the recording, in units of the
+  /// NRMSE, i.e. of the measured angle range). A smaller static misfit is within what an elastic
+  /// model is expected to be accurate to (a 1-3 % stiffness error, a coarse mesh, a geometry
+  /// tolerance; the seed paper called a 4 % trial-1 NRMSE a match): calibrate the elastic constants
+  /// on a static test instead. Not applied under trust_elastic_model.
+  double min_static_change = 0.05;
   /// Skip later rounds once the residual is within min_gain_of_floor of the noise floor (no effect
   /// could then be significant without fitting below the floor); false = run every round.
   bool stop_at_noise_floor = true;
@@ -129,6 +138,9 @@ struct CandidateResult {
   double delta_aic_beyond_static = 0.0;
   double removed_beyond_static = 0.0;
   bool beyond_static = false;
+  /// Effects without history: how much the calibrated effect changes the model's angle, RMS over the
+  /// recording in units of the NRMSE (min_static_change); -1 for history effects.
+  double static_change_nrmse = -1.0;
   /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
   /// always for history effects from round 2 on; in round 1 when only that calibration passes.
   bool profiled = false;
@@ -161,6 +173,10 @@ struct DiagnosisResult {
   /// stiffness) with the history effect second; this names the latter directly.
   std::string missing_history_effect;
   std::string stopped;                      ///< why the forward selection stopped early ("" = it did not)
+  /// Model equivalence: per round with a selection, the other candidates that passed the same tests
+  /// and fit as well (their RSS, beyond a static misfit from round 2 on, within 25 % of the chosen
+  /// one's: below the reduced model's own error, so the recording cannot tell them apart), in words.
+  std::vector<std::string> equivalents;
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
   std::vector<double> final_nrmse_per_trial;      ///< ... per trial (the baseline's when none is selected)
   std::vector<double> final_rmse_deg_per_trial;

@@ -49,6 +49,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     o.add("at_bound", ab + "]");
     o.add("nrmse_beyond_static", c.nrmse_beyond_static).add("delta_aic_beyond_static", c.delta_aic_beyond_static);
     o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
+    if (c.static_change_nrmse >= 0.0) o.add("static_change_nrmse", c.static_change_nrmse);
     o.add("profiled", c.profiled ? "true" : "false");
     if (!c.refit_selected.empty()) o.add("refit_selected_params", json::array(c.refit_selected));
     if (!c.trade_lo.empty()) {
@@ -65,6 +66,11 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
   root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
   root.add("missing_history_effect", out.missing_history_effect.empty() ? "null" : json::quote(out.missing_history_effect));
   if (!out.stopped.empty()) root.add("stopped", json::quote(out.stopped));
+  {
+    std::string eq = "[";
+    for (std::size_t j = 0; j < out.equivalents.size(); ++j) eq += (j ? ", " : "") + json::quote(out.equivalents[j]);
+    root.add("equivalents", eq + "]");
+  }
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
   root.add("selected", sel + "]");
@@ -109,7 +115,8 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     cm.add_str("scene_mesh_sweep_source", rom.fine_source());
     method.add("calibration_mesh", cm.str(4));
   }
-  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects);
+  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects)
+      .add("min_static_change", opt.min_static_change);
   method.add("trust_elastic_model", opt.trust_elastic_model ? "true" : "false");
   method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
   root.add("method", method.str(2));

@@ -168,6 +168,7 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
     s += "\n";
   }
   if (!out.stopped.empty()) s += "Stopped " + out.stopped + ".\n\n";
+  for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";
   if (!out.fem_error.empty()) s += "Full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"
