@@ -214,4 +214,26 @@ std::vector<FaceRef> boundary_faces(const Mesh& mesh) {
   return out;
 }
 
+void renumber_nodes_by_first_use(Mesh& m) {
+  std::vector<int> new_id(m.X.size(), -1);
+  int next = 0;
+  for (int& v : m.conn) {
+    if (new_id[v] < 0) new_id[v] = next++;
+    v = new_id[v];
+  }
+  std::vector<Eigen::Vector3d> X(static_cast<std::size_t>(next));
+  for (std::size_t i = 0; i < m.X.size(); ++i)
+    if (new_id[i] >= 0) X[new_id[i]] = m.X[i];
+  m.X = std::move(X);
+  for (auto& [name, nodes] : m.node_sets) {
+    std::vector<int> out;
+    out.reserve(nodes.size());
+    for (int i : nodes)
+      if (new_id[i] >= 0) out.push_back(new_id[i]);
+    std::sort(out.begin(), out.end());
+    nodes = std::move(out);
+  }
+  m.node_ids.clear();
+}
+
 }  // namespace pneufem

@@ -133,4 +133,9 @@ Mesh promote_to_tet10(const Mesh& tet4);
 /// actuator and to check user surfaces.
 std::vector<FaceRef> boundary_faces(const Mesh& mesh);
 
+/// Renumbers nodes by first use in the connectivity and drops unused ones (node sets follow,
+/// node_ids are cleared). Meshers that emit elements slab by slab along the actuator keep the
+/// matrix bandwidth ~ one slab of nodes this way (scenes/pneunet.cpp, scenes/stl/mesher.cpp).
+void renumber_nodes_by_first_use(Mesh& m);
+
 }  // namespace pneufem

@@ -538,22 +538,20 @@ void ReducedRun::solve_segment(const Segment& s) {
       // equations. Measured: with modes of strongly softened states in the basis, a vent from
       // 45 kPa of a 3-chamber actuator stopped at theta = -1.5 deg with a large correction and
       // stayed on that branch through the next trial (bench_rom, 2026-11-27).
+      bool released = false;
       if (span <= 0.0 && s.p1 == 0.0 && s.p0 > 0.0) {
         try {
           z_.theta = 0.0;
           z_.q.setZero();
           z_.lambda = 0.0;
           equilibrium(0.0, t, dt);
-          commit(t, dt, s.p1, s.report);
-          hist_prev_.clear();
-          hist_cur_.clear();
-          return;
+          released = true;
         } catch (const PhysicsError&) {
           ++stats_.rejected_steps;
         }
       }
       int pieces = 1;
-      for (;;) {
+      while (!released) {
         try {
           z_ = z0;
           for (int i = 1; i <= pieces; ++i) {

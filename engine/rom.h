@@ -181,8 +181,10 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
 /// response (measured: stretch 2.0 -> 2.7 in three fatigue trials where the linear responses' basis
 /// held it at 1.9), a large nonlinear deformation that only equilibria of softened states contain.
 /// Levels past the softened structure's limit point (no equilibrium at that pressure) are skipped.
+/// Parts stiffer than stiff_modulus_ratio x the softest (the fabric) are never softened.
 std::vector<Eigen::VectorXd> softened_states(const Model& reference, const ElasticPathTrace& trace, const std::vector<int>& samples,
-                                             int levels, double max_softening, bool verbose = false);
+                                             int levels, double max_softening, bool verbose = false,
+                                             double stiff_modulus_ratio = 100.0);
 
 /// A reduced state: path coordinate, correction amplitudes, gauge multiplier.
 struct ReducedCoordinates {

@@ -270,11 +270,12 @@ class IsochoricScaled final : public Material {
 }  // namespace
 
 std::vector<Eigen::VectorXd> softened_states(const Model& reference, const ElasticPathTrace& trace, const std::vector<int>& samples,
-                                             int levels, double max_softening, bool verbose) {
+                                             int levels, double max_softening, bool verbose, double stiff_modulus_ratio) {
   std::vector<Eigen::VectorXd> out;
   if (levels <= 0) return out;
   const auto t0 = Clock::now();
-  const std::vector<char> stiff = stiff_parts(reference, 100.0);
+  const std::vector<char> stiff = stiff_parts(reference, stiff_modulus_ratio);
+  Model soft = reference;  // one copy of the mesh; each level only reassigns parts
   const Assembler A0(reference);
   const ElementGeometry& geom = A0.geometry();
   const int ne = reference.mesh.num_elements();
@@ -305,7 +306,8 @@ std::vector<Eigen::VectorXd> softened_states(const Model& reference, const Elast
       Eigen::VectorXd u = uk;
       for (int l = 1; l <= levels; ++l) {
         const double s = max_softening * l / levels;
-        Model soft = reference;
+        soft.parts = reference.parts;
+        soft.element_part = reference.element_part;
         std::map<std::pair<int, int>, int> part_of;  // (original part, bin) -> new part
         for (int e = 0; e < ne; ++e) {
           const int op = reference.element_part[e];
@@ -406,7 +408,8 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     }
   }
   std::vector<Eigen::VectorXd> softened;
-  if (opt.softened_levels > 0) softened = softened_states(reference, trace, mode_k, opt.softened_levels, opt.softened_max, opt.verbose);
+  if (opt.softened_levels > 0) softened = softened_states(reference, trace, mode_k, opt.softened_levels, opt.softened_max, opt.verbose,
+                                                           opt.stiff_modulus_ratio);
   std::vector<Eigen::VectorXd> responses;
   std::vector<int> response_sample, response_cluster;
   for (int k : mode_k) {

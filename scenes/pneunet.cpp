@@ -347,30 +347,6 @@ const std::array<CellSplit, 2>& cell_splits() {
   return splits;
 }
 
-/// Renumbers nodes by first use in the connectivity (drops unused nodes): elements are ordered
-/// along y, so nodes follow and the matrix bandwidth stays ~ one y-slab of nodes.
-void renumber_by_first_use(Mesh& m) {
-  std::vector<int> new_id(m.X.size(), -1);
-  int next = 0;
-  for (int& v : m.conn) {
-    if (new_id[v] < 0) new_id[v] = next++;
-    v = new_id[v];
-  }
-  std::vector<Eigen::Vector3d> X(static_cast<std::size_t>(next));
-  for (std::size_t i = 0; i < m.X.size(); ++i)
-    if (new_id[i] >= 0) X[new_id[i]] = m.X[i];
-  m.X = std::move(X);
-  for (auto& [name, nodes] : m.node_sets) {
-    std::vector<int> out;
-    out.reserve(nodes.size());
-    for (int i : nodes)
-      if (new_id[i] >= 0) out.push_back(new_id[i]);
-    std::sort(out.begin(), out.end());
-    nodes = std::move(out);
-  }
-  m.node_ids.clear();
-}
-
 }  // namespace
 
 void PneuNetParams::validate() const {
@@ -483,7 +459,7 @@ Mesh build_pneunet(const PneuNetParams& p) {
   // promote_to_tet10 adds a mid-edge node to a node set when both corners are in it, which is
   // exact here because the sets are planes.
   if (p.element == ElementType::Tet10) m = promote_to_tet10(m);
-  renumber_by_first_use(m);
+  renumber_nodes_by_first_use(m);
   m.ensure_ids();
   return m;
 }

@@ -179,26 +179,6 @@ void check_volume(const TriSurface& s, const Mesh& m, const StuffingOptions& opt
   if (std::abs(rep.volume_error) > 0.01) rep.notes.push_back(what + "; a smaller mesh.h_mm resolves them better");
 }
 
-/// Renumbers nodes by first use in the connectivity (elements are ordered along y, so the
-/// matrix bandwidth stays ~ one slab of nodes), as the built-in mesher does.
-void renumber_by_first_use(Mesh& m) {
-  std::vector<int> new_id(m.X.size(), -1);
-  int next = 0;
-  for (int& v : m.conn) {
-    if (new_id[v] < 0) new_id[v] = next++;
-    v = new_id[v];
-  }
-  std::vector<Eigen::Vector3d> X(static_cast<std::size_t>(next));
-  for (std::size_t i = 0; i < m.X.size(); ++i)
-    if (new_id[i] >= 0) X[new_id[i]] = m.X[i];
-  m.X = std::move(X);
-  for (auto& [name, nodes] : m.node_sets) {
-    for (int& i : nodes) i = new_id[i];
-    std::sort(nodes.begin(), nodes.end());
-  }
-  m.node_ids.clear();
-}
-
 }  // namespace
 
 std::pair<double, double> dihedral_range_deg(const Mesh& m, int e) {
@@ -365,7 +345,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     m = promote_to_tet10(m);
     curve_boundary(m, st.on_surface, st.on_symmetry, *dist, rep);
   }
-  renumber_by_first_use(m);
+  renumber_nodes_by_first_use(m);
   m.ensure_ids();
   const MeshStats stats = compute_stats(m);
   rep.min_radius_ratio = stats.min_quality;
