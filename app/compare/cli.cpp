@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 
 namespace pneufem {
 
@@ -34,17 +35,33 @@ std::unique_ptr<CompareCommand> add_compare_command(CLI::App& app) {
               "Region sensitivity: re-simulate with each mesh region's stiffness x 0.9 and project the residual on it "
               "(one extra simulation per region)");
   s->add_option("--label", c->options.label, "Name of this model variant in the history (default: the scene file name)");
+  s->add_option("--model", c->model,
+                "full: the full FEM (on the default mesh ~1 h per trial of the paper's staircase with all effects on, "
+                "~5 h for ten). reduced: the reduced-order model (docs/theory.md): its offline part (elastic path and "
+                "basis: ~30-60 min on the default mesh, ~3 min at mesh.h_mm = 6) is cached in --cache and reused for "
+                "any effect constants and protocol, then minutes for ten trials; every report is checked against the "
+                "full residual and a run whose estimated error exceeds solver.reduced_check_deg is redone with the full "
+                "FEM (metrics.json \"simulation\".\"model\" says which ran). Default: the scene's solver.model")
+      ->check(CLI::IsMember({"full", "reduced"}));
+  s->add_option("--cache", c->options.cache_dir,
+                "Directory of the reduced model's offline part (default with the reduced model: DIR/cache, so every "
+                "compare into one study directory reuses it)");
   return c;
 }
 
 int run_compare_command(CompareCommand& c, const std::string& command_line) {
   c.options.command_line = command_line;
   c.options.progress = isatty(fileno(stderr));
-  const Scene scene = Scene::load(c.scene_path, c.sets);
+  std::vector<std::string> sets = c.sets;
+  if (!c.model.empty()) sets.push_back("solver.model=\"" + c.model + "\"");  // after --set: the option decides
+  const Scene scene = Scene::load(c.scene_path, sets);
+  if (scene.string("solver.model") == "reduced" && c.options.cache_dir.empty())
+    c.options.cache_dir = (std::filesystem::path(c.options.out_dir) / "cache").string();
   const CompareRunResult r = run_compare(scene, c.options);
-  std::printf("compare: NRMSE %.4f (noise floor %.4f) over %zu trials, %ld states, %.1f s; report %s/report.html\n",
-              r.comparison.nrmse, r.comparison.noise_floor_nrmse, r.comparison.trials.size(), r.drive.states, r.wall_s,
-              c.options.out_dir.c_str());
+  std::printf("compare: NRMSE %.4f (noise floor %.4f) over %zu trials, %ld states, model %s, %.1f s; report "
+              "%s/report.html\n",
+              r.comparison.nrmse, r.comparison.noise_floor_nrmse, r.comparison.trials.size(), r.drive.states,
+              r.drive.model.c_str(), r.wall_s, c.options.out_dir.c_str());
   // Everything the run noted (converted columns, dropped outlier frames, a recording in another
   // convention) is in metrics.json and the report; on the terminal too, so nobody misses it.
   for (const std::string& w : r.warnings)

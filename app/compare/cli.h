@@ -15,6 +15,7 @@ struct CompareCommand {
   CLI::App* cmd = nullptr;
   std::string scene_path;
   std::vector<std::string> sets;
+  std::string model;  ///< --model: "" = the scene's solver.model, else "full" or "reduced"
   CompareRunOptions options;
 };
 

@@ -128,7 +128,13 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
       .add_str("failure", r.drive.failure)
       .add("states", static_cast<double>(r.drive.states))
       .add("pressure_tolerance_kPa", r.drive.tolerance_kPa)
-      .add("wall_s", r.drive.wall_s);
+      .add("wall_s", r.drive.wall_s)
+      .add_str("model", r.drive.model);
+  if (r.drive.model != "full") {  // the reduced model ran (and stood, or was replaced by the FEM: model says which)
+    sim.add("reduced_offline_s", r.drive.reduced_offline_s)
+        .add_str("reduced_basis", r.drive.reduced_basis_source)
+        .add("reduced_worst_check_deg", r.drive.reduced_worst_check_deg);
+  }
   json::Object o;
   o.add_str("pneufem_version", version_string())
       .add_str("command_line", opt.command_line)
@@ -198,6 +204,7 @@ std::vector<RegionSensitivity> region_sensitivities(const Scene& scene, const Re
   DriveOptions dopt;
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
+  dopt.cache_dir = opt.cache_dir;
   std::vector<RegionSensitivity> out;
   const double d_scale = opt.region_scale - 1.0;
   for (const auto& [region, elements] : base.drive.mesh.elements_per_region) {
@@ -252,6 +259,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
   dopt.vtu_dir = staging.string();
+  dopt.cache_dir = opt.cache_dir;
   // A model the FEM cannot follow to the end (a limit point, failed walls) still gives the
   // comparison of the frames solved before: hours of computation are not thrown away, and where it
   // stopped is itself a finding. metrics.json says "incomplete" with the reason; the CLI exits 3.

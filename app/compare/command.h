@@ -34,7 +34,10 @@
 //   "regions": null or [{ "region", "elements", "best_scale", "variance_fraction", "nrmse" }]
 //              sorted by variance_fraction, descending,
 //   "worst_states": [{ "trial", "time_s", "model_deg", "measured_deg", "file" }],
-//   "simulation": { "states", "pressure_tolerance_kPa", "wall_s" }, "wall_s",
+//   "simulation": { "status", "failure", "states", "pressure_tolerance_kPa", "wall_s",
+//                   "model": "full" | "reduced" | "full (fallback: <why>)",
+//                   with the reduced model also "reduced_offline_s", "reduced_basis",
+//                   "reduced_worst_check_deg" }, "wall_s",
 //   "warnings": [..], "mesh": {..}, "scene": {..resolved..} }
 // NaN (a step without a mark) is written as null.
 //
@@ -66,6 +69,9 @@ struct CompareRunOptions {
   bool progress = false;
   std::string command_line;
   CompareOptions compare;
+  /// The reduced model's cached offline part (solver.model = "reduced"; app/simulate/drive.h);
+  /// "" = computed on every run.
+  std::string cache_dir;
 };
 
 struct RegionSensitivity {

@@ -57,11 +57,21 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       ->capture_default_str();
   c->cmd->add_flag("--verify", c->options.verify, "Also run the baseline and the fitted scene with the full FEM");
   c->cmd->add_option("--refine", c->options.refine,
-                     "Full-FEM corrections of the selected effects' constants (space mapping: N corrections cost N + 1 "
-                     "FEM runs of the recording, plus one of the baseline); recommended for damage effects (mullins, "
-                     "fatigue)")
+                     "Corrections of the selected effects' constants by the accurate model (--refine-model; space "
+                     "mapping: N corrections cost N + 1 runs of the recording). The path model that selects the effects "
+                     "biases damage constants (mullins, fatigue) up to ~2x; 0 = the path model's constants")
       ->check(CLI::Range(0, 5))
       ->capture_default_str();
+  c->cmd->add_option_function<std::string>(
+         "--refine-model",
+         [o = &c->options](const std::string& m) {
+           o->refine_model = m == "full" ? DiagnoseOptions::RefineModel::Full : DiagnoseOptions::RefineModel::Reduced;
+         },
+         "reduced (default): the reduced-order model of the calibration mesh (one offline part per actuator, "
+         "~2-5 min at h = 6 and kept in --cache, then ~1 min per run of a ten-trial recording); full: the full FEM of "
+         "the scene's mesh (~1 h per trial with damage on the default mesh), followed by a full-FEM check of the "
+         "baseline as --verify")
+      ->check(CLI::IsMember({"reduced", "full"}));
   c->cmd->add_option("--fem-calibrate", c->options.fem_calibration_runs,
                      "Then calibrate the selected effects' constants directly on the full FEM, locally from the "
                      "reduced-model (or refined) ones, with at most this many FEM runs per effect (~20 for two "
@@ -118,7 +128,13 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);
-  if (!r.fem_error.empty()) std::printf("full FEM: %s\n", r.fem_error.c_str());
+  if (!r.refined_model.empty()) {
+    std::printf("refined with the %s model: NRMSE %.4f; per trial", r.refined_model == "full" ? "full FEM" : "reduced-order",
+                r.refined_nrmse);
+    for (double e : r.refined_nrmse_per_trial) std::printf(" %.4f", e);
+    std::printf("\n");
+  }
+  if (!r.fem_error.empty()) std::printf("refinement/FEM: %s\n", r.fem_error.c_str());
   if (!r.missing_history_effect.empty() && r.missing_history_effect != r.missing_effect)
     std::printf("missing history effect: %s (after %s, which takes the larger, static part of the misfit)\n",
                 r.missing_history_effect.c_str(), r.missing_effect.c_str());

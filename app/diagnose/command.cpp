@@ -650,7 +650,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
                     (out.selected.empty() ? std::string("none") : join(out.selected, " + ")) + ") with calibrated constants.\n" +
                     "# Data: " + opt.data_path + "\n" + fitted.to_toml();
 
-  if (opt.verify || opt.refine > 0 || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
+  const bool fem_refined = opt.refine > 0 && opt.refine_model == DiagnoseOptions::RefineModel::Full;
+  if (opt.verify || fem_refined || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   if (opt.progress && !opt.cache_dir.empty())

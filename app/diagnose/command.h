@@ -84,7 +84,16 @@ struct DiagnoseOptions {
   bool trust_elastic_model = false;
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
-  int refine = 0;                       ///< FEM space-mapping refinements of the selected constants
+  /// Space-mapping refinements of the selected constants (app/diagnose/fem.cpp): N refinements cost
+  /// N + 1 runs of the accurate model. The path model that selects and calibrates is a 1-dof model
+  /// whose damage constants are biased up to ~2x; the refinement moves them to the accurate model's.
+  int refine = 2;
+  /// The accurate model of the refinement: the reduced-order model (engine/rom.h) of the calibration
+  /// scene, driven by the same chamber-pressure map as the path model (minutes: one offline part per
+  /// actuator, cached in cache_dir, then one reduced run per refinement), or the full FEM of the
+  /// scene (hours on the default mesh).
+  enum class RefineModel { Reduced, Full };
+  RefineModel refine_model = RefineModel::Reduced;
   /// Full-FEM runs for a final local calibration of each selected effect's constants directly on the
   /// FEM (bounded derivative-free search from the reduced-model or refined constants); 0 = none.
   int fem_calibration_runs = 0;
@@ -193,6 +202,11 @@ struct DiagnosisResult {
   /// still written: the reduced-model result does not depend on it.
   std::string fem_error;
   std::vector<std::vector<double>> refined_params;  ///< per selected effect, after refinement
+  /// The model that refined them ("" = no refinement completed a run; "reduced", "full") and the
+  /// error of the refined constants by that model, pooled and per trial.
+  std::string refined_model;
+  double refined_nrmse = -1.0;
+  std::vector<double> refined_nrmse_per_trial;
   std::string fitted_toml;
   double wall_s = 0.0;
   /// Wall time of the elastic FEM work before the calibrations (path trace, scene-mesh sweep;

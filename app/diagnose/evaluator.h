@@ -91,6 +91,11 @@ class PathModelEvaluator {
   /// True when a run of `variant` costs a static FEM sweep (elastic with gravity), not the reduced model.
   bool uses_fem_sweeps(const Scene& variant) const;
 
+  /// The pressure (Pa) that drives the calibration mesh for an inlet pressure p: p itself, or phi(p)
+  /// with a calibration mesh (interpolated between the sweep's points; identity above the sweep's
+  /// top is never needed: the sweep spans the reference peak, above every inlet pressure).
+  double chamber(double p) const { return map_Pa_.empty() ? p : curve_at(map_Pa_, reference_peak_Pa_, p); }
+
  private:
   /// Per trial, the model angle at the kept frames (kept_only) or at every angle sample.
   std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only) const;
@@ -103,10 +108,6 @@ class PathModelEvaluator {
   /// 24-point map moved it by 1e-4 kPa there, far below the reduced model's own error.
   static constexpr int kMeshCurvePoints = 12;
 
-  /// The pressure that drives the reduced model: p itself, or phi(p) with a calibration mesh
-  /// (interpolated between the sweep's points; identity above the sweep's top is never needed:
-  /// the sweep spans the reference peak, above every inlet pressure).
-  double chamber(double p) const { return map_Pa_.empty() ? p : curve_at(map_Pa_, reference_peak_Pa_, p); }
 
   static std::string fmt_kPa(double p_Pa);
 

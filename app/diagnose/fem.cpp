@@ -1,8 +1,8 @@
-// The full-FEM stages of diagnose (app/diagnose/detail.h): space-mapping refinement of the
-// selected constants (--refine), their local calibration on the FEM itself (--fem-calibrate) and
-// the FEM check of the baseline and fitted scenes (--verify). Apart from the selection because
-// they run after it, on its result, and cost full FEM runs of the recording rather than reduced-
-// model runs.
+// The accurate-model stages of diagnose (app/diagnose/detail.h): space-mapping refinement of the
+// selected constants (--refine, on the reduced-order model or the full FEM), their local
+// calibration on the FEM itself (--fem-calibrate) and the FEM check of the baseline and fitted
+// scenes (--verify). Apart from the selection because they run after it, on its result, and cost
+// runs of a model far slower than the 1-dof path model the selection uses.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,29 +16,64 @@
 
 namespace pneufem::diagnose_detail {
 
+namespace {
+
+/// How an accurate model runs a recording: the full FEM of the user's scene, or the reduced-order
+/// model (engine/rom.h) of the calibration scene, driven by the path model's chamber pressure map
+/// when that is a coarser mesh (PathModelEvaluator::chamber), so that both models of the space
+/// mapping see the same mesh and pressure. Reduced runs are unchecked and never fall back to the
+/// FEM (a diagnosis must not turn into hours of FEM unasked); a failure is that run's failure, as
+/// the FEM's would be.
+struct AccurateModel {
+  bool reduced;
+  const Scene& scene;      ///< the user's scene (full FEM)
+  const Scene& cal_scene;  ///< the calibration scene (reduced model)
+  const PathModelEvaluator& rom;
+  const DiagnoseOptions& opt;
+
+  const char* name() const { return reduced ? "the reduced-order model" : "the full FEM"; }
+
+  DriveResult run(const Recording& rec, const std::vector<std::string>& sets) const {
+    DriveOptions d;
+    d.threads = opt.threads;
+    d.partial_on_failure = true;
+    if (!reduced) return simulate_recording(scene.with(sets), rec, d);
+    std::vector<std::string> s = sets;
+    s.push_back("solver.model=\"reduced\"");
+    d.cache_dir = opt.cache_dir;
+    d.reduced_check = false;
+    d.reduced_fallback = false;
+    if (!rom.pressure_map_Pa().empty()) d.chamber_pressure = [this](double p) { return rom.chamber(p); };
+    return simulate_recording(cal_scene.with(s), rec, d);
+  }
+};
+
+}  // namespace
+
 void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording& rec,
                      const std::vector<ComparedFrame>& frames, const PathModelEvaluator& rom, const DiagnoseOptions& opt,
                      ChosenEffects& chosen, std::vector<std::string>& selected_sets, long& rom_runs,
                      DiagnosisResult& out, std::vector<Series>* fitted_fem) {
-  // Space mapping (output correction): the reduced model is a 1-dof Ritz model and misjudges
+  // Space mapping (output correction): the path model is a 1-dof Ritz model and misjudges
   // strongly localised effects (damage concentrated in the walls) by up to a factor ~2 in angle
-  // change (tests/app/test_path_model.cpp). Each refinement runs the full FEM once at the current
-  // constants, adds its frame-by-frame difference from the reduced model as a fixed correction,
-  // and re-calibrates each selected effect in turn from its current constants. At convergence the
-  // corrected reduced model equals the FEM at the fitted constants, so the constants are the FEM's.
+  // change (tests/app/test_path_model.cpp). Each refinement runs the accurate model (the
+  // reduced-order model, or the full FEM with --refine-model full) once at the current constants,
+  // adds its frame-by-frame difference from the path model as a fixed correction, and
+  // re-calibrates each selected effect in turn from its current constants. At convergence the
+  // corrected path model equals the accurate model at the fitted constants, so the constants are
+  // the accurate model's.
   //
-  // When the FEM cannot follow the constants to the end (typically fatigue: the reduced model
-  // misses the feedback "a damaged wall stretches more, so it damages faster", so its constants
-  // are too aggressive and the FEM's walls fail or reach a limit point), the refinement uses the
-  // frames the FEM did solve: the correction is applied there and the reduced model alone is used
-  // after the failure. Re-calibrating against that moves the constants towards what the FEM can
-  // follow, and the next refinement's FEM gets further (an FEM-verified continuation).
-  auto fem_at_frames = [&](const Scene& s, std::string* failure, double* failure_time_s,
-                           std::vector<Series>* traces = nullptr) {
-    DriveOptions d;
-    d.threads = opt.threads;
-    d.partial_on_failure = true;
-    const DriveResult dr = simulate_recording(s, rec, d);
+  // When the accurate model cannot follow the constants to the end (typically fatigue: the path
+  // model misses the feedback "a damaged wall stretches more, so it damages faster", so its
+  // constants are too aggressive and the FEM's walls fail or reach a limit point), the refinement
+  // uses the frames it did solve: the correction is applied there and the path model alone is used
+  // after the failure. Re-calibrating against that moves the constants towards what the accurate
+  // model can follow, and its next run gets further (a verified continuation).
+  const AccurateModel accurate{opt.refine_model == DiagnoseOptions::RefineModel::Reduced, scene, cal_scene, rom, opt};
+  const AccurateModel full_fem{false, scene, cal_scene, rom, opt};
+  auto at_frames_of = [&](const AccurateModel& model, const std::vector<std::string>& sets, std::string* failure,
+                          double* failure_time_s, std::vector<Series>* traces = nullptr) {
+    const DriveResult dr = model.run(rec, sets);
     *failure = dr.failure;
     *failure_time_s = dr.failure_time_s;
     if (traces) {
@@ -83,35 +118,45 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
     return sets_of(others);
   };
   auto chosen_best = chosen;
-  double best_fem_rss = std::numeric_limits<double>::infinity();  // complete FEM runs only
+  double best_fem_rss = std::numeric_limits<double>::infinity();  // complete accurate-model runs only
+  std::vector<Series> best_traces;                                // ... the angles of the best one
   if (fitted_fem) fitted_fem->clear();
   // Run 0 scores the reduced model's constants and gives the first correction; run k = 1..N scores
   // the k-th re-calibration (and corrects the next). So --refine N costs N + 1 FEM runs, and the
   // constants returned have always been run by the FEM (the last re-calibration too: before
   // 2026-11-26 it was never run, so --refine 1 returned the reduced model's constants unchanged).
-  const int fem_runs = opt.refine > 0 ? opt.refine + 1 : 0;
+  //
+  // With the reduced model only effects with history are re-calibrated: a static effect's constants
+  // (stiffness) change the elastic reference the reduced basis is built for, so each new value would
+  // cost a new offline part, and the path model is exact for them up to the mesh map anyway.
+  auto refinable = [&](const CandidateEffect& c) { return !accurate.reduced || c.history; };
+  const bool any_refinable =
+      std::any_of(chosen.begin(), chosen.end(), [&](const auto& ch) { return refinable(*ch.first); });
+  const int fem_runs = opt.refine > 0 && any_refinable ? opt.refine + 1 : 0;
   for (int it = 0; it < fem_runs && !chosen.empty(); ++it) {
-    if (opt.progress)
-      std::fprintf(stderr, it == 0 ? "diagnose: the reduced model's constants with the full FEM ...\n"
-                                   : "diagnose: refinement %d with the full FEM ...\n", it);
+    if (opt.progress) {
+      if (it == 0) std::fprintf(stderr, "diagnose: the path model's constants with %s ...\n", accurate.name());
+      else std::fprintf(stderr, "diagnose: refinement %d with %s ...\n", it, accurate.name());
+    }
     std::string failure;
     double failure_time_s = -1.0;
     std::vector<Series> traces;
-    const std::vector<double> fem = fem_at_frames(scene.with(selected_sets), &failure, &failure_time_s, &traces);
+    const std::vector<double> fem = at_frames_of(accurate, selected_sets, &failure, &failure_time_s, &traces);
     std::size_t solved = 0;
     for (double v : fem) solved += std::isfinite(v) ? 1 : 0;
     if (!failure.empty()) {
       std::ostringstream m;
-      m << (it == 0 ? std::string("the reduced model's constants") : "refinement " + std::to_string(it))
-        << ": the full FEM stopped at t = " << failure_time_s << " s of trial "
+      m << (it == 0 ? std::string("the path model's constants") : "refinement " + std::to_string(it)) << ": "
+        << accurate.name() << " stopped at t = " << failure_time_s << " s of trial "
         << frames[std::min(solved, frames.size() - 1)].trial_index + 1 << " (" << solved << " of " << frames.size()
-        << " frames solved; corrected there, reduced model alone after): " << failure;
+        << " frames solved; corrected there, path model alone after): " << failure;
       out.fem_error += (out.fem_error.empty() ? "" : "; ") + m.str();
       if (opt.progress) std::fprintf(stderr, "diagnose: %s\n", m.str().c_str());
       if (solved == 0 || it + 1 == fem_runs) break;
     } else {
       const double fem_rss = rss_of(fem, frames);
-      if (opt.progress) std::fprintf(stderr, "diagnose: FEM rss %.4g deg^2 (best before %.4g)\n", fem_rss, best_fem_rss);
+      if (opt.progress)
+        std::fprintf(stderr, "diagnose: rss of %s %.4g deg^2 (best before %.4g)\n", accurate.name(), fem_rss, best_fem_rss);
       if (!(fem_rss < best_fem_rss) && std::isfinite(best_fem_rss)) {
         // Worse than the best complete run: step halfway back, no new correction.
         for (std::size_t j = 0; j < chosen.size(); ++j) {
@@ -127,7 +172,8 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
       }
       best_fem_rss = fem_rss;
       chosen_best = chosen;
-      if (fitted_fem) *fitted_fem = std::move(traces);
+      best_traces = traces;
+      if (fitted_fem && !accurate.reduced) *fitted_fem = std::move(traces);  // --verify need not run them again
       if (it + 1 == fem_runs) break;  // the last run only scores
     }
     const std::vector<double> romv = rom.at_frames(cal_scene.with(selected_sets));
@@ -136,6 +182,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
     for (std::size_t j = 0; j < chosen.size(); ++j) {
       const Scene base_j = cal_scene.with(sets_except(j));
       const CandidateEffect& c = *chosen[j].first;
+      if (!refinable(c)) continue;
       auto rss = [&](const std::vector<double>& v) {
         std::vector<double> m = rom.at_frames(base_j.with(c.sets(base_j, v)));
         for (std::size_t i = 0; i < m.size(); ++i) m[i] += corr[i];
@@ -146,6 +193,13 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
       if (std::isfinite(cal.rss)) chosen[j].second = cal.values;
     }
     selected_sets = sets_of(chosen);
+  }
+  if (!best_traces.empty()) {  // the error of the refined constants, per trial, by the model that refined them
+    const Comparison c = compare_recording(rec, best_traces);
+    out.refined_model = accurate.reduced ? "reduced" : "full";
+    out.refined_nrmse = c.nrmse;
+    out.refined_nrmse_per_trial.clear();
+    for (const TrialComparison& t : c.trials) out.refined_nrmse_per_trial.push_back(t.nrmse);
   }
   if (opt.fem_calibration_runs > 0 && !chosen.empty()) {
     // Local calibration on the FEM itself (each effect in turn, the others at their constants). A
@@ -158,7 +212,10 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
       auto rss = [&](const std::vector<double>& v) {
         std::string failure;
         double t_fail = -1.0;
-        const std::vector<double> fem = fem_at_frames(base_j.with(c.sets(base_j, v)), &failure, &t_fail);
+        std::vector<std::string> sets = sets_except(j);
+        const std::vector<std::string> own = c.sets(base_j, v);
+        sets.insert(sets.end(), own.begin(), own.end());
+        const std::vector<double> fem = at_frames_of(full_fem, sets, &failure, &t_fail);
         if (!failure.empty()) throw PhysicsError("the FEM stopped early: " + failure);
         const double r = rss_of(fem, frames);
         if (opt.progress) {
@@ -178,9 +235,9 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
     }
     selected_sets = sets_of(chosen);
   }
-  if ((opt.refine > 0 || opt.fem_calibration_runs > 0) && !chosen.empty()) {
-    // The result: the constants of the best complete FEM run (the last re-calibration is untested
-    // by the FEM unless it was the best), else the last ones (no FEM run completed).
+  if ((fem_runs > 0 || opt.fem_calibration_runs > 0) && !chosen.empty()) {
+    // The result: the constants of the best complete accurate run (the last re-calibration is
+    // untested unless it was the best), else the last ones (no run completed).
     if (std::isfinite(best_fem_rss)) {
       chosen = chosen_best;
       selected_sets = sets_of(chosen);

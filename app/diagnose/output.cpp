@@ -83,6 +83,11 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     }
     root.add("refined_params", rp + "}");
   }
+  if (!out.refined_model.empty()) {
+    root.add_str("refined_model", out.refined_model);
+    root.add("refined_nrmse", out.refined_nrmse);
+    root.add("refined_nrmse_per_trial", json::array(out.refined_nrmse_per_trial));
+  }
   root.add("noise_floor_nrmse", out.noise_floor_nrmse);
   root.add("final_nrmse", out.final_nrmse);
   root.add("final_nrmse_per_trial", json::array(out.final_nrmse_per_trial));
@@ -145,13 +150,13 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     }
   write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
   write_file_atomic((fs::path(opt.out_dir) / "report.md").string(), diagnosis_report(scene, rec, rom, opt, out));
-  // History: the baseline, then the model after each round (the last is fitted.toml's, whose hash
-  // it carries: with --refine its constants are the refined ones, its errors the reduced model's
-  // before the refinement), each with the error per trial, so the fall shows trial by trial.
+  // History: the baseline, then the model after each round (the path model's errors; the last
+  // round carries fitted.toml's hash only without a refinement), then the refined model by the
+  // model that refined it, each with the error per trial, so the fall shows trial by trial.
   HistoryEntry h;
   h.time_utc = utc_now();
   h.source = "diagnose";
-  h.label = "diagnose baseline (reduced model)";
+  h.label = "diagnose baseline (path model)";
   h.scene_hash = scene_hash(scene);
   h.nrmse = out.baseline_nrmse;
   h.trial_nrmse = out.baseline_nrmse_per_trial;
@@ -161,11 +166,20 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     const ModelAfterRound& m = out.after_round[i];
     h.label = "diagnose";
     for (const std::string& e : m.effects) h.label += " + " + e;
-    h.label += " (reduced model)";
-    h.scene_hash = i + 1 == out.after_round.size() ? scene_hash(fitted) : scene_hash(scene.with(m.sets));
+    h.label += " (path model)";
+    const bool last = i + 1 == out.after_round.size();
+    h.scene_hash = last && out.refined_model.empty() ? scene_hash(fitted) : scene_hash(scene.with(m.sets));
     h.nrmse = m.nrmse;
     h.trial_nrmse = m.nrmse_per_trial;
     h.trial_rmse_deg = m.rmse_deg_per_trial;
+    append_history(opt.out_dir, h);
+  }
+  if (!out.refined_model.empty()) {
+    h.label = "diagnose, refined (" + std::string(out.refined_model == "full" ? "full FEM" : "reduced-order model") + ")";
+    h.scene_hash = scene_hash(fitted);
+    h.nrmse = out.refined_nrmse;
+    h.trial_nrmse = out.refined_nrmse_per_trial;
+    h.trial_rmse_deg.clear();
     append_history(opt.out_dir, h);
   }
 }
@@ -199,7 +213,7 @@ std::string selected_constants_text(const DiagnosisResult& r) {
     e.push_back({&*it, it->params, ""});
   }
   if (r.refined_params.size() == e.size())
-    for (std::size_t i = 0; i < e.size(); ++i) e[i].values = r.refined_params[i], e[i].how = "refined with the FEM";
+    for (std::size_t i = 0; i < e.size(); ++i) e[i].values = r.refined_params[i], e[i].how = r.refined_model == "reduced" ? "refined with the reduced-order model" : "refined with the FEM";
   std::string out;
   for (const Entry& x : e) {
     std::string line = "  " + x.c->effect + ":";

@@ -88,6 +88,14 @@ std::string per_trial_section(const DiagnosisResult& out) {
          at(out.final_rmse_deg_per_trial, k, "%.3f") + " |\n";
   s += "| all | " + fmt("%.4f", out.baseline_nrmse) + " | " + fmt("%.4f", out.final_nrmse) + " | | |\n\n";
   s += "Noise floor (NRMSE the angle tracking noise alone leaves): " + fmt("%.4f", out.noise_floor_nrmse) + ".";
+  if (!out.refined_model.empty()) {
+    s += std::string("\n\nThe constants were refined with the ") +
+         (out.refined_model == "full" ? "full FEM" : "reduced-order model") +
+         " (space mapping, --refine); its error at the refined constants, per trial:";
+    for (std::size_t k = 0; k < out.refined_nrmse_per_trial.size(); ++k)
+      s += (k ? ", " : " ") + fmt("%.4f", out.refined_nrmse_per_trial[k]);
+    s += " (all " + fmt("%.4f", out.refined_nrmse) + ").";
+  }
   if (out.verified_fitted_nrmse >= 0.0)
     s += " Full FEM (--verify): baseline " + fmt("%.4f", out.verified_baseline_nrmse) + ", fitted " +
          fmt("%.4f", out.verified_fitted_nrmse) + ".";
@@ -170,7 +178,7 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
   if (!out.stopped.empty()) s += "Stopped " + out.stopped + ".\n\n";
   for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";
-  if (!out.fem_error.empty()) s += "Full FEM: " + out.fem_error + "\n\n";
+  if (!out.fem_error.empty()) s += "Refinement / full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"
        "- `diagnosis.json`: every number of this report (schema in the README).\n"
        "- `fitted.toml`: the scene plus the selected effects; `pneufem compare fitted.toml --data " + opt.data_path +

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -14,6 +15,7 @@
 
 #include "analysis/hampel.h"
 #include "analysis/steps.h"
+#include "app/simulate/reduced.h"
 #include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
@@ -275,6 +277,47 @@ LoadHistory measured_load(const Recording& rec, const DriveOptions& opt, double 
   return h;
 }
 
+namespace {
+using StateObserver = std::function<void(const StateRecord&, const Eigen::VectorXd&, const std::vector<double>&)>;
+
+/// The reduced model through `load` (app/simulate/reduced.h), each report to `observe` (with the
+/// full displacement and history when checked, empty vectors otherwise). Returns "" when its angles
+/// stand, else why the full FEM must replace them: a report whose estimated angle error exceeds
+/// solver.reduced_check_deg, or a reduced run that failed (the FEM, not the reduction, is the
+/// judge of whether the actuator can follow the load). Without DriveOptions::reduced_fallback a
+/// failure propagates and an estimate above the tolerance is only recorded. Bad input (a scene the reduced model cannot
+/// run) propagates as InputError.
+std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory& load, const DriveOptions& opt,
+                          const StateObserver& observe, DriveResult& result) {
+  if (opt.progress) std::fprintf(stderr, "  reduced model: elastic path and basis ...\n");
+  const std::unique_ptr<ReducedSetup> setup = reduced_setup(scene, peak_pressure(load), bm.solver.reduced, opt.cache_dir);
+  result.reduced_offline_s = setup->offline_s;
+  result.reduced_basis_source = setup->basis_source;
+  bm.load = load;  // the measured pressure replaces the scene's protocol (run_reduced runs bm.load)
+  ReducedRunResult rr;
+  try {
+    rr = run_reduced(*setup, bm, observe, opt.reduced_check);
+  } catch (const PhysicsError& e) {
+    if (!opt.reduced_fallback) throw;
+    return std::string("the reduced model failed: ") + e.what();
+  }
+  result.states = rr.stats.states;
+  result.reduced_worst_check_deg = opt.reduced_check ? rr.worst_check_deg : -1.0;
+  const double tol = bm.solver.reduced_check_deg;
+  if (opt.reduced_check && rr.worst_check_deg > tol && opt.reduced_fallback) {
+    const StateRecord& w = rr.reports[static_cast<std::size_t>(rr.worst_report)].record;
+    char why[320];
+    std::snprintf(why, sizeof why,
+                  "the reduced model's estimated angle error %.3g deg at trial %d, t = %.2f s (%.1f kPa) exceeds "
+                  "solver.reduced_check_deg = %.3g",
+                  rr.worst_check_deg, w.trial, w.time_s, w.pressure_Pa * 1e-3, tol);
+    return why;
+  }
+  result.model = "reduced";
+  return "";
+}
+}  // namespace
+
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
@@ -301,6 +344,9 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     }
     load = std::move(lagged);
   }
+  if (opt.chamber_pressure)
+    for (TrialLoad& tl : load.trials)
+      for (double& p : tl.pressure_Pa) p = opt.chamber_pressure(p);
 
   // Measured angles without outlier frames, only to pick the worst states for VTU output.
   const bool want_vtu = !opt.vtu_dir.empty() && opt.vtu_worst > 0;
@@ -322,7 +368,7 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     if (opt.progress)
       std::fprintf(stderr, "\r  trial %d (%zu/%zu)  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", tt.trial, k + 1,
                    rec.trials.size(), t, r.pressure_Pa * 1e-3, r.angle_deg);
-    if (!want_vtu) return;
+    if (!want_vtu || u.size() == 0) return;  // an unchecked reduced run has no full fields
     const double meas = value_at(measured[k], t);
     if (!std::isfinite(meas)) return;
     const double a = std::abs(r.angle_deg - meas);
@@ -333,10 +379,30 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     worst.insert(pos, std::move(c));
     if (static_cast<int>(worst.size()) > opt.vtu_worst) worst.pop_back();
   };
-  QuasiStaticRun run(asmb, bm->solver.quasi_static);
+  auto clear_traces = [&] {
+    for (TrialTrace& tt : result.trials) tt.states_angle_deg = tt.states_pressure_kPa = Series();
+    worst.clear();
+  };
   std::size_t failed_trial = rec.trials.size();  // index of the trial that stopped early
   try {
-    run.run(load, observe);
+    const bool reduced =
+        bm->solver.mode == SolverSettings::Mode::QuasiStatic && bm->solver.model == SolverSettings::Model::Reduced;
+    const std::string fallback = reduced ? drive_reduced(scene, *bm, load, opt, observe, result) : std::string();
+    if (!fallback.empty()) {
+      clear_traces();
+      result.model = "full (fallback: " + fallback + ")";
+      if (opt.progress) std::fprintf(stderr, "\n  %s\n", result.model.c_str());
+    }
+    if (!reduced || !fallback.empty()) {
+      QuasiStaticRun run(asmb, bm->solver.quasi_static);
+      try {
+        run.run(load, observe);
+      } catch (...) {
+        result.states = run.stats().states;
+        throw;
+      }
+      result.states = run.stats().states;
+    }
   } catch (const PhysicsError& e) {
     if (!opt.partial_on_failure) throw;
     result.failure = e.what();
@@ -347,7 +413,6 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     result.failure_time_s = solved.t_s.empty() ? 0.0 : solved.t_s.back();
   }
   if (opt.progress) std::fprintf(stderr, "\n");
-  result.states = run.stats().states;
   result.mesh = bm->stats;
 
   for (std::size_t k = 0; k < rec.trials.size(); ++k) {

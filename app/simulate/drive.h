@@ -32,6 +32,14 @@
 // around it (frames before the first / after the last state of the trial take that state's
 // angle). Physics failures propagate as PhysicsError; bad input (a trial without pressure)
 // throws InputError naming the data file and trial. Results do not depend on `threads`.
+//
+// Model. A scene with solver.model = "reduced" is driven through the reduced-order model
+// (app/simulate/reduced.h): its offline part is traced for the measured load's peak and cached in
+// DriveOptions::cache_dir. With `reduced_check` every report is checked against the full residual
+// as `simulate` does; a reduced run whose estimated angle error exceeds solver.reduced_check_deg,
+// or that fails, is replaced by the full FEM, and DriveResult::model says so. Without the check
+// (calibration loops, which only need angles) the reduced run's angles are used as they are.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,6 +61,18 @@ struct DriveOptions {
   /// On a PhysicsError (e.g. the actuator past its limit point): false = rethrow; true = return
   /// the frames solved so far (later frames NaN) with DriveResult::failure set.
   bool partial_on_failure = false;
+  /// Reduced model only: the cache of its offline part ("" = computed each call) and whether the
+  /// reports are checked (one whole-mesh replay; false = no VTU of worst states either).
+  std::string cache_dir;
+  bool reduced_check = true;
+  /// Reduced model only: replace a run that fails or whose check exceeds the tolerance by the full
+  /// FEM (false: a failure propagates as PhysicsError, an estimate above the tolerance is only
+  /// recorded; for callers that never want the FEM's cost, e.g. diagnose's refinement).
+  bool reduced_fallback = true;
+  /// Applied to every pressure of the load after the lag (inlet Pa -> chamber Pa; empty = none):
+  /// diagnose drives a coarser calibration mesh with the pressure at which it bends as the scene's
+  /// mesh does (app/diagnose/evaluator.h).
+  std::function<double(double)> chamber_pressure;
 };
 
 struct TrialTrace {
@@ -78,6 +98,11 @@ struct DriveResult {
   MeshStats mesh;                  ///< statistics of the model's mesh (regions: elements_per_region)
   std::string failure;             ///< why the run stopped early ("" = it completed; partial_on_failure)
   double failure_time_s = -1.0;    ///< recording time of the last solved state of the failed trial
+  /// Which model made the angles: "full", "reduced", or "full (fallback: <why>)".
+  std::string model = "full";
+  double reduced_offline_s = 0.0;   ///< reduced model: wall time of its offline part (trace + basis, or reading them)
+  std::string reduced_basis_source; ///< reduced model: "computed" or "cache <file>"
+  double reduced_worst_check_deg = -1.0;  ///< reduced model, checked: largest estimated angle error over the reports
 };
 
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt);

@@ -94,7 +94,13 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
   const ReducedOrderModel rom(setup.reference->model, setup.basis, bm.model);
   ReducedRun run(rom, bm.solver.quasi_static);
   std::vector<StateRecord> records;
-  run.run(bm.load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) { records.push_back(r); });
+  // Unchecked, each report goes to at_report as it is solved (without fields), so a run that fails
+  // part-way has shown the reports before the failure.
+  const Eigen::VectorXd no_field;
+  run.run(bm.load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) {
+    records.push_back(r);
+    if (!check && at_report) at_report(r, no_field, {});
+  });
   res.stats = run.stats();
   if (!check) {
     for (const StateRecord& r : records) res.reports.push_back({r, ReducedCheck{}});

@@ -56,7 +56,8 @@ struct ReducedRunResult {
 /// Runs `bm` (the scene's model, same mesh as the setup's reference) through its load with the
 /// reduced model, replays the history and checks every report. `at_report` (optional) sees each
 /// report's record, full displacement and whole-mesh history, in order, after the replay.
-/// `check` = false: no replay (no at_report calls, no indicator): the reports of the run alone.
+/// `check` = false: no replay and no indicator: the reports of the run alone, each passed to
+/// `at_report` as it is solved, with empty displacement and history.
 ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
                              const std::function<void(const StateRecord&, const Eigen::VectorXd&, const std::vector<double>&)>&
                                  at_report = nullptr,

@@ -61,6 +61,7 @@ DiagnoseOptions hidden_options(const std::string& name, const std::string& out, 
   o.max_effects = max_effects;
   o.candidates = std::move(candidates);
   o.cache_dir = shared_cache();
+  o.refine = 0;  // the path model's selection and constants; the refinement: DiagnoseRefinement.*
   return o;
 }
 
@@ -287,6 +288,7 @@ TEST(DiagnoseFem, OneRefinementMovesTheConstantsToTheFems) {
   const fs::path dir = softer_silicone_recording(scene, "pneufem_diag_refine");
   DiagnoseOptions o = stiffness_only(dir);
   o.refine = 1;
+  o.refine_model = DiagnoseOptions::RefineModel::Full;
   const DiagnosisResult r = run_diagnosis(scene, o);
   ASSERT_EQ(r.refined_params.size(), 1u);
   const double rom_scale = r.candidates.front().params[0], refined = r.refined_params[0][0];

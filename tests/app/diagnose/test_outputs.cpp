@@ -75,6 +75,7 @@ class DiagnoseOutputs : public ::testing::Test {
       o.max_effects = 2;
       o.max_evaluations = 15;  // the outputs are the point here, not the last digit of the fit
       o.cache_dir = (dir_ / "cache").string();
+      o.refine = 0;  // the path model's outputs; a refinement's: DiagnoseRefinement.* (test_command.cpp)
       return o;
     };
     first_result_ = run_diagnosis(Scene::load("", kScene), options("first.csv", "first"));
@@ -146,7 +147,7 @@ TEST_F(DiagnoseOutputs, HistoryCarriesTheErrorPerTrialOfEveryModel) {
   EXPECT_EQ(h.front().trial_rmse_deg, second_result_.baseline_rmse_deg_per_trial);
   EXPECT_EQ(h.back().trial_nrmse, second_result_.final_nrmse_per_trial);
   EXPECT_EQ(h.back().trial_rmse_deg, second_result_.final_rmse_deg_per_trial);
-  EXPECT_EQ(h.back().label, "diagnose + stiffness (reduced model)");
+  EXPECT_EQ(h.back().label, "diagnose + stiffness (path model)");
   const nlohmann::json j = diagnosis_json("second");
   EXPECT_EQ(j["final_nrmse_per_trial"].get<std::vector<double>>(), h.back().trial_nrmse);
   for (std::size_t k = 0; k < 2; ++k) EXPECT_LT(h.back().trial_nrmse[k], h.front().trial_nrmse[k]) << "trial " << k + 1;

@@ -242,6 +242,33 @@ TEST_F(DriveTest, PartialRunOnFailureKeepsTheSolvedFrames) {
   EXPECT_GT(r.failure_time_s, 4.0);
 }
 
+// DriveOptions::chamber_pressure maps every pressure of the load (diagnose drives a coarser mesh
+// with the pressure at which it bends as the scene's mesh does): halving it is the same run as a
+// recording of half the pressure. Exactly: halving a noise-free staircase keeps its breakpoints
+// (the 0.05 kPa simplification tolerance is met by both) and 0.5 p is exact in binary.
+TEST_F(DriveTest, ChamberPressureMapDrivesTheMappedPressure) {
+  DriveOptions opt;
+  opt.threads = 2;
+  opt.chamber_pressure = [](double p) { return 0.5 * p; };
+  const DriveResult mapped = simulate_recording(scene(), sampled_staircase(scene(), 0.0, 1), opt);
+  Recording half = sampled_staircase(scene(), 0.0, 1);
+  for (TrialRecording& tr : half.trials)
+    for (double& p : tr.pressure_kPa.value) p *= 0.5;
+  opt.chamber_pressure = nullptr;
+  const DriveResult direct_half = simulate_recording(scene(), half, opt);
+  ASSERT_EQ(mapped.trials.size(), direct_half.trials.size());
+  for (std::size_t k = 0; k < mapped.trials.size(); ++k) {
+    EXPECT_EQ(mapped.trials[k].states_pressure_kPa.value, direct_half.trials[k].states_pressure_kPa.value);
+    for (std::size_t j = 0; j < mapped.trials[k].angle_deg.value.size(); ++j)
+      EXPECT_NEAR(mapped.trials[k].angle_deg.value[j], direct_half.trials[k].angle_deg.value[j], 1e-9);
+  }
+  const auto top = [](const DriveResult& r) {
+    const std::vector<double>& a = r.trials[0].states_angle_deg.value;
+    return *std::max_element(a.begin(), a.end(), [](double x, double y) { return std::abs(x) < std::abs(y); });
+  };
+  EXPECT_LT(std::abs(top(mapped)), 0.8 * std::abs(top(clean()))) << "the map must change the angles for this test to mean anything";
+}
+
 TEST(Drive, CreepCarriesOverBetweenTrialsAsInADirectRun) {
   // Viscoelastic silicone (one Prony term, tau = 2 s, so a 3 s hold creeps visibly and trial 2
   // starts before trial 1's creep has recovered). Both runs solve the same pressures but at
