@@ -440,6 +440,20 @@ Scene elastic_reference_scene(const Scene& scene) {
   return scene.with(sets);
 }
 
+LoadHistory chamber_load(const Scene& s) {
+  LoadHistory load = inlet_load(s);
+  // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
+  // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
+  // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
+  const double lag_s = s.number("load.pressure_lag_s");
+  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
+    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
+  if (lag_s > 0.0)
+    load = apply_pressure_lag(load, lag_s,
+                              s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+  return load;
+}
+
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
   const std::string source = s.string("mesh.source");
   if (source == "pneunet") return built_in_mesh(s);
@@ -537,17 +551,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   set_rig_gravity(s, model);
   out->stats = compute_stats(mesh);
 
-  // Load.
-  out->load = inlet_load(s);
-  // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
-  // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
-  // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
-  const double lag_s = s.number("load.pressure_lag_s");
-  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
-    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
-  if (lag_s > 0.0)
-    out->load = apply_pressure_lag(out->load, lag_s,
-                                   s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+  out->load = chamber_load(s);
 
   out->solver = solver_settings(s);
 

@@ -60,6 +60,9 @@ std::unique_ptr<BuiltModel> build_model(const Scene& scene);
 /// The scene's inlet pressure history ([load]: the staircase or load.csv), before any chamber lag
 /// (load.pressure_lag_s acts on it in build_model and when a recording is driven). Cheap: no mesh.
 LoadHistory inlet_load(const Scene& scene);
+/// The chambers' pressure history: the inlet's through load.pressure_lag_s, the load of
+/// build_model. Cheap: no mesh.
+LoadHistory chamber_load(const Scene& scene);
 
 /// Load history from a pressure CSV (columns trial,time_s,pressure_kPa; other columns and rows
 /// without a pressure value are ignored). The 400 Hz signal is simplified to a piecewise-linear

@@ -42,6 +42,19 @@ std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app) {
   sw->add_option("--threads-per-job", sweep.threads_per_job, "Threads of each worker process")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
+  sw->add_option("--model", sweep.model,
+                 "The model of every point: reduced (the reduced-order model: one offline part per actuator, ~25 min on the "
+                 "default mesh, shared by the points through DIR/rom_cache; then seconds to minutes per point, checked at "
+                 "every report, falling back to the full FEM above solver.reduced_check_deg), full (the full FEM: ~30 min "
+                 "per trial on the default mesh with effects on), or auto: reduced when every point has the same elastic "
+                 "reference (the swept keys are effect constants, gravity or protocol), else full. Overrides the scene's "
+                 "solver.model")
+      ->check(CLI::IsMember({"auto", "full", "reduced"}))
+      ->capture_default_str();
+  sw->add_option("--fem-points", sweep.fem_points,
+                 "Comma-separated points (the point column of sweep.csv) to run again with the full FEM after a reduced "
+                 "sweep, into DIR/points/NNNN/fem/; sweep.csv gets their FEM NRMSE and largest |reduced - FEM| angle")
+      ->delimiter(',');
   sw->add_option("--set", sweep.sets, "Override a scene key at every point, e.g. --set load.trials=10 (repeatable)");
   sw->add_flag("--dry-run", sweep.dry_run, "List the points and exit without running them");
   return c;
@@ -56,7 +69,9 @@ int run_sweep_command(SweepCommand& c, const std::string& command_line) {
   std::printf("sweep: %zu points, %d ok (%d skipped), %d failed, %.1f s; table %s\n", r.points.size(), r.ok, r.skipped,
               r.failed, r.wall_s, (fs::path(sweep.out_dir) / "sweep.csv").c_str());
   if (r.failed > 0) std::fprintf(stderr, "error: %d of %zu points failed (their errors are in sweep.csv)\n", r.failed, r.points.size());
-  return r.failed > 0 ? 1 : 0;
+  if (r.fem_failed > 0)
+    std::fprintf(stderr, "error: %d FEM re-run(s) of --fem-points failed (their errors are in sweep.csv)\n", r.fem_failed);
+  return r.failed > 0 || r.fem_failed > 0 ? 1 : 0;
 }
 
 }  // namespace pneufem

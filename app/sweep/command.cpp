@@ -15,10 +15,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
 #include <random>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -30,6 +32,7 @@
 #include "core/output_dir.h"
 #include "core/json_writer.h"
 #include "core/version.h"
+#include "scenes/build_model.h"
 #include "scenes/scene.h"
 #include "viz/svg_plot.h"
 
@@ -95,17 +98,36 @@ std::optional<std::string> run_status(const nlohmann::json& summary) {
   return status.get<std::string>();
 }
 
-double last_angle(const fs::path& angles_csv) {
-  std::ifstream in(angles_csv);
-  std::string line, last;
-  std::getline(in, line);  // header
-  while (std::getline(in, line))
-    if (!line.empty()) last = line;
-  double angle = kNaN;
+/// One row of a run's angles.csv (trial,time_s,pressure_kPa,angle_deg): a report.
+struct ReportAngle {
   int trial = 0;
-  double t = 0, p = 0;
-  if (!last.empty() && std::sscanf(last.c_str(), "%d,%lf,%lf,%lf", &trial, &t, &p, &angle) != 4) angle = kNaN;
-  return angle;
+  double time_s = 0.0, angle_deg = 0.0;
+};
+
+/// The reports of angles.csv, in order; rows that do not read as four numbers are left out.
+std::vector<ReportAngle> read_angles(const fs::path& angles_csv) {
+  std::ifstream in(angles_csv);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<ReportAngle> reports;
+  for (ReportAngle r; std::getline(in, line);) {
+    double p = 0;
+    if (std::sscanf(line.c_str(), "%d,%lf,%lf,%lf", &r.trial, &r.time_s, &p, &r.angle_deg) == 4) reports.push_back(r);
+  }
+  return reports;
+}
+
+/// Which model made a finished run's reports, from its summary.json: the reduced_model entry is
+/// there only when the reduced model was asked for, and its fallback says whether the full FEM
+/// replaced it ("full FEM: <reason>").
+std::string model_that_ran(const nlohmann::json& summary) {
+  const nlohmann::json& fallback = member(member(summary, "reduced_model"), "fallback");
+  if (!fallback.is_string()) return "full";
+  std::string why = fallback.get<std::string>();
+  if (why == "none") return "reduced";
+  const std::string prefix = "full FEM: ";
+  if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+  return "full (fallback: " + why + ")";
 }
 
 /// The last non-empty lines of a log, joined, at most `max_chars` (the reason a worker failed).
@@ -140,13 +162,16 @@ void read_point(SweepPoint& pt, const fs::path& dir, int exit_code, double measu
   const nlohmann::json& trials = member(metrics, "trials");
   if (trials.is_array())
     for (const nlohmann::json& t : trials) pt.nrmse.push_back(number_or_nan(member(t, "nrmse")));
-  pt.final_angle_deg = last_angle(dir / "angles.csv");
+  const std::vector<ReportAngle> reports = read_angles(dir / "angles.csv");
+  pt.final_angle_deg = reports.empty() ? kNaN : reports.back().angle_deg;
   if (status && *status == "ok" && exit_code <= 0) {
     pt.status = "ok";
+    pt.model = model_that_ran(summary);
     pt.error.clear();
     return;
   }
   pt.status = "failed";
+  pt.model.clear();
   if (status && *status != "ok") {
     pt.error = *status;
   } else {
@@ -155,6 +180,34 @@ void read_point(SweepPoint& pt, const fs::path& dir, int exit_code, double measu
                                  : "exit code " + std::to_string(exit_code)) +
                (tail.empty() ? "" : ": " + tail);
   }
+}
+
+double final_nrmse(const SweepPoint& p) { return p.nrmse.empty() ? kNaN : p.nrmse.back(); }
+
+/// Fills a --fem-points comparison from the point's run directory and its FEM run in DIR/fem:
+/// the FEM's NRMSE, and the largest angle difference over the reports, which both runs make at
+/// the same times (the protocol's, whatever the model).
+void read_fem_comparison(SweepPoint& pt, const fs::path& dir, int exit_code) {
+  SweepPoint fem_run;
+  read_point(fem_run, dir / "fem", exit_code, 0.0);
+  FemComparison& c = pt.fem.emplace();
+  c.status = fem_run.status;
+  c.error = fem_run.error;
+  c.final_nrmse = final_nrmse(fem_run);
+  if (c.status != "ok") return;
+  const std::vector<ReportAngle> point = read_angles(dir / "angles.csv"), fem = read_angles(dir / "fem" / "angles.csv");
+  const auto same_report = [](const ReportAngle& a, const ReportAngle& b) {
+    return a.trial == b.trial && std::abs(a.time_s - b.time_s) <= 1e-5;  // angles.csv writes 6 decimals
+  };
+  if (point.empty() || point.size() != fem.size() || !std::equal(point.begin(), point.end(), fem.begin(), same_report)) {
+    c.status = "failed";
+    c.error = "the FEM run's reports (" + std::to_string(fem.size()) + ") are not those of the point's run (" +
+              std::to_string(point.size()) + "): nothing to compare";
+    return;
+  }
+  double worst = 0.0;
+  for (std::size_t k = 0; k < point.size(); ++k) worst = std::max(worst, std::abs(point[k].angle_deg - fem[k].angle_deg));
+  c.max_abs_diff_deg = std::round(worst * 1e6) / 1e6;  // the angles' 6 decimals, without the subtraction's noise
 }
 
 /// The worker's exit code (128 + signal when it was killed).
@@ -237,15 +290,16 @@ std::size_t max_trials(const std::vector<SweepPoint>& points) {
   return k;
 }
 
-double final_nrmse(const SweepPoint& p) { return p.nrmse.empty() ? kNaN : p.nrmse.back(); }
-
 std::string sweep_csv(const std::vector<ParamSpec>& params, const std::vector<SweepPoint>& points) {
   const std::size_t K = max_trials(points);
   std::string s = "point";
   for (const ParamSpec& p : params) s += "," + (p.key.find_first_of(",\"") == std::string::npos ? p.key : csv_quote(p.key));
-  s += ",status,wall_s,final_nrmse";
+  const bool fem = std::any_of(points.begin(), points.end(), [](const SweepPoint& q) { return q.fem.has_value(); });
+  s += ",status,model,wall_s,final_nrmse";
   for (std::size_t k = 1; k <= K; ++k) s += ",nrmse_trial_" + std::to_string(k);
-  s += ",final_angle_deg,error\n";
+  s += ",final_angle_deg";
+  if (fem) s += ",fem_final_nrmse,max_abs_reduced_minus_fem_deg";
+  s += ",error\n";
   // Field by field (appending, not concatenating temporaries).
   const auto field = [&s](const std::string& f) {
     s += ',';
@@ -256,11 +310,19 @@ std::string sweep_csv(const std::vector<ParamSpec>& params, const std::vector<Sw
     for (const std::string& t : pt.texts) field(t);
     const bool done = pt.status != "pending";
     field(pt.status);
+    field(pt.model.find_first_of(",\"") == std::string::npos ? pt.model : csv_quote(pt.model));
     field(done ? csv_num(pt.wall_s, "%.3f") : "");
     field(csv_num(final_nrmse(pt)));
     for (std::size_t k = 0; k < K; ++k) field(k < pt.nrmse.size() ? csv_num(pt.nrmse[k]) : "");
     field(done ? csv_num(pt.final_angle_deg) : "");
-    field(pt.error.empty() ? "" : csv_quote(pt.error));
+    if (fem) {
+      field(pt.fem ? csv_num(pt.fem->final_nrmse) : "");
+      field(pt.fem ? csv_num(pt.fem->max_abs_diff_deg) : "");
+    }
+    // A failed FEM re-run is the point's error too (its own run succeeded, or there is no FEM run).
+    std::string error = pt.error;
+    if (pt.fem && pt.fem->status == "failed" && pt.status == "ok") error = "FEM re-run: " + pt.fem->error;
+    field(error.empty() ? "" : csv_quote(error));
     s += '\n';
   }
   return s;
@@ -353,12 +415,22 @@ std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& para
         .add_str("dir", "points/" + point_name(q.index))
         .add("values", values.str(6))
         .add_str("status", q.status)
+        .add_str("model", q.model)
         .add("skipped", q.skipped ? "true" : "false")
         .add("wall_s", q.status == "pending" ? kNaN : q.wall_s)
         .add("final_nrmse", final_nrmse(q))
         .add("nrmse_trials", json::array(q.nrmse))
         .add("final_angle_deg", q.final_angle_deg)
         .add_str("error", q.error);
+    if (q.fem) {
+      json::Object fem;
+      fem.add_str("dir", "points/" + point_name(q.index) + "/fem")
+          .add_str("status", q.fem->status)
+          .add("final_nrmse", q.fem->final_nrmse)
+          .add("max_abs_reduced_minus_fem_deg", q.fem->max_abs_diff_deg)
+          .add_str("error", q.fem->error);
+      e.add("fem", fem.str(6));
+    }
     pts += (i ? ",\n    " : "\n    ") + e.str(4);
   }
   pts += "\n  ]";
@@ -372,12 +444,17 @@ std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& para
       .add("seed", o.lhs > 0 ? json::num(static_cast<double>(o.seed)) : "null")
       .add("params", ps)
       .add("sets", sets)
+      .add_str("model", r.model)
+      .add_str("model_reason", r.model_reason)
+      .add("offline_parts", r.offline_parts)
+      .add("fem_points", json::array(std::vector<double>(o.fem_points.begin(), o.fem_points.end())))
       .add("jobs", o.jobs)
       .add("threads_per_job", o.threads_per_job)
       .add("points_total", static_cast<double>(r.points.size()))
       .add("ok", r.ok)
       .add("failed", r.failed)
       .add("skipped", r.skipped)
+      .add("fem_failed", r.fem_failed)
       .add("wall_s", r.wall_s)
       .add_str("metric", have_nrmse ? "final_nrmse" : "final_angle_deg")
       .add("best_point", best ? json::num(best->index) : "null")
@@ -396,6 +473,279 @@ std::string describe(const std::vector<ParamSpec>& params, const SweepPoint& pt)
   std::string s;
   for (std::size_t j = 0; j < params.size(); ++j) s += (j ? " " : "") + params[j].key + "=" + pt.texts[j];
   return s;
+}
+
+// --- the model the workers run ---
+
+/// What the reduced model's offline part of a point depends on (app/simulate/reduced.h).
+struct OfflineKeys {
+  /// The actuator: the elastic reference without [load], [output] and [solver]. Points with one
+  /// actuator differ only in effect constants, gravity or protocol, and can share a basis.
+  std::string actuator;
+  /// The offline part itself, the cache key of reduced_setup but for the executable and the mesh
+  /// bytes (both fixed by the scene): the elastic reference with its solver (Newton tolerance,
+  /// basis options) and the chambers' peak pressure, which sets the traced range.
+  std::string offline;
+};
+
+/// The offline keys of a point's scene; none when its load cannot be built (the point will fail
+/// in its worker and say why).
+std::optional<OfflineKeys> offline_keys(const Scene& scene) {
+  try {
+    const Scene reference = elastic_reference_scene(scene);
+    double peak_Pa = 0.0;
+    for (const TrialLoad& trial : chamber_load(scene).trials)
+      for (double p : trial.pressure_Pa) peak_Pa = std::max(peak_Pa, p);
+    return OfflineKeys{reference.model_toml_without({"load", "output", "solver"}),
+                       reference.model_toml_without({"load", "output"}) + "\npeak_Pa = " + json::num(peak_Pa)};
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
+/// The model of a sweep's workers and its offline parts.
+struct ModelPlan {
+  bool reduced = false;
+  std::string why;          ///< for the log and sweep.json
+  std::vector<int> offline;  ///< per point: its offline part (0, 1, ...), -1 = unknown; reduced only
+  int offline_parts = 0;
+};
+
+/// The swept keys that change the actuator, for the log: each key in which the first point of
+/// another actuator differs from point `a`, set alone on point `a`'s scene; all of those keys
+/// when none does it alone.
+std::string keys_changing_actuator(const Scene& base, const std::vector<ParamSpec>& params,
+                                   const std::vector<std::vector<std::string>>& overrides,
+                                   const std::vector<std::optional<OfflineKeys>>& keys, std::size_t a) {
+  std::size_t b = a;
+  while (b < keys.size() && (!keys[b] || keys[b]->actuator == keys[a]->actuator)) ++b;
+  std::vector<std::string> differing, alone;
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    if (overrides[a][j] == overrides[b][j]) continue;
+    differing.push_back(params[j].key);
+    std::vector<std::string> ov = overrides[a];
+    ov[j] = overrides[b][j];
+    std::optional<OfflineKeys> k;
+    try {
+      k = offline_keys(base.with(ov));
+    } catch (const InputError&) {  // a combination of values no point has may be invalid: not this key alone
+      continue;
+    }
+    if (!k || k->actuator != keys[a]->actuator) alone.push_back(params[j].key);
+  }
+  const std::vector<std::string>& culprits = alone.empty() ? differing : alone;
+  std::string s;
+  for (std::size_t i = 0; i < culprits.size(); ++i) s += (i ? (i + 1 == culprits.size() ? " and " : ", ") : "") + culprits[i];
+  return s + (culprits.size() > 1 ? " change" : " changes");
+}
+
+/// --model applied to the points: auto takes the reduced model when every point has one actuator.
+/// `keys` are the points' offline keys (none with --model full).
+ModelPlan plan_model(const SweepOptions& o, const Scene& base, const std::vector<ParamSpec>& params,
+                     const std::vector<std::vector<std::string>>& overrides,
+                     const std::vector<std::optional<OfflineKeys>>& keys) {
+  ModelPlan plan;
+  if (o.model == "full") {
+    plan.why = "full FEM (--model full)";
+    return plan;
+  }
+  const std::string mode = base.string("solver.mode");
+  if (mode != "quasi_static") {
+    const std::string why = "the reduced model runs quasi-static scenes only, and solver.mode = \"" + mode + "\" (" +
+                            base.origin("solver.mode") + ")";
+    if (o.model == "reduced") throw InputError("--model reduced: " + why);
+    plan.why = "full FEM: " + why;
+    return plan;
+  }
+  std::map<std::string, int> actuators, offline_parts;
+  std::optional<std::size_t> first_known;
+  plan.offline.assign(keys.size(), -1);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (!keys[i]) continue;
+    if (!first_known) first_known = i;
+    actuators.emplace(keys[i]->actuator, static_cast<int>(actuators.size()));
+    plan.offline[i] = offline_parts.emplace(keys[i]->offline, static_cast<int>(offline_parts.size())).first->second;
+  }
+  plan.offline_parts = static_cast<int>(offline_parts.size());
+  const std::string parts = std::to_string(plan.offline_parts) + " offline part" + (plan.offline_parts == 1 ? "" : "s");
+  if (actuators.size() <= 1) {
+    plan.reduced = true;
+    plan.why = "reduced model" + std::string(o.model == "reduced" ? " (--model reduced)" : "") +
+               ": every point has the same elastic reference (the swept keys are effect constants, gravity or protocol), " +
+               (plan.offline_parts <= 1 ? std::string("so the points share one offline part (elastic path and basis), built once")
+                                        : "but the chambers' peak pressure (the traced range) or the basis options differ: " +
+                                              parts + " (elastic path and basis), each built once") +
+               " in rom_cache/";
+    return plan;
+  }
+  const std::string culprits = keys_changing_actuator(base, params, overrides, keys, *first_known);
+  const std::string distinct = std::to_string(actuators.size()) + " distinct actuators";
+  if (o.model == "auto") {
+    plan.offline.clear();
+    plan.offline_parts = 0;
+    plan.why = "full FEM: " + culprits + " the elastic reference, which the reduced model's basis is built for (" +
+               distinct + "; --model reduced would build one offline part per actuator)";
+    return plan;
+  }
+  plan.reduced = true;
+  plan.why = "reduced model (--model reduced): " + culprits + " the elastic reference (" + distinct +
+             "), which costs one offline part per distinct actuator: " + parts + ", in rom_cache/";
+  return plan;
+}
+
+/// A `pneufem simulate` worker: the point (its index in the sweep's points) and its command.
+struct Worker {
+  std::size_t i = 0;
+  fs::path dir;  ///< its run directory, emptied before it starts
+  std::vector<std::string> argv;
+};
+
+/// Where and how a sweep's workers run.
+struct WorkerSetup {
+  const SweepOptions& o;
+  fs::path out;           ///< the sweep directory
+  std::string scene_abs;  ///< the scene file, absolute ("" = the built-in default)
+  int jobs = 1;           ///< workers at a time
+
+  /// The command of a worker writing `dir`: the scene, the sweep's --set, the point's `overrides`;
+  /// with `rom_cache`, the reduced model's cache.
+  std::vector<std::string> argv(const fs::path& dir, const std::vector<std::string>& overrides, bool rom_cache) const;
+};
+
+std::vector<std::string> WorkerSetup::argv(const fs::path& dir, const std::vector<std::string>& overrides, bool rom_cache) const {
+  std::vector<std::string> argv = {o.exe, "simulate"};
+  if (!scene_abs.empty()) argv.push_back(scene_abs);
+  // Full-FEM points share one ideal elastic model per actuator (app/simulate/ideal_cache.h): a sweep
+  // over damage constants computes it once instead of once per point (a reduced run computes its
+  // own with the reduced model, in seconds).
+  for (const std::string& a : {std::string("--out"), dir.string(), std::string("--threads"), std::to_string(o.threads_per_job),
+                               std::string("--ideal-cache"), (out / "ideal_cache").string()})
+    argv.push_back(a);
+  if (rom_cache) argv.insert(argv.end(), {"--cache", (out / "rom_cache").string()});
+  for (const std::string& s : o.sets) argv.insert(argv.end(), {"--set", s});
+  for (const std::string& s : overrides) argv.insert(argv.end(), {"--set", s});
+  return argv;
+}
+
+/// Runs `workers`, at most `jobs` at a time; `finished(worker, exit code, measured wall time)` as
+/// each ends, in the order they end.
+void run_workers(const std::vector<Worker>& workers, int jobs,
+                 const std::function<void(const Worker&, int, double)>& finished) {
+  struct Running {
+    pid_t pid;
+    const Worker* worker;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::vector<Running> running;
+  std::size_t next = 0;
+  while (next < workers.size() || !running.empty()) {
+    while (next < workers.size() && static_cast<int>(running.size()) < jobs) {
+      const Worker& w = workers[next++];
+      fs::remove_all(w.dir);  // an interrupted, failed or changed point starts clean
+      fs::create_directories(w.dir);
+      running.push_back({launch(w.argv, w.dir / "log.txt"), &w, std::chrono::steady_clock::now()});
+    }
+    bool any = false;
+    for (std::size_t r = 0; r < running.size();) {
+      int st = 0;
+      const pid_t w = waitpid(running[r].pid, &st, WNOHANG);
+      if (w == 0 || (w < 0 && errno == EINTR)) {
+        ++r;
+        continue;
+      }
+      any = true;
+      const Running done = running[r];
+      running.erase(running.begin() + static_cast<std::ptrdiff_t>(r));
+      const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - done.start).count();
+      finished(*done.worker, w < 0 ? 1 : exit_code_of(st), measured);
+    }
+    if (!any && !running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+/// The points of --fem-points, each once; InputError for one the sweep does not have.
+std::set<int> checked_fem_points(const std::vector<int>& given, std::size_t points) {
+  std::set<int> fem_points;
+  for (int index : given) {
+    if (index < 1 || static_cast<std::size_t>(index) > points)
+      throw InputError("--fem-points " + std::to_string(index) + ": no such point; the sweep's points are 1 to " +
+                       std::to_string(points) + " (the point column of sweep.csv, or --dry-run)");
+    fem_points.insert(index);
+  }
+  return fem_points;
+}
+
+/// The workers in two waves. The reduced model's offline part is built by the first point that
+/// needs it, alone, and read from rom_cache/ by the others: started together, every point of an
+/// actuator would wait on the cache's lock for it, each holding a worker slot. The first wave has
+/// the first point of each offline part (distinct parts are built in parallel), the second the
+/// rest; with the full FEM, the first wave is empty.
+std::pair<std::vector<Worker>, std::vector<Worker>> offline_waves(std::vector<Worker> workers, const ModelPlan& plan) {
+  std::vector<Worker> first, rest;
+  std::set<int> started;
+  for (Worker& w : workers) {
+    const bool builds_offline = plan.reduced && plan.offline[w.i] >= 0 && started.insert(plan.offline[w.i]).second;
+    (builds_offline ? first : rest).push_back(std::move(w));
+  }
+  return {std::move(first), std::move(rest)};
+}
+
+/// A finished point for the log: its values, status, model (of a reduced sweep), time, NRMSE, error.
+std::string outcome_line(const std::vector<ParamSpec>& params, const SweepPoint& pt, bool reduced) {
+  std::string line = "point " + point_name(pt.index) + " " + describe(params, pt) + ": " + pt.status;
+  if (pt.status == "ok" && reduced) line += " (" + pt.model + ")";
+  char tail[96];
+  std::snprintf(tail, sizeof tail, ", %.1f s", pt.wall_s);
+  line += tail;
+  if (!pt.nrmse.empty()) {
+    std::snprintf(tail, sizeof tail, ", final NRMSE %.4g", pt.nrmse.back());
+    line += tail;
+  }
+  if (!pt.error.empty()) line += ": " + pt.error;
+  return line;
+}
+
+/// Whether `dir` holds a finished run of the resolved scene `scene_text` (the resume check).
+bool done_before(const fs::path& dir, const std::string& scene_text) {
+  const std::optional<std::string> status = run_status(read_json(dir / "summary.json"));
+  return status && *status == "ok" && slurp(dir / "scene.toml") == scene_text;
+}
+
+/// --fem-points: the chosen points again with the full FEM, into points/NNNN/fem/, each compared
+/// with the point's own run. `overrides` are the points' (their last is solver.model).
+void run_fem_points(const WorkerSetup& setup, const Scene& base, const std::vector<ParamSpec>& params,
+                    const std::set<int>& fem_points, const std::vector<std::vector<std::string>>& overrides,
+                    SweepResult& result) {
+  std::vector<Worker> fem_runs;
+  for (int index : fem_points) {
+    SweepPoint& pt = result.points[static_cast<std::size_t>(index) - 1];
+    const fs::path dir = setup.out / "points" / point_name(index);
+    std::vector<std::string> ov = overrides[static_cast<std::size_t>(index) - 1];
+    ov.back() = "solver.model=\"full\"";
+    if (pt.status != "ok") {
+      pt.fem = FemComparison{"failed", kNaN, kNaN, "not run: the point's own run failed"};
+      ++result.fem_failed;
+    } else if (done_before(dir / "fem", base.with(ov).to_toml())) {
+      read_fem_comparison(pt, dir, -1);
+      if (pt.fem->status != "ok") ++result.fem_failed;
+      say(setup.o.log, "FEM re-run of point " + point_name(index) + " skipped (already done)");
+    } else {
+      fem_runs.push_back({static_cast<std::size_t>(index) - 1, dir / "fem", setup.argv(dir / "fem", ov, false)});
+    }
+  }
+  if (!fem_runs.empty())
+    say(setup.o.log, std::to_string(fem_runs.size()) + " point(s) again with the full FEM (--fem-points), into points/NNNN/fem/");
+  run_workers(fem_runs, setup.jobs, [&](const Worker& w, int exit_code, double) {
+    SweepPoint& pt = result.points[w.i];
+    read_fem_comparison(pt, w.dir.parent_path(), exit_code);
+    if (pt.fem->status != "ok") ++result.fem_failed;
+    char line[200];
+    std::snprintf(line, sizeof line, "FEM re-run of point %s: final NRMSE %.4g (the point's %.4g), largest |point - FEM| angle %.4g deg",
+                  point_name(pt.index).c_str(), pt.fem->final_nrmse, final_nrmse(pt), pt.fem->max_abs_diff_deg);
+    say(setup.o.log, pt.fem->status == "ok" ? line : "FEM re-run of point " + point_name(pt.index) + " failed: " + pt.fem->error);
+    write_file_atomic((setup.out / "sweep.csv").string(), sweep_csv(params, result.points));
+  });
+  write_file_atomic((setup.out / "sweep.csv").string(), sweep_csv(params, result.points));  // with the skipped re-runs too
 }
 
 }  // namespace
@@ -548,10 +898,10 @@ SweepResult run_sweep(const SweepOptions& o) {
   }
   const std::vector<std::vector<double>> values = o.lhs > 0 ? lhs_points(params, o.lhs, o.seed) : grid_points(params);
 
-  // Each point's resolved scene: what the worker will run, and the key of the resume check.
+  // Each point: its overrides and its offline keys, which decide the model (plan_model).
   SweepResult result;
-  std::vector<std::string> scene_text;
   std::vector<std::vector<std::string>> overrides;
+  std::vector<std::optional<OfflineKeys>> keys;
   for (std::size_t i = 0; i < values.size(); ++i) {
     SweepPoint pt;
     pt.index = static_cast<int>(i) + 1;
@@ -564,7 +914,8 @@ SweepResult run_sweep(const SweepOptions& o) {
     }
     ov.emplace_back("output.vtu=\"none\"");
     try {
-      scene_text.push_back(base.with(ov).to_toml());
+      const Scene scene = base.with(ov);
+      if (o.model != "full") keys.push_back(offline_keys(scene));
     } catch (const InputError& e) {
       std::string which;
       for (const ParamSpec& p : params) which += (which.empty() ? "" : ", ") + p.text;
@@ -573,8 +924,28 @@ SweepResult run_sweep(const SweepOptions& o) {
     overrides.push_back(ov);
     result.points.push_back(pt);
   }
+  const std::set<int> fem_points = checked_fem_points(o.fem_points, result.points.size());
+  for (int index : fem_points) result.points[static_cast<std::size_t>(index) - 1].fem.emplace();  // pending: sweep.csv's columns
+  const ModelPlan plan = plan_model(o, base, params, overrides, keys);
+  if (!fem_points.empty() && !plan.reduced)
+    throw InputError("--fem-points: the points run with the full FEM already (" + plan.why +
+                     "); --fem-points compares reduced points with the FEM");
+  result.model = plan.reduced ? "reduced" : "full";
+  result.model_reason = plan.why;
+  result.offline_parts = plan.offline_parts;
+  // --model decides over the scene's own solver.model; every point's resolved scene records it.
+  const std::string model_key = std::string("solver.model=\"") + result.model + "\"";
+  const std::string scene_model = base.string("solver.model");
+  for (std::vector<std::string>& ov : overrides) ov.push_back(model_key);
+  // Each point's resolved scene: what the worker will run, and the key of the resume check.
+  std::vector<std::string> scene_text;
+  for (const std::vector<std::string>& ov : overrides) scene_text.push_back(base.with(ov).to_toml());
 
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1, tbb::info::default_concurrency());
+  say(o.log, plan.why);
+  if (scene_model != result.model && scene_model != Scene::load("").string("solver.model"))
+    say(o.log, "--model " + o.model + " decides over the scene's solver.model = \"" + scene_model + "\" (" +
+                   base.origin("solver.model") + "): the points run the " + (plan.reduced ? "reduced model" : "full FEM"));
   if (o.dry_run) {
     say(o.log, std::to_string(result.points.size()) + " points (" + (o.lhs > 0 ? "Latin hypercube" : "grid") + "), " +
                    std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s):");
@@ -586,15 +957,14 @@ SweepResult run_sweep(const SweepOptions& o) {
   const fs::path out(o.out_dir);
   prepare_output_dir((out / "points").string(), "--out");
   const DirLock lock(out);
-  const std::string scene_abs = o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string();
+  const WorkerSetup setup{o, out, o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string(), jobs};
 
   // Resume: points already done by an earlier invocation with the same resolved scene.
   std::vector<std::size_t> queue;
   for (std::size_t i = 0; i < result.points.size(); ++i) {
     SweepPoint& pt = result.points[i];
     const fs::path dir = out / "points" / point_name(pt.index);
-    const std::optional<std::string> status = run_status(read_json(dir / "summary.json"));
-    if (status && *status == "ok" && slurp(dir / "scene.toml") == scene_text[i]) {
+    if (done_before(dir, scene_text[i])) {
       read_point(pt, dir, -1, 0.0);
       pt.skipped = true;
       ++result.ok;
@@ -609,65 +979,34 @@ SweepResult run_sweep(const SweepOptions& o) {
   say(o.log, std::to_string(result.points.size()) + " points, " + std::to_string(queue.size()) + " to run with " +
                  std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s)");
 
-  struct Running {
-    pid_t pid;
-    std::size_t i;
-    std::chrono::steady_clock::time_point start;
-  };
-  std::vector<Running> running;
-  std::size_t next = 0;
+  std::vector<Worker> workers;
+  for (std::size_t i : queue) {
+    const fs::path dir = out / "points" / point_name(result.points[i].index);
+    workers.push_back({i, dir, setup.argv(dir, overrides[i], plan.reduced)});
+  }
+  const auto [first, rest] = offline_waves(std::move(workers), plan);
+  if (!first.empty() && !rest.empty()) {
+    std::string names;
+    for (const Worker& w : first) names += (names.empty() ? "" : ", ") + point_name(result.points[w.i].index);
+    say(o.log, "point" + std::string(first.size() > 1 ? "s " : " ") + names + " first, building the reduced model's offline part" +
+                   (first.size() > 1 ? "s" : "") + "; then the other " + std::to_string(rest.size()) + " read it");
+  }
   int finished = result.skipped;
   const int total = static_cast<int>(result.points.size());
-  while (next < queue.size() || !running.empty()) {
-    while (next < queue.size() && static_cast<int>(running.size()) < jobs) {
-      const std::size_t i = queue[next++];
-      const fs::path dir = out / "points" / point_name(result.points[i].index);
-      fs::remove_all(dir);  // an interrupted, failed or changed point starts clean
-      fs::create_directories(dir);
-      std::vector<std::string> argv = {o.exe, "simulate"};
-      if (!scene_abs.empty()) argv.push_back(scene_abs);
-      // The points share one ideal elastic model per actuator (app/simulate/ideal_cache.h): a sweep over
-      // damage constants computes it once instead of once per point.
-      for (const std::string& a : {std::string("--out"), dir.string(), std::string("--threads"),
-                                   std::to_string(o.threads_per_job), std::string("--ideal-cache"),
-                                   (out / "ideal_cache").string()})
-        argv.push_back(a);
-      for (const std::string& s : o.sets) argv.insert(argv.end(), {"--set", s});
-      for (const std::string& s : overrides[i]) argv.insert(argv.end(), {"--set", s});
-      running.push_back({launch(argv, dir / "log.txt"), i, std::chrono::steady_clock::now()});
-    }
-    bool any = false;
-    for (std::size_t r = 0; r < running.size();) {
-      int st = 0;
-      const pid_t w = waitpid(running[r].pid, &st, WNOHANG);
-      if (w == 0 || (w < 0 && errno == EINTR)) {
-        ++r;
-        continue;
-      }
-      any = true;
-      const Running done = running[r];
-      running.erase(running.begin() + static_cast<std::ptrdiff_t>(r));
-      SweepPoint& pt = result.points[done.i];
-      const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - done.start).count();
-      read_point(pt, out / "points" / point_name(pt.index), w < 0 ? 1 : exit_code_of(st), measured);
-      (pt.status == "ok" ? result.ok : result.failed)++;
-      ++finished;
-      char head[64];
-      std::snprintf(head, sizeof head, "[%d/%d] point %s ", finished, total, point_name(pt.index).c_str());
-      std::string line = head + describe(params, pt) + ": " + pt.status;
-      char tail[96];
-      std::snprintf(tail, sizeof tail, ", %.1f s", pt.wall_s);
-      line += tail;
-      if (!pt.nrmse.empty()) {
-        std::snprintf(tail, sizeof tail, ", final NRMSE %.4g", pt.nrmse.back());
-        line += tail;
-      }
-      if (!pt.error.empty()) line += ": " + pt.error;
-      say(o.log, line);
-      write_file_atomic(csv.string(), sweep_csv(params, result.points));
-    }
-    if (!any && !running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  const auto point_finished = [&](const Worker& w, int exit_code, double measured_s) {
+    SweepPoint& pt = result.points[w.i];
+    read_point(pt, w.dir, exit_code, measured_s);
+    (pt.status == "ok" ? result.ok : result.failed)++;
+    ++finished;
+    char head[64];
+    std::snprintf(head, sizeof head, "[%d/%d] ", finished, total);
+    say(o.log, head + outcome_line(params, pt, plan.reduced));
+    write_file_atomic(csv.string(), sweep_csv(params, result.points));
+  };
+  run_workers(first, jobs, point_finished);
+  run_workers(rest, jobs, point_finished);
+
+  run_fem_points(setup, base, params, fem_points, overrides, result);
 
   std::vector<std::string> plots;
   for (std::size_t j = 0; j < params.size(); ++j) {
@@ -678,6 +1017,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   SweepOptions recorded = o;
   recorded.jobs = jobs;
+  recorded.fem_points.assign(fem_points.begin(), fem_points.end());
   write_file_atomic((out / "sweep.json").string(), sweep_json(recorded, params, result, plots));
   return result;
 }

@@ -11,11 +11,22 @@
 //              scene.toml equal to the point's resolved scene (same scene file, --set and
 //              parameter values); anything else (failed, interrupted, changed) is run again from a
 //              clean directory. Re-running the same command after a kill continues the sweep.
+//   model      --model auto (default) runs the reduced-order model (app/simulate/reduced.h) when
+//              every point has the same elastic reference, i.e. the swept keys are effect
+//              constants, gravity or protocol; else the full FEM. The offline part of the reduced
+//              model (elastic path and basis, ~25 min on the default mesh) is built in
+//              DIR/rom_cache by the first point that needs it, before any other point, and read by
+//              the others. Each point records which model ran (a reduced run may fall back to the
+//              full FEM).
+//              --fem-points re-runs chosen points with the full FEM into DIR/points/NNNN/fem/ and
+//              records the FEM's NRMSE and the largest |reduced - FEM| angle.
 //   outputs    DIR/sweep.csv (one row per point, rewritten atomically after every point),
 //              DIR/sweep_<key>.svg (final-trial NRMSE against each parameter), DIR/sweep.json.
 // A failed point is recorded with its error and does not stop the sweep.
 #include <cstdint>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,9 +70,19 @@ struct SweepOptions {
   int jobs = 0;             ///< worker processes (0 = number of cores)
   int threads_per_job = 1;  ///< --threads of each worker
   std::string exe;          ///< the pneufem binary the workers run
+  std::string model = "auto";   ///< "auto", "full" or "reduced": the model of the workers (solver.model)
+  std::vector<int> fem_points;  ///< points (1-based) re-run with the full FEM after the sweep
   bool dry_run = false;     ///< print the points, run nothing, write nothing
   std::string command_line;
   std::FILE* log = stdout;  ///< one line per point; nullptr = quiet
+};
+
+/// A point re-run with the full FEM (--fem-points) against its reduced run.
+struct FemComparison {
+  std::string status = "pending";  ///< "ok", "failed" or "pending"
+  double final_nrmse = std::numeric_limits<double>::quiet_NaN();       ///< the FEM's final-trial NRMSE
+  double max_abs_diff_deg = std::numeric_limits<double>::quiet_NaN();  ///< largest |reduced - FEM| angle of a report
+  std::string error;
 };
 
 struct SweepPoint {
@@ -69,21 +90,27 @@ struct SweepPoint {
   std::vector<double> values;       ///< one per parameter
   std::vector<std::string> texts;   ///< the values as given to the scene
   std::string status = "pending";   ///< "ok", "failed" or "pending"
+  std::string model;                ///< what ran: "reduced", "full" or "full (fallback: <reason>)"; "" = unknown
   bool skipped = false;             ///< done by an earlier invocation
   double wall_s = 0.0;
   std::vector<double> nrmse;        ///< per trial, from metrics.json (empty without metrics)
   double final_angle_deg = 0.0;     ///< NaN when no angle was reported
   std::string error;
+  std::optional<FemComparison> fem;  ///< set for the --fem-points
 };
 
 struct SweepResult {
   std::vector<SweepPoint> points;
+  std::string model;         ///< "reduced" or "full": what the workers were asked to run
+  std::string model_reason;  ///< why (the --model choice, or what auto saw)
+  int offline_parts = 0;     ///< distinct offline parts of a reduced sweep (0 with the full FEM)
   int ok = 0, failed = 0, skipped = 0;
+  int fem_failed = 0;        ///< --fem-points whose FEM run failed
   double wall_s = 0.0;
 };
 
 /// Runs (or, with dry_run, plans) the sweep. Bad options throw InputError naming the option
-/// (--param, --lhs, --jobs, ...); failed points are recorded, not thrown.
+/// (--param, --lhs, --jobs, --fem-points, ...); failed points are recorded, not thrown.
 SweepResult run_sweep(const SweepOptions& options);
 
 }  // namespace pneufem

@@ -1,7 +1,9 @@
 // Parameter sweeps: --param parsing and its errors, grid and Latin-hypercube designs (each stratum
 // hit once, deterministic for a seed), and end to end through the pneufem binary on a tiny scene:
 // one row per point, plots, resume (done points skipped, changed or interrupted points rerun),
-// failed points recorded without stopping the sweep, and results independent of --jobs.
+// failed points recorded without stopping the sweep, and results independent of --jobs; the
+// model of the points (reduced when only effect constants change, its offline part built once;
+// full when the elastic reference changes) and --fem-points' comparison with the full FEM.
 #include "app/sweep/command.h"
 
 #include <sys/stat.h>
@@ -15,6 +17,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/app/cli_helpers.h"
 
@@ -184,7 +187,8 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
 }
 
 // A tiny fatigue scene: two chambers, coarse mesh, 0-10 kPa, two trials; a low damage threshold
-// so that tau_s changes the result. About 1.5 s per point.
+// so that tau_s changes the result. About 1.5 s per point with the full FEM; a sweep over tau_s runs
+// the reduced model (--model auto), whose offline part adds ~12 s once.
 const std::string kTiny =
     "--set geometry.chambers=2 --set mesh.h_mm=6.0 --set load.max_kPa=10.0 --set load.trials=2 "
     "--set materials.silicone.fatigue.enabled=true --set materials.silicone.fatigue.W_th_MPa=0.002";
@@ -192,7 +196,9 @@ const std::string kTau = "materials.silicone.fatigue.tau_s";
 
 TEST(SweepCli, GridSweepResumesAndDoesNotDependOnJobs) {
   const fs::path d = fresh_dir("grid");
-  const std::string args = "sweep --param " + kTau + "=100:1000:3:log " + kTiny + " --threads-per-job 1 --out ";
+  // The full FEM: its points share the ideal elastic model through the sweep's ideal cache (a
+  // reduced run computes its own, in seconds, with the reduced model).
+  const std::string args = "sweep --param " + kTau + "=100:1000:3:log " + kTiny + " --model full --threads-per-job 1 --out ";
   const Result r = run(args + d.string() + " --jobs 2");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("3 points, 3 ok (0 skipped), 0 failed"), std::string::npos) << r.out;
@@ -256,7 +262,7 @@ TEST(SweepCli, GridSweepResumesAndDoesNotDependOnJobs) {
   EXPECT_EQ(mtime(1), m1);
 
   // Changed values rerun only the points whose scene changed (point 1 is still tau = 100).
-  const Result changed = run("sweep --param " + kTau + "=100:1000:2:log " + kTiny + " --jobs 2 --out " + d.string());
+  const Result changed = run("sweep --param " + kTau + "=100:1000:2:log " + kTiny + " --model full --jobs 2 --out " + d.string());
   ASSERT_EQ(changed.code, 0) << changed.out;
   EXPECT_EQ(count(changed.out, "skipped (already done)"), 1u) << changed.out;
   EXPECT_EQ(read_csv(d / "sweep.csv")[1].at(kTau), "1000.0");
@@ -390,8 +396,138 @@ TEST(SweepCli, BadOptionsAreRejectedBeforeAnythingRuns) {
   EXPECT_FALSE(fs::exists(d));
 
   const Result help = run("sweep --help");
-  for (const char* opt : {"--param", "--lhs", "--seed", "--out", "--jobs", "--threads-per-job", "--set", "--dry-run"})
+  for (const char* opt : {"--param", "--lhs", "--seed", "--out", "--jobs", "--threads-per-job", "--set", "--dry-run", "--model",
+                          "--fem-points"})
     EXPECT_NE(help.out.find(opt), std::string::npos) << opt;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The model of the points
+
+// The small story scene of tests/app/simulate/test_reduced.cpp: 3 chambers, h = 6 mm, Mullins,
+// fatigue and viscoelasticity, one trial with 4 s holds; ~5 s per reduced run once its offline
+// part is built.
+const std::string kStory = std::string(PNEUFEM_TEST_DATA_DIR) + "/../../scenes/examples/paper_story.toml";
+const std::string kSmallStory = kStory +
+                                " --set geometry.chambers=3 --set mesh.h_mm=6.0 --set load.trials=1 --set load.hold_s=4.0 "
+                                "--set load.mark_s=2.0 --threads-per-job 1";
+
+/// A field of a run's summary.json reduced_model.offline ("basis" or "path").
+std::string offline_source(const fs::path& run_dir, const std::string& field) {
+  const nlohmann::json s = nlohmann::json::parse(slurp(run_dir / "summary.json"), nullptr, false);
+  if (s.is_discarded() || !s.contains("reduced_model") || !s["reduced_model"].is_object()) return "";
+  return s["reduced_model"]["offline"].value(field, "");
+}
+
+TEST(SweepModel, EffectConstantsRunTheReducedModelWithOneOfflinePart) {
+  const fs::path d = fresh_dir("rom_fatigue");
+  const Result r = run("sweep " + kSmallStory + " --param " + kTau + "=80:160:2 --jobs 2 --out " + d.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("reduced model: every point has the same elastic reference (the swept keys are effect constants, "
+                       "gravity or protocol), so the points share one offline part"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("point 0001 first, building the reduced model's offline part; then the other 1 read it"),
+            std::string::npos)
+      << r.out;
+  // Point 1 ran alone and built the basis; point 2 read it from rom_cache/.
+  EXPECT_EQ(offline_source(d / "points" / "0001", "basis"), "computed");
+  EXPECT_EQ(offline_source(d / "points" / "0002", "basis").rfind("cache " + (d / "rom_cache").string(), 0), 0u)
+      << offline_source(d / "points" / "0002", "basis");
+  const auto rows = read_csv(d / "sweep.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok");
+    EXPECT_EQ(row.at("model"), "reduced");
+    EXPECT_FALSE(row.at("final_nrmse").empty());
+    EXPECT_EQ(row.count("fem_final_nrmse"), 0u);  // no --fem-points, no FEM columns
+  }
+  EXPECT_NE(rows[0].at("final_nrmse"), rows[1].at("final_nrmse"));  // tau_s matters
+  const nlohmann::json j = nlohmann::json::parse(slurp(d / "sweep.json"));
+  EXPECT_EQ(j["model"], "reduced");
+  EXPECT_EQ(j["offline_parts"], 1);
+  EXPECT_EQ(j["points"][1]["model"], "reduced");
+  fs::remove_all(d);
+}
+
+TEST(SweepModel, AnElasticModulusRunsTheFullFemUnderAuto) {
+  const fs::path d = fresh_dir("rom_modulus");
+  const std::string modulus = "materials.silicone.C10_MPa";
+  const Result r = run("sweep --param " + modulus + "=0.018:0.02:2 " + kTiny + " --jobs 2 --out " + d.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("full FEM: " + modulus + " changes the elastic reference, which the reduced model's basis is built for"),
+            std::string::npos)
+      << r.out;
+  for (const auto& row : read_csv(d / "sweep.csv")) EXPECT_EQ(row.at("model"), "full");
+  EXPECT_FALSE(fs::exists(d / "points" / "0001" / "reduced_check.csv"));
+  EXPECT_EQ(nlohmann::json::parse(slurp(d / "sweep.json"))["model"], "full");
+
+  // --model reduced is allowed, at the price of one offline part per actuator, and said so; --model
+  // decides over the scene's own solver.model, and says that too.
+  const Result forced = run("sweep --param " + modulus + "=0.018:0.02:2 " + kTiny +
+                            " --model reduced --dry-run --out " + d.string());
+  ASSERT_EQ(forced.code, 0) << forced.out;
+  EXPECT_NE(forced.out.find("costs one offline part per distinct actuator: 2 offline parts"), std::string::npos) << forced.out;
+  const Result over = run("sweep --param " + kTau + "=100:1000:2 " + kTiny +
+                          " --set solver.model=reduced --model full --dry-run --out " + d.string());
+  ASSERT_EQ(over.code, 0) << over.out;
+  EXPECT_NE(over.out.find("--model full decides over the scene's solver.model = \"reduced\" (--set solver.model): the points run the full FEM"),
+            std::string::npos)
+      << over.out;
+  fs::remove_all(d);
+}
+
+// The reduced model's verified accuracy on this scene: every report within 0.1 deg of the full
+// FEM (tests/app/simulate/test_reduced.cpp, the same scene and bound), and the trials' NRMSE
+// within the 0.5 points (tests/engine/test_rom.cpp, measured 0.28 points on the default
+// actuator). The sweep must record a difference within those bounds, read from both runs' angles.csv.
+TEST(SweepModel, FemPointsRecordTheFemNrmseAndTheReducedError) {
+  const fs::path d = fresh_dir("rom_fem_points");
+  const Result r = run("sweep " + kSmallStory + " --param " + kTau + "=80:80:1 --fem-points 1 --jobs 2 --out " + d.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("FEM re-run of point 0001: final NRMSE"), std::string::npos) << r.out;
+  const fs::path fem = d / "points" / "0001" / "fem";
+  EXPECT_EQ(nlohmann::json::parse(slurp(fem / "summary.json"))["solver"]["model"], "full");
+  const auto rows = read_csv(d / "sweep.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].at("model"), "reduced");
+  ASSERT_FALSE(rows[0].at("fem_final_nrmse").empty()) << slurp(d / "sweep.csv");
+  ASSERT_FALSE(rows[0].at("max_abs_reduced_minus_fem_deg").empty());
+  const double diff = std::stod(rows[0].at("max_abs_reduced_minus_fem_deg"));
+  EXPECT_GT(diff, 0.0);  // two different models
+  EXPECT_LT(diff, 0.1);
+  EXPECT_NEAR(std::stod(rows[0].at("final_nrmse")), std::stod(rows[0].at("fem_final_nrmse")), 0.005);
+  const nlohmann::json j = nlohmann::json::parse(slurp(d / "sweep.json"));
+  EXPECT_EQ(j["points"][0]["fem"]["status"], "ok");
+  EXPECT_EQ(j["points"][0]["fem"]["max_abs_reduced_minus_fem_deg"].get<double>(), diff);
+
+  // Again: the point and its FEM re-run are done, nothing runs, the table is the same.
+  const std::string csv = slurp(d / "sweep.csv");
+  const Result again = run("sweep " + kSmallStory + " --param " + kTau + "=80:80:1 --fem-points 1 --jobs 2 --out " + d.string());
+  ASSERT_EQ(again.code, 0) << again.out;
+  EXPECT_NE(again.out.find("FEM re-run of point 0001 skipped (already done)"), std::string::npos) << again.out;
+  EXPECT_EQ(slurp(d / "sweep.csv"), csv);
+  fs::remove_all(d);
+}
+
+TEST(SweepModel, BadFemPointsAndModelAreRejectedBeforeAnythingRuns) {
+  const fs::path d = fresh_dir("rom_bad");
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {"--fem-points 3", "--fem-points 3: no such point; the sweep's points are 1 to 2"},
+      {"--fem-points 1,0", "--fem-points 0: no such point"},
+      {"--fem-points x", "--fem-points"},
+      {"--model tiny", "--model: tiny not in {auto,full,reduced}"},
+      {"--model full --fem-points 1", "--fem-points: the points run with the full FEM already"},
+  };
+  for (const Case& c : cases) {
+    const Result r = run("sweep --param " + kTau + "=100:1000:2 " + kTiny + " " + c.args + " --out " + d.string());
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.message), std::string::npos) << c.args << "\n" << r.out;
+  }
+  EXPECT_FALSE(fs::exists(d / "points"));
 }
 
 }  // namespace
