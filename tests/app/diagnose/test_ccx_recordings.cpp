@@ -104,7 +104,6 @@ DiagnosisResult diagnose(const std::string& name, double lag_s) {
   // error) would be taken for, what noise on a creep-free record could pass for, and the truth.
   o.candidates = {"stiffness", "viscoelastic", "pressure_lag"};
   o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();  // shared elastic work (app/simulate/result_cache.h)
-  o.refine = 0;  // the selection on a recording made by CalculiX is the point here
   return run_diagnosis(Scene::load(kData + "scene.toml"), o);
 }
 

@@ -61,7 +61,6 @@ DiagnoseOptions hidden_options(const std::string& name, const std::string& out, 
   o.max_effects = max_effects;
   o.candidates = std::move(candidates);
   o.cache_dir = shared_cache();
-  o.refine = 0;  // the path model's selection and constants; the refinement: DiagnoseRefinement.*
   return o;
 }
 
@@ -616,6 +615,44 @@ TEST(HiddenEffect, Mullins) {
   EXPECT_LT(r.final_nrmse, 1.5 * r.noise_floor_nrmse + 0.005);
   EXPECT_NEAR(param(r, "r"), 3.0, 1.0);
   EXPECT_NEAR(std::log10(param(r, "m_MPa")), std::log10(0.001), 1.0);
+}
+
+// The refinement with the reduced-order model (--refine 2, the reduced model by default) on the
+// hidden Mullins recording: the path model's constants (measured r 2.81, m 0.0048 MPa) fit it with
+// the path model, but the full FEM - the model that made the recording - at those constants is far
+// off (measured NRMSE 0.0455 at a floor of 0.0095): the path model misjudges damage localised in the
+// walls. Two refinements on the reduced model move them to where the FEM fits (measured 0.0106,
+// r 2.34, m 0.0017 MPa; the truth's own FEM NRMSE is 0.0098). r and m trade off along a valley the
+// three trials do not close (HiddenEffect.Mullins), so the constants themselves are not asserted;
+// the FEM's fit is, by the FEM itself (an independent run, not the reduced model): under 1.3x the
+// floor (the reduced model's 0.1-0.3 deg error on this case, about a third of the noise) and
+// under half the path constants' error.
+TEST(DiagnoseRefinement, TheReducedModelMovesMullinsConstantsToWhereTheFemFits) {
+  DiagnoseOptions o = hidden_options("mullins", "refine_mullins", 1, {"mullins"});
+  o.refine = 2;
+  const Scene scene = Scene::load("", kScene);
+  const DiagnosisResult r = run_diagnosis(scene, o);
+  ASSERT_EQ(r.selected, std::vector<std::string>{"mullins"});
+  EXPECT_EQ(r.refined_model, "reduced");
+  ASSERT_EQ(r.refined_params.size(), 1u);
+  ASSERT_EQ(r.refined_nrmse_per_trial.size(), 3u);
+  const Recording rec = read_measurements_csv(data("mullins"));
+  auto fem_nrmse = [&](const std::vector<double>& v) {
+    const CandidateEffect& c = candidate_effect("mullins");
+    std::vector<Series> model;
+    for (TrialTrace& t : simulate_recording(scene.with(c.sets(scene, v)), rec, DriveOptions{}).trials)
+      model.push_back(std::move(t.angle_deg));
+    return compare_recording(rec, model).nrmse;
+  };
+  const double path = fem_nrmse(r.candidates.front().params), refined = fem_nrmse(r.refined_params[0]);
+  std::printf("full FEM NRMSE: path-model constants %.4f, refined %.4f (r %.3f, m %.4g MPa); floor %.4f\n", path, refined,
+              r.refined_params[0][0], r.refined_params[0][1], r.noise_floor_nrmse);
+  EXPECT_LT(refined, 1.3 * r.noise_floor_nrmse);
+  EXPECT_LT(refined, 0.5 * path);
+  // The report and history carry the refined model's error per trial.
+  std::ifstream hist(fs::path(o.out_dir) / "history.jsonl");
+  const std::string h((std::istreambuf_iterator<char>(hist)), std::istreambuf_iterator<char>());
+  EXPECT_NE(h.find("diagnose, refined (reduced-order model)"), std::string::npos) << h;
 }
 
 // Fatigue (W_th = 8 kPa, tau = 200 s, energy driver) softens the interior walls over the trials.

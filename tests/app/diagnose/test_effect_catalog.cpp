@@ -236,7 +236,6 @@ TEST(CreepConventions, ARecordingThatCreepsBeyondTheElasticModelIsInstantaneousC
   o.max_effects = 1;
   o.candidates = {"stiffness", "viscoelastic", "viscoelastic_instantaneous"};
   o.cache_dir = (std::filesystem::temp_directory_path() / "pneufem_diagnose_cache").string();  // as test_command's
-  o.refine = 0;  // the path model's calibration is the point here
   const DiagnosisResult r = run_diagnosis(Scene::load("", scene), o);
   for (const CandidateResult& c : r.candidates) {
     std::printf("%s NRMSE %.4f%s", c.effect.c_str(), c.nrmse, c.significant ? " (sig)" : "");

@@ -45,7 +45,6 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
   o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_othermeans_" + name)).string();
   fs::remove_all(o.out_dir);
   o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();  // shared elastic work
-  o.refine = 0;  // what the path model selects; the refinement: DiagnoseRefinement.* (test_command.cpp)
   const auto t0 = std::chrono::steady_clock::now();
   const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
   std::printf("%s: baseline %.4f, floor %.4f, final %.4f (%.2fx); selected:", name.c_str(), r.baseline_nrmse,

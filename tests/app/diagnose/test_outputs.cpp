@@ -75,7 +75,6 @@ class DiagnoseOutputs : public ::testing::Test {
       o.max_effects = 2;
       o.max_evaluations = 15;  // the outputs are the point here, not the last digit of the fit
       o.cache_dir = (dir_ / "cache").string();
-      o.refine = 0;  // the path model's outputs; a refinement's: DiagnoseRefinement.* (test_command.cpp)
       return o;
     };
     first_result_ = run_diagnosis(Scene::load("", kScene), options("first.csv", "first"));
