@@ -767,6 +767,32 @@ TEST_F(InpFiles, IncludeFanOutEndsAtTheLimitWithTheChain) {
   EXPECT_NE(msg.find("include each file once"), std::string::npos) << msg;
 }
 
+// The deck's text is bounded too (issue 30, item 4): an included file that takes the text over the
+// 1 GiB limit is refused at its *INCLUDE, with the chain, before its bytes are read (the file is
+// sparse: nothing is written to disk or memory; a reader that read it first would take seconds and
+// a gigabyte, so the time bound shows it did not); a top-level deck over the limit alone is refused
+// the same way.
+TEST_F(InpFiles, DeckTextOverOneGibibyteIsRefusedBeforeItIsRead) {
+  const fs::path big = dir_ / "sub" / "big.inp";
+  fs::create_directories(big.parent_path());
+  std::ofstream(big).put('*');
+  fs::resize_file(big, (std::uintmax_t{1} << 30) + 1);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string msg = error_of(kNodes + "*INCLUDE, INPUT=sub/big.inp\n", "main.inp");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  EXPECT_NE(msg.find("main.inp:6: the deck's text reaches 1024.0 MiB with "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("over the limit of 1024.0 MiB (a file counts each time it is included)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("include chain "), std::string::npos) << msg;
+  std::string top;
+  try {
+    read_inp(big.string(), 1e-3);
+  } catch (const InputError& e) {
+    top = e.what();
+  }
+  EXPECT_NE(top.find(big.string() + ": the deck's text reaches 1024.0 MiB"), std::string::npos) << top;
+  EXPECT_NE(top.find("split the model or coarsen the mesh"), std::string::npos) << top;
+}
+
 TEST_F(InpFiles, IncludeCycleIsNamedWithItsChain) {
   write("a.inp", "** a\n*INCLUDE, INPUT=sub/b.inp\n");
   write("sub/b.inp", "*INCLUDE, INPUT=../a.inp\n");
