@@ -3,7 +3,7 @@
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--dump-points]
-// --softened N adds softened equilibria (N levels to --softened-max; the scenes' default is 6 to 0.9,
+// --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --dump-points runs the FEM beside
 // the reduced model and compares damage and largest stretch at the kept points at every trial's end.

@@ -141,7 +141,7 @@ const Offline& offline() {
   return *o;
 }
 
-/// The same with softened equilibria (6 levels to 0.9, the scenes' default): built once (~20 s).
+/// The same with softened equilibria (6 levels to 0.9; solver.reduced_softened_levels = 6): built once (~20 s).
 const ReducedBasis& softened_basis() {
   static const ReducedBasis* b = [] {
     RomBasisOptions opt;
@@ -463,7 +463,7 @@ void register_peak_energy_softening() {
 // responses alone (the plain basis): every level below 45 kPa within 0.035 deg, the 45 kPa step
 // 0.23 deg under the FEM, the trials' NRMSE 0.81 and 0.82 points under the FEM's (16.8 %, 18.1 %),
 // whatever the basis size (8-64 modes), mode samples, clusters or hyper-reduction. With the softened
-// equilibria (the scenes' default basis) measured 0.090 deg and 0.28 / 0.23 points: the issue's
+// equilibria (solver.reduced_softened_levels = 6) measured 0.090 deg and 0.28 / 0.23 points: the issue's
 // targets (0.5 deg, 0.5 points) hold, and are the tolerances.
 TEST(ReducedModel, FollowsTheFemForAnEffectKnownOnlyToTheRegistry) {
   register_peak_energy_softening();
