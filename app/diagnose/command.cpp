@@ -40,7 +40,7 @@ std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::v
     const CandidateParameter& p = c.params[i];
     const double v = std::clamp(values[i], p.lo, p.hi);
     const double x = p.log ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
-    if (x <= 0.01 || x >= 0.99) out.push_back(p.name);
+    if ((x <= 0.01 && !p.reduces_at_lo) || x >= 0.99) out.push_back(p.name);
   }
   return out;
 }

@@ -28,6 +28,9 @@ struct CandidateParameter {
   double initial;     ///< start of calibration
   double truth;       ///< value `pneufem synth --hidden` uses by default
   bool log = false;   ///< calibrate/sample in log space
+  /// lo is where the effect reduces to a simpler one of its kind (pressure_lag's tau2 = 0: the
+  /// first-order lag), not an extreme: a value there is no "constant at a bound" (params_at_bounds).
+  bool reduces_at_lo = false;
 };
 
 struct CandidateEffect {

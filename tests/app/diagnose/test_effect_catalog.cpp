@@ -102,7 +102,9 @@ TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRight
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.W_th_MPa"), 0.02);
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.tau_s"), 2000.0);
   EXPECT_EQ(s.string("materials.silicone.fatigue.driver"), base.string("materials.silicone.fatigue.driver"));
-  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5}).number("load.pressure_lag_s"), 0.5);
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag_s"), 0.5);
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag2_s"), 0.0);  // first order
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.24, 0.27}).number("load.pressure_lag2_s"), 0.27);  // second order
   // Gravity: the rig angle in the actuator's frame; on the built-in actuator phi = 0 hangs the tip
   // down along +y, 90 deg is horizontal with g towards the fabric (-z), bit for bit the vectors the
   // hidden-effect datasets were made with (g_m_s2 = [0, 9.81 cos(phi), -9.81 sin(phi)]).
