@@ -16,9 +16,10 @@
 // SECOND ORDER (load.pressure_lag2_s = tau2 > 0): the lumped pneumatic line, the standard
 // resistance-inertance-capacitance model of a fluid line feeding a volume (e.g. Doebelin, System
 // Dynamics, 1998, fluid systems; the first mode of a distributed line model such as Richer &
-// Hurmuzlu's, ASME J. Dyn. Syst. Meas. Control 122, 2000): the tube's flow q obeys L dq/dt = p_in - p_c - R q (inertance L = rho l / A of
-// the air in a tube of length l and bore A, resistance R), the chamber C dp_c/dt = q (compliance C =
-// dV/dp + V/(kappa p), large for a soft chamber), so
+// Hurmuzlu's, ASME J. Dyn. Syst. Meas. Control 122, 2000): the tube's flow q obeys
+// L dq/dt = p_in - p_c - R q (inertance L = rho l / A of the air in a tube of length l and bore A,
+// resistance R), the chamber C dp_c/dt = q (compliance C = dV/dp + V/(kappa p), large for a soft
+// chamber), so
 //     tau2^2 p_c'' + tau p_c' + p_c = p_in,        tau = R C,  tau2 = sqrt(L C).                (2)
 // Why this form and not two first-order lags in series: (2) holds both. Its damping ratio is
 // zeta = tau / (2 tau2) and natural frequency f_n = 1 / (2 pi tau2):
