@@ -524,6 +524,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
                      "large misfit of the elastic response hides it from the raw tests."
                    : "") +
               " Residual signature: " + evidence(c.name, sig) + ". " + c.signature + ".";
+      if (c.reading) {
+        const std::string reading = c.reading(r.params);
+        if (!reading.empty()) r.why += " " + reading;
+      }
       for (const std::string& name : r.at_bound) {
         const auto p = std::find_if(c.params.begin(), c.params.end(), [&](const CandidateParameter& q) { return q.name == name; });
         const double v = r.params[static_cast<std::size_t>(p - c.params.begin())];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 
@@ -94,6 +95,33 @@ CandidateEffect material_candidate(const std::string& effect, const std::string&
   return e;
 }
 
+/// pressure_lag's constants in words (scenes/pressure_lag.h (2)): the order, and for the second
+/// the damping ratio and natural frequency, or the two RC stages it is.
+std::string lag_reading(const std::vector<double>& v) {
+  if (v.size() != 2 || !(v[0] > 0.0)) return "";
+  const double tau = v[0], tau2 = v[1];
+  char buf[320];
+  if (!(tau2 > 0.0)) {
+    std::snprintf(buf, sizeof buf, "First order (tau2 = 0): the chamber trails the inlet by tau = %.3g s.", tau);
+    return buf;
+  }
+  const double zeta = tau / (2.0 * tau2), fn = 1.0 / (2.0 * 3.14159265358979323846 * tau2);
+  if (zeta < 1.0) {
+    const double overshoot = 100.0 * std::exp(-3.14159265358979323846 * zeta / std::sqrt(1.0 - zeta * zeta));
+    std::snprintf(buf, sizeof buf,
+                  "Second order, under-damped (tau2 > tau/2): zeta = %.2f, f_n = %.3g Hz; the chamber overshoots a step "
+                  "by %.0f %% (the air in the tube ringing against the chamber's compliance).",
+                  zeta, fn, overshoot);
+    return buf;
+  }
+  const double d = std::sqrt(std::max(0.0, tau * tau - 4.0 * tau2 * tau2));
+  std::snprintf(buf, sizeof buf,
+                "Second order, over-damped (tau2 <= tau/2, zeta = %.2f): two first-order stages of %.3g s and %.3g s "
+                "in series.",
+                zeta, 0.5 * (tau + d), 0.5 * (tau - d));
+  return buf;
+}
+
 std::vector<CandidateEffect> builtin_candidates() {
   std::vector<CandidateEffect> c;
   // stiffness, pressure_lag and gravity are not material effects: their ranges are declared here.
@@ -178,6 +206,7 @@ std::vector<CandidateEffect> builtin_candidates() {
       require_count(e, v);
       return std::vector<std::string>{"load.pressure_lag_s=" + json::num(v[0]), "load.pressure_lag2_s=" + json::num(v[1])};
     };
+    e.reading = lag_reading;
     c.push_back(e);
   }
   {

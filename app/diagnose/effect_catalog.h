@@ -45,6 +45,9 @@ struct CandidateEffect {
   /// `--set` overrides (key=value) that add the effect with these parameter values (one per param,
   /// in order) to `scene`. Throws InputError for a wrong number of values.
   std::function<std::vector<std::string>(const Scene& scene, const std::vector<double>& values)> sets;
+  /// Optional: what calibrated `values` mean, in plain words (pressure_lag: which order, zeta and
+  /// f_n); diagnose appends it to the candidate's "why".
+  std::function<std::string(const std::vector<double>& values)> reading;
 };
 
 /// Built-ins then every registered material effect (rebuilt when effects were registered since).

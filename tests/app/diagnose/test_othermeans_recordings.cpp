@@ -182,6 +182,7 @@ TEST(OtherMeansRecording, UnderDampedSecondOrderLagIsNamedWithItsFrequencyAndDam
   const double tau = c.params[0], tau2 = c.params[1];
   EXPECT_NEAR(1.0 / (2.0 * M_PI * tau2), 0.6, 0.03);  // 5 %, as the first-order lag's tau
   EXPECT_NEAR(tau / (2.0 * tau2), 0.45, 0.045);       // 10 %: noise and the regulator seen through the lag
+  EXPECT_NE(c.why.find("under-damped"), std::string::npos) << c.why;  // and the diagnosis says so
 }
 // Incomplete measurement (whole catalog, max_effects 4; over 75 min of wall time on a shared machine,
 // not finished by the deadline): creep was selected in round 1 in the instantaneous convention
