@@ -437,6 +437,7 @@ Scene elastic_reference_scene(const Scene& scene) {
   sets.push_back("gravity.g_m_s2=[0.0, 0.0, 0.0]");
   sets.push_back("gravity.rig_angle_deg=-1.0");
   if (scene.has("load.pressure_lag_s")) sets.push_back("load.pressure_lag_s=0.0");
+  if (scene.has("load.pressure_lag2_s")) sets.push_back("load.pressure_lag2_s=0.0");
   return scene.with(sets);
 }
 
@@ -445,11 +446,10 @@ LoadHistory chamber_load(const Scene& s) {
   // Chamber pressure lagging the inlet (scenes/pressure_lag.h). Breakpoint tolerance: 0.5 % of a
   // staircase step (far below the 5 kPa steps' effect on the angle, ~0.1 deg); for a CSV inlet
   // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
-  const double lag_s = s.number("load.pressure_lag_s");
-  if (!(std::isfinite(lag_s) && lag_s >= 0.0))
-    s.fail("load.pressure_lag_s", "must be >= 0 s (0 = the chamber follows the inlet instantly)");
-  if (lag_s > 0.0)
-    load = apply_pressure_lag(load, lag_s,
+  // First order, or second (load.pressure_lag2_s > 0) with the same tolerance.
+  const PressureLag lag = scene_pressure_lag(s);
+  if (lag.on())
+    load = apply_pressure_lag(load, lag,
                               s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
   return load;
 }

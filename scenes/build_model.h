@@ -58,9 +58,10 @@ Mesh build_mesh(const Scene& scene, std::vector<std::string>* warnings = nullptr
 std::unique_ptr<BuiltModel> build_model(const Scene& scene);
 
 /// The scene's inlet pressure history ([load]: the staircase or load.csv), before any chamber lag
-/// (load.pressure_lag_s acts on it in build_model and when a recording is driven). Cheap: no mesh.
+/// (load.pressure_lag_s and load.pressure_lag2_s act on it in build_model and when a recording is
+/// driven). Cheap: no mesh.
 LoadHistory inlet_load(const Scene& scene);
-/// The chambers' pressure history: the inlet's through load.pressure_lag_s, the load of
+/// The chambers' pressure history: the inlet's through load.pressure_lag_s (and _lag2_s), the load of
 /// build_model. Cheap: no mesh.
 LoadHistory chamber_load(const Scene& scene);
 

@@ -89,6 +89,7 @@ std::vector<KeyLimit> make_limits() {
   l.push_back(closed("load.rest_s", 0.0, kMaxTime_s, std::string("0 = no rest; ") + kTimeWhy));
   l.push_back(closed("load.output_every_s", 0.0, kMaxTime_s, std::string("0 = only the mark and the end; ") + kTimeWhy));
   l.push_back(closed("load.pressure_lag_s", 0.0, kMaxTime_s, std::string("0 = no lag; ") + kTimeWhy));
+  l.push_back(closed("load.pressure_lag2_s", 0.0, kMaxTime_s, std::string("0 = a first-order lag; ") + kTimeWhy));
   // [gravity], [angle]: 1000 g is no rig on earth.
   l.push_back(closed("gravity.g_m_s2", -1e4, 1e4, "1000 g is no rig on earth"));
   l.push_back(closed("gravity.rig_angle_deg", -360.0, 180.0, "< 0 = off (g_m_s2 applies); else degrees from the axis"));

@@ -40,7 +40,7 @@ std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::v
     const CandidateParameter& p = c.params[i];
     const double v = std::clamp(values[i], p.lo, p.hi);
     const double x = p.log ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
-    if (x <= 0.01 || x >= 0.99) out.push_back(p.name);
+    if ((x <= 0.01 && !p.reduces_at_lo) || x >= 0.99) out.push_back(p.name);
   }
   return out;
 }
@@ -524,6 +524,10 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
                      "large misfit of the elastic response hides it from the raw tests."
                    : "") +
               " Residual signature: " + evidence(c.name, sig) + ". " + c.signature + ".";
+      if (c.reading) {
+        const std::string reading = c.reading(r.params);
+        if (!reading.empty()) r.why += " " + reading;
+      }
       for (const std::string& name : r.at_bound) {
         const auto p = std::find_if(c.params.begin(), c.params.end(), [&](const CandidateParameter& q) { return q.name == name; });
         const double v = r.params[static_cast<std::size_t>(p - c.params.begin())];

@@ -243,7 +243,9 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& options
 /// (in the calibration coordinate, log or linear) of either bound. A constant pushed to the edge of
 /// its physical range is the mark of an effect standing in for a misfit of another kind (measured:
 /// a recording made on a finer mesh than the model's, diagnosed on the coarse one, selects Mullins
-/// with r = 1.1, its lower bound, in round 2). The rig angle is exempt: 0 and 180 deg are real rigs.
+/// with r = 1.1, its lower bound, in round 2). The rig angle is exempt: 0 and 180 deg are real rigs;
+/// so is a lower bound where the effect reduces to a simpler one (CandidateParameter::reduces_at_lo:
+/// pressure_lag's tau2 = 0 is the first-order lag).
 std::vector<std::string> params_at_bounds(const CandidateEffect& c, const std::vector<double>& values);
 
 /// A static model-form discrepancy (the delta(x) of Kennedy & O'Hagan 2001, here a cubic in the

@@ -28,6 +28,9 @@ struct CandidateParameter {
   double initial;     ///< start of calibration
   double truth;       ///< value `pneufem synth --hidden` uses by default
   bool log = false;   ///< calibrate/sample in log space
+  /// lo is where the effect reduces to a simpler one of its kind (pressure_lag's tau2 = 0: the
+  /// first-order lag), not an extreme: a value there is no "constant at a bound" (params_at_bounds).
+  bool reduces_at_lo = false;
 };
 
 struct CandidateEffect {
@@ -42,6 +45,9 @@ struct CandidateEffect {
   /// `--set` overrides (key=value) that add the effect with these parameter values (one per param,
   /// in order) to `scene`. Throws InputError for a wrong number of values.
   std::function<std::vector<std::string>(const Scene& scene, const std::vector<double>& values)> sets;
+  /// Optional: what calibrated `values` mean, in plain words (pressure_lag: which order, zeta and
+  /// f_n); diagnose appends it to the candidate's "why".
+  std::function<std::string(const std::vector<double>& values)> reading;
 };
 
 /// Built-ins then every registered material effect (rebuilt when effects were registered since).

@@ -22,11 +22,14 @@ namespace pneufem::diagnose_detail {
 
 namespace {
 
+/// The scene without its chamber-pressure lag (both orders): the lag acts on the load, not the curves.
+Scene without_lag(const Scene& s) { return s.with({"load.pressure_lag_s=0.0", "load.pressure_lag2_s=0.0"}); }
+
 /// Cache key of a scene's elastic FEM curve: its TOML without the lag (curves are lag-free) and
 /// without the tables of disabled effects, whose constants do not change the model (otherwise
 /// every calibration run of a history effect on top of gravity missed the cache of its elastic
 /// gravity offset, one FEM sweep per run).
-std::string curve_key(const Scene& s) { return s.with({"load.pressure_lag_s=0.0"}).model_toml(); }
+std::string curve_key(const Scene& s) { return without_lag(s).model_toml(); }
 
 bool has_history(const Model& m) {
   for (const Part& p : m.parts)
@@ -163,8 +166,8 @@ bool PathModelEvaluator::uses_fem_sweeps(const Scene& variant) const {
 
 std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& variant, bool kept_only) const {
   const std::unique_ptr<BuiltModel> bm = build_model(variant);
-  const double lag = variant.has("load.pressure_lag_s") ? variant.number("load.pressure_lag_s") : 0.0;
-  const LoadHistory load = lag > 0.0 ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
+  const PressureLag lag = scene_pressure_lag(variant);  // first or second order (load.pressure_lag2_s)
+  const LoadHistory load = lag.on() ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
   const std::size_t nt = rec_.trials.size();
   // Engine times of the requested samples, per trial.
   std::vector<std::vector<double>> times(nt);
@@ -326,7 +329,7 @@ std::vector<double> PathModelEvaluator::stored_curve(const Scene& variant, const
   Fnv1a h;
   h.str(executable_fingerprint());
   h.str("static angle curve");
-  hash_model(h, variant.with({"load.pressure_lag_s=0.0"}), bm.model);  // curves are lag-free (curve_key)
+  hash_model(h, without_lag(variant), bm.model);  // curves are lag-free (curve_key)
   h.num(hi);
   h.num(n);
   return cached_doubles(cache_dir_, "curve", h.hex(), [&] { return static_angle_curve(bm, hi, n); }, source);

@@ -329,13 +329,14 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
   std::vector<double> offset;
   DriveResult result;
   LoadHistory load = measured_load(rec, opt, scene.number("load.rest_s"), rate_dependent, offset, &result.tolerance_kPa);
-  // The scene's chamber-pressure lag (load.pressure_lag_s) acts on the measured inlet exactly as
-  // on the scene's own load (same 0.05 kPa breakpoint tolerance as build_model uses for a CSV
-  // inlet). Its breakpoints become reported states too, so the lagged rise after each step is
-  // resolved at the frames rather than bridged by one straight line.
-  const double lag_s = scene.has("load.pressure_lag_s") ? scene.number("load.pressure_lag_s") : 0.0;
-  if (lag_s > 0.0) {
-    LoadHistory lagged = apply_pressure_lag(load, lag_s, 0.05e3);
+  // The scene's chamber-pressure lag (load.pressure_lag_s, first or with load.pressure_lag2_s
+  // second order) acts on the measured inlet exactly as on the scene's own load (same 0.05 kPa
+  // breakpoint tolerance as build_model uses for a CSV inlet). Its breakpoints become reported
+  // states too, so the lagged rise after each step is resolved at the frames rather than bridged
+  // by one straight line.
+  const PressureLag lag = scene_pressure_lag(scene);
+  if (lag.on()) {
+    LoadHistory lagged = apply_pressure_lag(load, lag, 0.05e3);
     for (TrialLoad& tl : lagged.trials) {
       std::vector<double>& out = tl.output_s;
       out.insert(out.end(), tl.time_s.begin(), tl.time_s.end());

@@ -21,8 +21,8 @@
 //     pressure changes (ramps) and, for models with history (creep, damage: Assembler state
 //     non-empty), everywhere, so relaxation inside holds is resolved; for elastic models a hold
 //     at constant pressure has a constant angle and needs no extra states.
-// A scene with a chamber-pressure lag (load.pressure_lag_s, scenes/pressure_lag.h) filters the
-// measured inlet pressure through it, as it would its own load.
+// A scene with a chamber-pressure lag (load.pressure_lag_s, load.pressure_lag2_s,
+// scenes/pressure_lag.h) filters the measured inlet pressure through it, as it would its own load.
 // Trial times are the recording's (times before 0 are allowed: the trial clock is shifted for
 // the engine and shifted back). All trials run in order through ONE quasi-static run, so
 // internal variables carry over; between trials the pressure is released to 0 and held for the

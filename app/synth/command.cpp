@@ -275,8 +275,8 @@ SynthResult run_synth(const SynthOptions& o) {
         tl.pressure_Pa.push_back(ps[i] * 1e3);
       }
   }
-  const double lag_s = scene.number("load.pressure_lag_s");
-  LoadHistory chamber = lag_s > 0 ? apply_pressure_lag(inlet, lag_s, o.inlet_tolerance_kPa * 1e3) : inlet;
+  const PressureLag lag = scene_pressure_lag(scene);  // first or second order (load.pressure_lag2_s)
+  LoadHistory chamber = lag.on() ? apply_pressure_lag(inlet, lag, o.inlet_tolerance_kPa * 1e3) : inlet;
   for (TrialLoad& tl : chamber.trials) {
     std::vector<double> out = tl.time_s;  // a state at every breakpoint (t = 0 included) ...
     for (double t = o.report_every_s; t < tl.duration(); t += o.report_every_s) out.push_back(t);  // ... and in holds
@@ -285,7 +285,7 @@ SynthResult run_synth(const SynthOptions& o) {
     tl.output_s = out;
   }
   chamber.description = "synth: " + commanded.description + " through a second-order controller" +
-                        (lag_s > 0 ? " and a chamber lag" : "");
+                        (lag.on() ? " and a chamber lag" : "");
 
   std::vector<std::vector<double>> rec_t(chamber.trials.size()), rec_angle(chamber.trials.size());
   {

@@ -15,9 +15,9 @@
 //     1.96/w = 0.31 s, settled to 2 % in 4/(zeta w) = 0.98 s);
 //  3. the model is driven by that inlet: a piecewise-linear fit within inlet_tolerance_kPa (the
 //     400 Hz samples simplified by Ramer-Douglas-Peucker; sampling the smooth response every 2.5 ms
-//     adds < h^2/8 max|p''| = 2e-4 kPa per 5 kPa step), through load.pressure_lag_s if set, and
-//     solved quasi-statically through all trials with a report at every breakpoint and at least
-//     every report_every_s (so creep within a hold is resolved);
+//     adds < h^2/8 max|p''| = 2e-4 kPa per 5 kPa step), through load.pressure_lag_s (and
+//     load.pressure_lag2_s) if set, and solved quasi-statically through all trials with a report at
+//     every breakpoint and at least every report_every_s (so creep within a hold is resolved);
 //  4. the model angle is interpolated linearly between solved states at the frame times; noise:
 //     white Gaussian on both streams, plus outlier frames (tracking failures) jumping by
 //     +-U(outlier_min_deg, outlier_max_deg).

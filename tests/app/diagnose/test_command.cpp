@@ -136,7 +136,8 @@ TEST(EffectiveSampleSize, WhiteAndCorrelatedResiduals) {
 // within 0.5 % of the truth, closer than the reduced model, and the FEM error near zero (noise-free
 // data; 0.5 % of stiffness is ~0.3 % of the angle range).
 // A calibrated constant within 1 % (of the calibration coordinate, log here) of a bound is flagged;
-// inside the range it is not; the rig angle's ends are real rigs, never flagged.
+// inside the range it is not; the rig angle's ends are real rigs, never flagged, and so is the
+// lag's tau2 = 0 (the first-order lag, reduces_at_lo), though its upper end is.
 TEST(Diagnose, ConstantsAtTheEdgeOfTheirRangeAreFlagged) {
   const CandidateEffect& m = candidate_effect("mullins");  // r in [1.1, 20], m in [1e-3, 0.1], both log
   EXPECT_EQ(params_at_bounds(m, {1.1, 0.02}), std::vector<std::string>{"r"});
@@ -145,6 +146,8 @@ TEST(Diagnose, ConstantsAtTheEdgeOfTheirRangeAreFlagged) {
   EXPECT_EQ(params_at_bounds(candidate_effect("fatigue"), {0.02, 1e5}), std::vector<std::string>{"tau_s"});
   EXPECT_EQ(params_at_bounds(candidate_effect("gravity"), {180.0}), std::vector<std::string>{});
   EXPECT_EQ(params_at_bounds(candidate_effect("gravity"), {0.0}), std::vector<std::string>{});
+  EXPECT_EQ(params_at_bounds(candidate_effect("pressure_lag"), {0.4, 0.0}), std::vector<std::string>{});
+  EXPECT_EQ(params_at_bounds(candidate_effect("pressure_lag"), {0.4, 1.0}), std::vector<std::string>{"tau2_s"});
 }
 
 // The static discrepancy (fit_static_discrepancy) on a synthetic staircase: three trials of four

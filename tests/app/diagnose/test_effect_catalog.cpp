@@ -102,7 +102,19 @@ TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRight
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.W_th_MPa"), 0.02);
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.tau_s"), 2000.0);
   EXPECT_EQ(s.string("materials.silicone.fatigue.driver"), base.string("materials.silicone.fatigue.driver"));
-  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5}).number("load.pressure_lag_s"), 0.5);
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag_s"), 0.5);
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag2_s"), 0.0);  // first order
+  EXPECT_DOUBLE_EQ(with("pressure_lag", {0.24, 0.27}).number("load.pressure_lag2_s"), 0.27);  // second order
+  // ... and what its constants mean, in the diagnosis's words: the order, zeta and f_n, or the RC stages.
+  const CandidateEffect& lag = candidate_effect("pressure_lag");
+  ASSERT_TRUE(lag.reading);
+  EXPECT_NE(lag.reading({0.4, 0.0}).find("First order"), std::string::npos) << lag.reading({0.4, 0.0});
+  const std::string under = lag.reading({2.0 * 0.45 / (2.0 * M_PI * 0.6), 1.0 / (2.0 * M_PI * 0.6)});
+  EXPECT_NE(under.find("under-damped"), std::string::npos) << under;
+  EXPECT_NE(under.find("zeta = 0.45, f_n = 0.6 Hz"), std::string::npos) << under;
+  EXPECT_NE(under.find("overshoots a step by 21 %"), std::string::npos) << under;
+  const std::string over = lag.reading({0.5, 0.2});  // T1 T2 = 0.04, T1 + T2 = 0.5
+  EXPECT_NE(over.find("two first-order stages of 0.4 s and 0.1 s"), std::string::npos) << over;
   // Gravity: the rig angle in the actuator's frame; on the built-in actuator phi = 0 hangs the tip
   // down along +y, 90 deg is horizontal with g towards the fabric (-z), bit for bit the vectors the
   // hidden-effect datasets were made with (g_m_s2 = [0, 9.81 cos(phi), -9.81 sin(phi)]).

@@ -15,6 +15,7 @@
 // most 0.4x the baseline's; the recordings with a static misfit only name nothing.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -115,19 +116,22 @@ TEST(OtherMeansNull, AnotherMeshsCurveIsNamedAsStiffnessWithTheRestStatic) {
 // ---- Item 5 in CI: the first-order lag against the candidates that could stand in for it (a static
 // misfit, creep in a hold, softening). Measured: pressure_lag named alone, NRMSE 0.1046 -> 0.0080
 // (0.08x) at a 0.0082 floor, tau 0.396 s for the truth's 0.4 s (the regulator's overshoot is in the
-// recorded inlet pressure, so the lag is seen behind it); round 2 skipped at the noise floor. 30 s
-// of one core.
+// recorded inlet pressure, so the lag is seen behind it) and tau2 = 0 (first order: the candidate's
+// second constant, free in [0, 1] s, stays at 0); round 2 skipped at the noise floor. 30 s of one
+// core; 17 s on two threads with the two-constant lag (2026-11-27).
 TEST(OtherMeansRecording, FirstOrderLagIsNamedWithItsTimeConstant) {
   const DiagnosisResult r = diagnose("lag_first_order", {"stiffness", "pressure_lag", "viscoelastic_instantaneous", "mullins"});
   expect_found(r, {"lag"});
   ASSERT_FALSE(r.candidates.empty());
   ASSERT_EQ(r.candidates.front().effect, "pressure_lag");
   EXPECT_NEAR(r.candidates.front().params.at(0), 0.4, 0.02);  // 5 %: the CalculiX recording's tolerance
+  EXPECT_LE(r.candidates.front().params.at(1), 0.05);          // tau2: first order (measured 0)
 }
 
 // ---- Item 5: the whole catalog, as a user runs it. Too slow for CI on one core (a whole-catalog
 // diagnosis of a 3-10 trial recording with two rounds: 3.5-15 min of one core, measured on a shared
-// machine); run with --gtest_also_run_disabled_tests. Each comment gives what was measured (the CLI,
+// machine), except the second-order lag (one round, 100 s on two threads); run the others with
+// --gtest_also_run_disabled_tests. Each comment gives what was measured (the CLI,
 // `pneufem diagnose scenes/examples/small_actuator.toml --data tests/data/othermeans/NAME.csv`, the
 // same run_diagnosis with the same defaults).
 
@@ -157,17 +161,28 @@ TEST(OtherMeansRecording, DISABLED_SofterReloadBelowThePeakIsMullins) {
   expect_found(diagnose("mullins_reload"), {"mullins"});
 }
 // The CI test FirstOrderLagIsNamedWithItsTimeConstant runs this recording on four candidates.
+// Measured with the whole catalog and the two-constant lag (2026-11-27): pressure_lag alone, NRMSE
+// 0.1046 -> 0.0080 (0.08x) at a 0.0082 floor, tau 0.396 s, tau2 0; round 2 skipped at the noise
+// floor. 75 s on two threads.
 TEST(OtherMeansRecording, DISABLED_FirstOrderLagIsNamed) { expect_found(diagnose("lag_first_order"), {"lag"}); }
-// FAILS (measured 2026-11-27, candidates stiffness, pressure_lag, viscoelastic_instantaneous,
-// mullins): pressure_lag is named alone (tau 0.35 s for a 0.6 Hz, zeta 0.45 chamber response), but
-// NRMSE 0.0939 -> 0.0386 is 0.41x the baseline, not <= 0.4x, at a 0.0092 floor: 82 % of what is left
-// changes within the holds (0.0352 beyond a static misfit). The catalog's lag is first order; an
-// under-damped chamber overshoots, which no first-order filter of the inlet can. In round 2 creep
-// (delta AIC -9.8, tau at its bound) and stiffness (-9.3) just miss the AIC test: nothing spurious.
-// The fix is a second-order lag (load.pressure_lag_s plus a natural frequency, scenes/pressure_lag.h)
-// as a second constant of the candidate, outside app/diagnose. 200 s of one core.
-TEST(OtherMeansRecording, DISABLED_UnderDampedSecondOrderLagIsNamed) {
-  expect_found(diagnose("lag_second_order"), {"lag"});
+// In CI (the whole catalog, 100 s on two threads): the second-order lag. Named as pressure_lag with
+// tau2 > tau/2 (under-damped), its natural frequency 1/(2 pi tau2) and damping tau/(2 tau2) those of
+// the truth's chamber (f_n 0.6 Hz, zeta 0.45). Measured (2026-11-27): pressure_lag named alone, NRMSE
+// 0.0939 -> 0.0091 (0.10x) at a 0.0092 floor, tau 0.2378 s, tau2 0.2632 s: f_n 0.605 Hz, zeta 0.452
+// (truth tau 0.2387 s, tau2 0.2653 s); round 2 skipped at the noise floor. With the first-order lag
+// of the catalog before it (tau 0.35 s) the error left was 0.0386, 0.41x: an under-damped chamber
+// overshoots each step, which no first-order filter of the inlet can.
+TEST(OtherMeansRecording, UnderDampedSecondOrderLagIsNamedWithItsFrequencyAndDamping) {
+  const DiagnosisResult r = diagnose("lag_second_order");
+  expect_found(r, {"lag"});
+  ASSERT_FALSE(r.candidates.empty());
+  const CandidateResult& c = r.candidates.front();
+  ASSERT_EQ(c.effect, "pressure_lag");
+  ASSERT_EQ(c.params.size(), 2u);
+  const double tau = c.params[0], tau2 = c.params[1];
+  EXPECT_NEAR(1.0 / (2.0 * M_PI * tau2), 0.6, 0.03);  // 5 %, as the first-order lag's tau
+  EXPECT_NEAR(tau / (2.0 * tau2), 0.45, 0.045);       // 10 %: noise and the regulator seen through the lag
+  EXPECT_NE(c.why.find("under-damped"), std::string::npos) << c.why;  // and the diagnosis says so
 }
 // Incomplete measurement (whole catalog, max_effects 4; over 75 min of wall time on a shared machine,
 // not finished by the deadline): creep was selected in round 1 in the instantaneous convention
@@ -180,7 +195,11 @@ TEST(OtherMeansRecording, DISABLED_CreepAndFatigueOverTenTrialsAreBothNamed) {
 // Measured with the candidates stiffness, mullins, pressure_lag, viscoelastic_instantaneous (max 3):
 // the lag in round 1 (NRMSE 0.0953 -> 0.0350), Mullins in round 2 (-> 0.0164 at a 0.0160 floor,
 // 0.17x; r 1.71, m 0.044 MPa), the lag re-fitted jointly to tau 0.351 s (truth 0.35 s); round 3
-// skipped at the noise floor. 115 s of one core.
+// skipped at the noise floor. 115 s of one core. Measured again with the whole catalog and the
+// two-constant lag (2026-11-27): the lag in round 1 (0.0953 -> 0.0339, tau 0.325 s, tau2 0.128 s:
+// over-damped, taking part of the softening), Mullins in round 2 (-> 0.0163 at a 0.0160 floor,
+// 0.17x; r 1.48, m 0.052 MPa) with the lag re-fitted jointly to tau 0.352 s, tau2 0: first order, as
+// the truth. 296 s on two threads.
 TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(diagnose("mullins_lag"), {"mullins", "lag"}); }
 // FAILS (measured 2026-11-27, whole catalog, max_effects 4): creep (viscoelastic_instantaneous) in
 // round 1 (NRMSE 0.1534 -> 0.0771, floor 0.0059), the lag in round 2 (-> 0.0136, tau 0.31 s for the
@@ -189,7 +208,11 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // found. The power-law creep of this recording (n 0.35) never recovers between trials, so it too
 // drifts upward over the six trials; the long Prony term (tau 10.5 s, re-fitted in round 2) takes
 // that drift, and the log-law fatigue's own growth (D 0.02 -> 0.05) is left below the tests. 813 s
-// of one core.
+// of one core. Measured again with the two-constant lag (2026-11-27): the same selection and
+// errors (0.1534 -> 0.0771 -> 0.0136, 0.09x; fatigue in round 3 0.0136 -> 0.0135, delta AIC 0.8);
+// the lag first order as the truth's (tau 0.311 s, tau2 0; re-fitted in round 3 to 0.310 s, 0);
+// in round 1, alone under the creep, it had fitted tau 0.18 s, tau2 0.25 s. 927 s on two threads
+// of a shared machine. Still FAILS: fatigue not found.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
