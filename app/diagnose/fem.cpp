@@ -44,6 +44,9 @@ struct AccurateModel {
     d.reduced_check = false;
     d.reduced_fallback = false;
     if (!rom.pressure_map_Pa().empty()) d.chamber_pressure = [this](double p) { return rom.chamber(p); };
+    // The offline part for the protocol's peak, not this recording's noisy one: a second recording
+    // of the protocol reuses it from the cache (elastic_reference_peak_Pa, app/diagnose/evaluator.h).
+    d.reduced_peak_Pa = rom.chamber(rom.reference_peak_Pa());
     return simulate_recording(cal_scene.with(s), rec, d);
   }
 };

@@ -290,7 +290,8 @@ using StateObserver = std::function<void(const StateRecord&, const Eigen::Vector
 std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory& load, const DriveOptions& opt,
                           const StateObserver& observe, DriveResult& result) {
   if (opt.progress) std::fprintf(stderr, "  reduced model: elastic path and basis ...\n");
-  const std::unique_ptr<ReducedSetup> setup = reduced_setup(scene, peak_pressure(load), bm.solver.reduced, opt.cache_dir);
+  const double peak_Pa = std::max(opt.reduced_peak_Pa, peak_pressure(load));
+  const std::unique_ptr<ReducedSetup> setup = reduced_setup(scene, peak_Pa, bm.solver.reduced, opt.cache_dir);
   result.reduced_offline_s = setup->offline_s;
   result.reduced_basis_source = setup->basis_source;
   bm.load = load;  // the measured pressure replaces the scene's protocol (run_reduced runs bm.load)

@@ -73,6 +73,10 @@ struct DriveOptions {
   /// diagnose drives a coarser calibration mesh with the pressure at which it bends as the scene's
   /// mesh does (app/diagnose/evaluator.h).
   std::function<double(double)> chamber_pressure;
+  /// Reduced model only: the peak pressure (Pa) its offline part is built for, when above the load's
+  /// own (0 = the load's). The offline part is cached by this peak, so recordings of one protocol,
+  /// whose noisy peaks differ, share it when the caller passes the protocol's peak (diagnose does).
+  double reduced_peak_Pa = 0.0;
 };
 
 struct TrialTrace {

@@ -180,6 +180,29 @@ TEST(DriveReduced, FollowsTheFullFemOnARecording) {
   EXPECT_EQ(largest_difference(unchecked, reduced), 0.0);
 }
 
+// Two recordings of one protocol differ in their noisy peaks; with DriveOptions::reduced_peak_Pa
+// (the protocol's peak with headroom, as diagnose passes) the second reuses the first's offline part
+// from the cache instead of building its own.
+TEST(DriveReduced, RecordingsOfOneProtocolShareTheOfflinePart) {
+  const Scene scene = Scene::load(kStory, kSmall).with({"solver.model=\"reduced\""});
+  const Recording first = commanded_recording(scene);
+  Recording second = first;
+  for (TrialRecording& tr : second.trials)
+    for (double& p : tr.pressure_kPa.value) p *= 1.02;  // another peak: 45.9 kPa instead of 45
+  DriveOptions opt;
+  opt.threads = 2;
+  opt.reduced_check = false;
+  opt.cache_dir = temp_dir("drive_peak").string();
+  opt.reduced_peak_Pa = 50e3;  // the protocol's 45 kPa with 10 % headroom, as diagnose takes it
+  const DriveResult a = simulate_recording(scene, first, opt);
+  const DriveResult b = simulate_recording(scene, second, opt);
+  EXPECT_EQ(a.reduced_basis_source, "computed");
+  EXPECT_EQ(b.reduced_basis_source.rfind("cache ", 0), 0u) << b.reduced_basis_source;
+  opt.reduced_peak_Pa = 0.0;  // each recording's own peak: a new offline part
+  const DriveResult c = simulate_recording(scene, second, opt);
+  EXPECT_EQ(c.reduced_basis_source, "computed");
+}
+
 // A basis broken on purpose (as above): a checked recording run is replaced by the full FEM, whose
 // angles it then gives bit for bit, and DriveResult::model says why; without the fallback (what
 // diagnose's refinement asks for) the reduced angles stand and the estimate is recorded.
