@@ -1,7 +1,9 @@
 #include "scenes/pressure_lag.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "core/errors.h"
 #include "scenes/scene.h"
@@ -21,6 +23,28 @@ void for_each_segment(const TrialLoad& tl, double tau, Visit&& visit) {
     const double C = pc - a + b * tau;
     pc = a + b * (tb - ta) - b * tau + C * std::exp(-(tb - ta) / tau);
   }
+}
+
+/// Appends the breakpoints inside one inlet segment [ta, tb] (s = t - ta), and its end: from
+/// s = 0 in steps step(s) (the largest step whose chord stays within the tolerance, from the
+/// transient's size at s), each at least 1e-9 of the segment (the staircase's jumps are 1e-9 of a
+/// hold long; keeps the loop finite whatever the transient), the last landing on the segment's end.
+template <class Step, class PressureAt>
+void append_breakpoints(double ta, double tb, Step&& step, PressureAt&& p_at, std::vector<double>& ts,
+                        std::vector<double>& ps) {
+  const double len = tb - ta, h_min = 1e-9 * len;
+  double s = 0.0;
+  while (s < len) {
+    double h = std::max(step(s), h_min);
+    if (s + h >= len * (1.0 - 1e-12)) h = len - s;
+    s += h;
+    if (s < len) {
+      ts.push_back(ta + s);
+      ps.push_back(p_at(s));
+    }
+  }
+  ts.push_back(tb);
+  ps.push_back(p_at(len));
 }
 
 }  // namespace
@@ -54,24 +78,12 @@ LoadHistory apply_pressure_lag(const LoadHistory& inlet, double tau, double tol)
     for_each_segment(tl, tau, [&](double ta, double tb, double a, double b, double pc) {
       const double C = pc - a + b * tau;
       auto p_at = [&](double s) { return a + b * s - b * tau + C * std::exp(-s / tau); };
-      double s = 0.0;
       const double len = tb - ta;
-      // Shortest interval worth a breakpoint: 1e-9 of the segment (the staircase's jumps are 1e-9
-      // hold long); keeps the loop finite for any C.
-      const double h_min = 1e-9 * len;
-      while (s < len) {
+      auto step = [&](double s) {
         const double amp = std::abs(C) * std::exp(-s / tau);
-        double h = amp <= tol ? len - s : tau * std::sqrt(8.0 * tol / amp);
-        h = std::max(h, h_min);
-        if (s + h >= len * (1.0 - 1e-12)) h = len - s;
-        s += h;
-        if (s < len) {
-          ts.push_back(ta + s);
-          ps.push_back(p_at(s));
-        }
-      }
-      ts.push_back(tb);
-      ps.push_back(p_at(len));
+        return amp <= tol ? len - s : tau * std::sqrt(8.0 * tol / amp);
+      };
+      append_breakpoints(ta, tb, step, p_at, ts, ps);
       return true;
     });
     tl.time_s = std::move(ts);
@@ -170,26 +182,15 @@ void lag_trial2(TrialLoad& tl, const PressureLag& lag, double tol) {
       T.at(e0, de0, s, e, de);
       return a + b * (s - T.tau()) + e;
     };
-    const double len = tb - ta, h_min = 1e-9 * len;  // as the first order: keeps the loop finite
-    double s = 0.0;
-    while (s < len) {
+    const double len = tb - ta;
+    auto step = [&](double s) {
       double e, de;
       T.at(e0, de0, s, e, de);
-      double h = len - s;
-      if (std::sqrt(e * e + b2 * de * de) > 0.5 * tol) {
-        const double e2 = -(T.tau() * de + e) / b2, e3 = -(T.tau() * e2 + de) / b2;  // from the equation
-        h = std::sqrt(8.0 * tol / std::sqrt(e2 * e2 + b2 * e3 * e3));
-      }
-      h = std::max(h, h_min);
-      if (s + h >= len * (1.0 - 1e-12)) h = len - s;
-      s += h;
-      if (s < len) {
-        ts.push_back(ta + s);
-        ps.push_back(p_at(s));
-      }
-    }
-    ts.push_back(tb);
-    ps.push_back(p_at(len));
+      if (std::sqrt(e * e + b2 * de * de) <= 0.5 * tol) return len - s;
+      const double e2 = -(T.tau() * de + e) / b2, e3 = -(T.tau() * e2 + de) / b2;  // from the equation
+      return std::sqrt(8.0 * tol / std::sqrt(e2 * e2 + b2 * e3 * e3));
+    };
+    append_breakpoints(ta, tb, step, p_at, ts, ps);
     return true;
   });
   tl.time_s = std::move(ts);

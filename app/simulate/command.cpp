@@ -358,17 +358,11 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       const ReducedRunResult rr = run_reduced(*rsetup, *bm, observe);
       const double tol = bm->solver.reduced_check_deg;
       std::string fallback = "none";
-      if (rr.worst_check_deg > tol) {
-        const StateRecord& w = rr.reports[static_cast<std::size_t>(rr.worst_report)].record;
-        char why[320];
-        std::snprintf(why, sizeof why,
-                      "full FEM: the reduced model's estimated angle error %.3g deg at trial %d, t = %.2f s (%.1f kPa) exceeds "
-                      "solver.reduced_check_deg = %.3g",
-                      rr.worst_check_deg, w.trial, w.time_s, w.pressure_Pa * 1e-3, tol);
-        fallback = why;
+      if (const std::string why = reduced_check_failure(rr, tol); !why.empty()) {
+        fallback = "full FEM: " + why;
         bm->warnings.push_back(fallback);
         progress.done();
-        if (opt.progress) std::fprintf(stderr, "  %s\n", why);
+        if (opt.progress) std::fprintf(stderr, "  %s\n", fallback.c_str());
         records.clear();  // the FEM's reports and VTU files replace the reduced ones
         app.vtu.clear();
         pvd = PvdSeries((dir / "results.pvd").string());

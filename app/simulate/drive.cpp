@@ -304,15 +304,9 @@ std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory&
   }
   result.states = rr.stats.states;
   result.reduced_worst_check_deg = opt.reduced_check ? rr.worst_check_deg : -1.0;
-  const double tol = bm.solver.reduced_check_deg;
-  if (opt.reduced_check && rr.worst_check_deg > tol && opt.reduced_fallback) {
-    const StateRecord& w = rr.reports[static_cast<std::size_t>(rr.worst_report)].record;
-    char why[320];
-    std::snprintf(why, sizeof why,
-                  "the reduced model's estimated angle error %.3g deg at trial %d, t = %.2f s (%.1f kPa) exceeds "
-                  "solver.reduced_check_deg = %.3g",
-                  rr.worst_check_deg, w.trial, w.time_s, w.pressure_Pa * 1e-3, tol);
-    return why;
+  if (opt.reduced_check && opt.reduced_fallback) {
+    std::string why = reduced_check_failure(rr, bm.solver.reduced_check_deg);
+    if (!why.empty()) return why;
   }
   result.model = "reduced";
   return "";

@@ -37,6 +37,17 @@ ElasticPathTrace unflatten_trace(const std::vector<double>& f, Eigen::Index dofs
 
 }  // namespace
 
+std::string reduced_check_failure(const ReducedRunResult& run, double tol_deg) {
+  if (!(run.worst_check_deg > tol_deg)) return "";
+  const StateRecord& w = run.reports[static_cast<std::size_t>(run.worst_report)].record;
+  char why[320];
+  std::snprintf(why, sizeof why,
+                "the reduced model's estimated angle error %.3g deg at trial %d, t = %.2f s (%.1f kPa) exceeds "
+                "solver.reduced_check_deg = %.3g",
+                run.worst_check_deg, w.trial, w.time_s, w.pressure_Pa * 1e-3, tol_deg);
+  return why;
+}
+
 double peak_pressure(const LoadHistory& load) {
   double p = 0.0;
   for (const TrialLoad& tl : load.trials)

@@ -63,6 +63,10 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
                                  at_report = nullptr,
                              bool check = true);
 
+/// Why a checked reduced run must not stand ("" = it may): its worst estimated angle error
+/// exceeds `tol_deg` (solver.reduced_check_deg), with the report where.
+std::string reduced_check_failure(const ReducedRunResult& run, double tol_deg);
+
 /// The largest pressure of a load history (Pa).
 double peak_pressure(const LoadHistory& load);
 
