@@ -100,6 +100,7 @@ std::vector<double> nrmse_per_trial(const LoadHistory& load, const Record& a, co
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
   bool fem = false, check = false, dump = false;
@@ -156,6 +157,7 @@ int main(int argc, char** argv) {
   ElasticPathTrace trace;
   {
     const fs::path f = fs::path(work) / ("trace_" + key + ".bin");
+    std::printf("elastic path file: %s\n", f.c_str());
     std::vector<double> d;
     const auto t0 = Clock::now();
     if (read_doubles(f, d)) {
@@ -185,7 +187,25 @@ int main(int argc, char** argv) {
     std::printf("snapshots: %zu FEM reports of %d trial(s) in %.1f s\n", snapshots.size(), snap_trials, since(t0));
   }
   const auto tb = Clock::now();
-  const ReducedBasis basis = build_reduced_basis(ref->model, trace, ro, snapshots);
+  // The basis is cached too (keyed by the reference, the options and the snapshot run), so that an
+  // A/B of the online part does not pay the offline part again.
+  const ReducedBasis basis = [&] {
+    char opts[256];
+    std::snprintf(opts, sizeof opts, "%d/%d/%d/%.6g/%.6g/%d/%d/%.6g/%d/%zu", ro.clusters, ro.mode_samples, ro.max_modes,
+                  ro.pod_tolerance, ro.ecsw_tolerance, ro.hyper_reduce ? 1 : 0, ro.softened_levels, ro.softened_max, snap_trials,
+                  snap_sets.size());
+    std::string snap_key;
+    for (const std::string& s : snap_sets) snap_key += s + ";";
+    const fs::path f = fs::path(work) / ("basis_" + std::to_string(fnv(ref_scene.model_toml() + opts + snap_key)) + ".bin");
+    std::vector<double> d;
+    if (read_doubles(f, d)) {
+      std::printf("basis: from %s\n", f.c_str());
+      return ReducedBasis::from_doubles(d);
+    }
+    ReducedBasis b = build_reduced_basis(ref->model, trace, ro, snapshots);
+    write_doubles(f, b.to_doubles());
+    return b;
+  }();
   std::printf("basis: %d modes, %zu sampled elements of %d soft (%d clusters), POD energy left %.2e, ECSW worst %.2e, %.1f s; path to %.2f deg\n",
               basis.num_modes(), basis.elements.size(), basis.info.soft_elements, basis.info.clusters, basis.info.pod_energy_left,
               basis.info.ecsw_worst_residual, since(tb), basis.theta.back());
@@ -237,8 +257,8 @@ int main(int argc, char** argv) {
   std::printf("largest correction: RMS %.3g mm; path top RMS %.3g mm\n", qmax * 1e3,
               1e3 * basis.U.col(basis.num_samples() - 1).norm() / std::sqrt(basis.dofs() / 3.0));
   const ReducedRunStats& st = run.stats();
-  std::printf("reduced run: %.2f s wall, %ld states (%ld rejected), %ld Newton its, %ld tangents, %ld residuals, %d points%s\n",
-              since(t_on), st.states, st.rejected_steps, st.newton_iterations, st.tangents, st.residuals, rom.num_points(),
+  std::printf("reduced run: %.2f s wall, %ld states (%ld rejected), %ld Newton its, %ld tangents (%ld iterations on a kept one), %ld residuals, %d points%s\n",
+              since(t_on), st.states, st.rejected_steps, st.newton_iterations, st.tangents, st.reused_tangents, st.residuals, rom.num_points(),
               st.beyond_path ? ", BEYOND THE PATH" : "");
   // The a-posteriori indicators at every report: the adjoint-weighted residual and one full Newton step.
   std::vector<double> est_adj, est_newton;
@@ -355,8 +375,12 @@ int main(int argc, char** argv) {
     }
   } else {
     for (std::size_t i = 0; i < red.angle.size(); ++i)
-      std::printf("  %d %7.2f %6.2f %9.3f (ideal %9.3f)\n", red.trial[i], red.t[i], red.p[i] * 1e-3, red.angle[i],
+    {
+      std::printf("  %d %7.2f %6.2f %9.3f (ideal %9.3f)", red.trial[i], red.t[i], red.p[i] * 1e-3, red.angle[i],
                   i < ideal.angle.size() ? ideal.angle[i] : std::nan(""));
+      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f", est_adj[i], est_newton[i]);
+      std::printf("\n");
+    }
   }
   return 0;
 }

@@ -203,6 +203,7 @@ struct ReducedStep {
 
 struct ReducedRunStats {
   long states = 0, rejected_steps = 0, newton_iterations = 0, tangents = 0, residuals = 0;
+  long reused_tangents = 0;  ///< iterations solved with an earlier Jacobian (modified Newton)
   double wall_s = 0.0;
   bool beyond_path = false;  ///< theta left the traced path (extrapolated): trust it less
 };
@@ -261,6 +262,7 @@ class ReducedRun {
   /// Called at every report with its record, the reduced coordinates and the full displacement.
   using Observer = std::function<void(const StateRecord&, const ReducedCoordinates&, const Eigen::VectorXd& u)>;
   ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options);
+  ~ReducedRun();
 
   void run(const LoadHistory& load, const Observer& observer);
 
@@ -278,6 +280,9 @@ class ReducedRun {
 
   const ReducedOrderModel& rom_;
   QuasiStaticOptions opt_;
+  /// The last factorised reduced Jacobian, reused by later iterations and steps while it still
+  /// contracts (equilibrium()); reset where the state jumps (a release, a zero-time load).
+  std::unique_ptr<Eigen::MatrixXd> jacobian_;
   ReducedCoordinates z_, z_prev_;
   double p_prev_ = 0.0;
   std::vector<double> hist_, trial_;
