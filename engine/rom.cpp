@@ -644,6 +644,7 @@ void ReducedRun::solve_segment(const Segment& s) {
   if (kink) hist_prev_.clear();
   double t = s.g0;
   long steps = 0;
+  seg_steps_ = 0;
   while (t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1))) {
     if (++steps > opt_.max_segment_steps) {
       std::ostringstream m;
@@ -655,8 +656,24 @@ void ReducedRun::solve_segment(const Segment& s) {
     double hstep = std::min(dt_suggest_, s.g1 - t);
     if (s.g1 - (t + hstep) < 0.25 * hstep) hstep = s.g1 - t;
     const ReducedCoordinates z_saved = z_;
+    // Predictor: within a segment (one ramp or one hold) the state moves smoothly, so Newton starts
+    // from the linear extrapolation of the last two committed states (the converged state does not
+    // depend on the start; from a start that fails, Newton runs again from the committed state).
+    const bool predict = seg_steps_ > 0;
+    if (predict) {
+      const double ratio = hstep / h_seg_prev_;
+      z_.theta += ratio * (z_saved.theta - z_seg_prev_.theta);
+      z_.q += ratio * (z_saved.q - z_seg_prev_.q);
+      z_.lambda += ratio * (z_saved.lambda - z_seg_prev_.lambda);
+    }
     try {
-      equilibrium(p_at(t + hstep), t + hstep, hstep);
+      try {
+        equilibrium(p_at(t + hstep), t + hstep, hstep);
+      } catch (const PhysicsError&) {
+        if (!predict) throw;
+        z_ = z_saved;
+        equilibrium(p_at(t + hstep), t + hstep, hstep);
+      }
     } catch (const PhysicsError&) {
       if (minimal || hstep <= opt_.min_dt_s * (1.0 + 1e-9)) throw;
       z_ = z_saved;
@@ -685,6 +702,9 @@ void ReducedRun::solve_segment(const Segment& s) {
     }
     hist_cur_ = std::move(hist_new);
     rate_prev_ = rate;
+    z_seg_prev_ = z_saved;
+    h_seg_prev_ = hstep;
+    ++seg_steps_;
     t += hstep;
     const bool last = !(t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1)));
     commit(t, hstep, p_at(t), last && s.report);

@@ -284,6 +284,9 @@ class ReducedRun {
   /// contracts (equilibrium()); reset where the state jumps (a release, a zero-time load).
   std::unique_ptr<Eigen::MatrixXd> jacobian_;
   ReducedCoordinates z_, z_prev_;
+  ReducedCoordinates z_seg_prev_;   ///< the committed state before the last one in this segment (predictor)
+  double h_seg_prev_ = 0.0;         ///< the last committed step's length in this segment
+  long seg_steps_ = 0;              ///< steps committed in this segment
   double p_prev_ = 0.0;
   std::vector<double> hist_, trial_;
   std::vector<ReducedStep> steps_;
