@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/json_writer.h"
+#include "viz/xml_escape.h"
 
 namespace pneufem::svg {
 
@@ -245,23 +246,7 @@ std::string tick_label(double v, double step) {
   return s;
 }
 
-std::string escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default:
-        // XML 1.0 forbids control characters other than tab, newline and carriage return.
-        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n' || c == '\r') out += c;
-    }
-  }
-  return out;
-}
+std::string escape(const std::string& text) { return xml_escape(text); }
 
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n\r") == std::string::npos && (text.empty() || text[0] != '#')) return text;

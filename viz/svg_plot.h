@@ -53,8 +53,8 @@ Ticks linear_ticks(double lo, double hi, int target = 5, bool widen = true, bool
 Ticks log_ticks(double lo, double hi, bool widen = true);
 /// Label of a linear tick: as many decimals as the step needs, no "-0".
 std::string tick_label(double v, double step);
-/// Text made safe for SVG/XML character data and attribute values (& < > " ' escaped, control
-/// characters other than tab and newline dropped).
+/// Text made safe for SVG/XML character data and attribute values: xml_escape (viz/xml_escape.h),
+/// the one escape of viz/'s XML (& < > " ' escaped, the control characters XML 1.0 forbids dropped).
 std::string escape(const std::string& text);
 
 /// A CSV field: quoted (quotes doubled) when it holds a comma, a quote or a newline, or starts with '#'.
