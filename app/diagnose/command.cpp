@@ -28,6 +28,7 @@
 #include "core/errors.h"
 #include "core/output_dir.h"
 #include "scenes/build_model.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
 
@@ -187,13 +188,14 @@ double resolve_calibration_h(const Scene& scene, double requested_mm, std::vecto
   const Mesh mesh = build_mesh(scene);
   const long dofs = 3 * static_cast<long>(mesh.num_nodes());
   if (dofs <= kAutoCalibrationDofs) return 0.0;
-  if (scene.string("mesh.source") != "pneunet") {
+  const MeshSettings ms = mesh_settings(scene);
+  if (ms.source != MeshSettings::Source::PneuNet) {
     notes.push_back("the scene's mesh has " + std::to_string(dofs) +
                     " dof: tracing its elastic path and the gravity candidate's FEM sweeps will take long; a coarser "
                     "deck calibrates faster (then --verify on this one)");
     return 0.0;
   }
-  const double h = 3.0 * scene.number("mesh.h_mm");
+  const double h = 3.0 * ms.h_mm;
   notes.push_back("the scene's mesh has " + std::to_string(dofs) + " dof: the candidates are calibrated on the built-in " +
                   "mesher at h = " + fmt("%g", h) + " mm through the scene mesh's elastic curve (--calibration-h " +
                   fmt("%g", h) + "; --calibration-h 0 calibrates on the scene's mesh, slower)");
@@ -227,9 +229,10 @@ std::vector<ComparedFrame> kept_frames(const Recording& rec) {
 // fitted.toml keep the user's mesh).
 Scene calibration_scene(const Scene& scene, const DiagnoseOptions& opt) {
   if (opt.calibration_h_mm <= 0.0) return scene;
-  if (scene.string("mesh.source") != "pneunet")
+  const MeshSettings ms = mesh_settings(scene);
+  if (ms.source != MeshSettings::Source::PneuNet)
     throw InputError("diagnose: --calibration-h needs the built-in mesher (mesh.source = \"pneunet\"); this scene's mesh "
-                     "comes from a deck (" + scene.string("mesh.file") + "): coarsen the deck itself, or omit --calibration-h");
+                     "comes from a deck (" + ms.file + "): coarsen the deck itself, or omit --calibration-h");
   return scene.with({"mesh.h_mm=" + fmt("%.17g", opt.calibration_h_mm)});
 }
 

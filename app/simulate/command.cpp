@@ -24,6 +24,7 @@
 #include "engine/assembly.h"
 #include "engine/explicit.h"
 #include "scenes/build_model.h"
+#include "scenes/scene_settings.h"
 #include "viz/vtk_output.h"
 
 namespace pneufem {
@@ -250,7 +251,7 @@ IdealModel ideal_model(const Scene& scene, const RunOptions& opt, const fs::path
   const bool reduced = rsetup != nullptr;
   bool any_effect = false;
   const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
-  const bool staircase = scene.string("load.protocol") == "staircase";
+  const bool staircase = load_settings(scene).protocol == LoadSettings::Protocol::Staircase;
   if (!(opt.compare_ideal && any_effect && staircase && bm.solver.mode == SolverSettings::Mode::QuasiStatic)) return ideal;
   if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
     ideal.records = read_angles_csv((dir / "ideal_angles.csv").string());

@@ -20,6 +20,7 @@
 #include "engine/assembly.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
 
@@ -239,9 +240,9 @@ SynthResult run_synth(const SynthOptions& o) {
   const Scene scene = base.with(res.hidden_sets).with(user_sets);
   json::Object effects;
   for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys, replaced_keys, user_sets));
-  if (scene.string("load.protocol") != "staircase")
+  if (load_settings(scene).protocol != LoadSettings::Protocol::Staircase)
     scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
-  if (scene.string("solver.mode") != "quasi_static")
+  if (solver_settings(scene).mode != SolverSettings::Mode::QuasiStatic)
     scene.fail("solver.mode", "synth runs the quasi-static model; use \"quasi_static\"");
 
   const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
