@@ -210,6 +210,13 @@ class Figure {
   const Axes& at(int row, int col) const;
   Layout layout(int row, int col) const;
   std::string render_axes(int row, int col) const;
+  // The parts of render_axes, in drawing order (svg_plot.cpp): one axes being drawn is a Panel.
+  struct Panel;
+  static std::string draw_grid(const Panel& p);            ///< grid lines at the major ticks
+  static std::string draw_data(const Panel& p);            ///< bars, range bars, lines (clipped)
+  static std::string draw_markers(const Panel& p);         ///< markers (not clipped)
+  std::string draw_frame_and_text(const Panel& p) const;   ///< frame, ticks, tick and axis labels, title, note
+  static std::string draw_legend(const Panel& p);
   /// Pixel positions covered by the data of `a` (for the legend's Best corner).
   static std::vector<std::array<double, 2>> ink_samples(const Axes& a, const Scale& X, const Scale& Y, const Scale& Y2);
 
