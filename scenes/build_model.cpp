@@ -382,10 +382,10 @@ LoadHistory chamber_load(const Scene& s) {
   // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
   // First order, or second (load.pressure_lag2_s > 0) with the same tolerance.
   const PressureLag lag = scene_pressure_lag(s);
-  if (lag.on())
-    load = apply_pressure_lag(load, lag,
-                              load_settings(s).protocol == LoadSettings::Protocol::Staircase ? 0.005 * s.number("load.step_kPa") * kkPa
-                                                                                             : 0.05 * kkPa);
+  if (lag.on()) {
+    const bool staircase = load_settings(s).protocol == LoadSettings::Protocol::Staircase;
+    load = apply_pressure_lag(load, lag, staircase ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+  }
   return load;
 }
 
