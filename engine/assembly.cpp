@@ -195,12 +195,235 @@ SparseMatrix Assembler::tangent_pattern() const {
   return K;
 }
 
+/// The inputs and outputs of one internal() call, shared by its element kernels.
+struct Assembler::Pass {
+  const Eigen::VectorXd& u;
+  const TimeStep& ts;
+  std::span<const double> state_old;
+  std::span<double> state_new;
+  Eigen::VectorXd* f_int;      ///< null: not assembled
+  SparseMatrix* K;             ///< null: force only
+  double* elem_energy;         ///< per element; null: no energy
+  std::atomic<int>& bad;       ///< lowest element that inverted or gave a non-finite stress (INT_MAX: none)
+  bool has_state;              ///< some law has history
+};
+
 void Assembler::internal(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
                          std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const {
   if (model_.mesh.type == ElementType::Tet4)
     internal_impl<4, 1>(u, ts, state_old, state_new, f_int, K, energy);
   else
     internal_impl<10, 4>(u, ts, state_old, state_new, f_int, K, energy);
+}
+
+// F = I + grad u at the element's points (not x grad N): at small strain the displacement
+// gradient is computed to full relative precision, so stresses of a stiff layer (E = 6.5 GPa)
+// carry no round-off floor.
+template <int NPE, int NQP>
+inline void Assembler::deformation_gradients(const Eigen::VectorXd& u, int pos, std::array<Mat3, NQP>& F) const {
+  const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
+  const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
+  Eigen::Matrix<double, 3, NPE> ue;
+  for (int a = 0; a < NPE; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
+  for (int q = 0; q < NQP; ++q) {
+    const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);  // column a = dN_a/dX
+    F[q] = Mat3::Identity() + ue * g.transpose();
+  }
+}
+
+namespace {
+
+inline bool inverted(double J) { return !(J > 0.0) || !std::isfinite(J); }
+
+}  // namespace
+
+// The element's slice of the material history (empty spans for a law without history).
+inline void Assembler::element_states(const Pass& p, int pos, std::span<const double>& s_old,
+                                      std::span<double>& s_new) const {
+  if (!p.has_state) return;
+  const int e = kelem_[pos];
+  const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
+  s_old = p.state_old.subspan(o0, o1 - o0);
+  if (!p.state_new.empty()) s_new = p.state_new.subspan(o0, o1 - o0);
+}
+
+// Force only (explicit steps, residuals): consecutive elements of one material share a batch of
+// StressBatch::kLanes points, hence one virtual call, and the law computes them with
+// structure-of-arrays arithmetic (materials/material.h); a law with history gets one element per
+// batch, with its state. F and fe stay element by element, with the tangent path's Eigen
+// expressions (same bits); det F, P = P_iso + P_vol and the finiteness checks run on the batch.
+// The Tet4 force became 2x faster (BENCHMARKS §4); arranging F and fe by lanes too was slower.
+template <int NPE, int NQP>
+void Assembler::force_range(const Pass& p, int begin, int end) const {
+  constexpr int kPerBatch = StressBatch::kLanes / NQP;
+  static_assert(StressBatch::kLanes % NQP == 0, "a batch holds whole elements");
+  StressBatch b;
+  std::array<int, kPerBatch> bpos;  // loop positions of the batch's elements
+  std::array<Mat3, NQP> F;
+  for (int pos = begin; pos < end;) {
+    const Material& mat = *kmat_[pos];
+    const int cap = p.has_state && mat.state_size() > 0 ? 1 : kPerBatch;
+    int m = 0;
+    for (; pos < end && m < cap && kmat_[pos] == &mat; ++pos) {
+      deformation_gradients<NPE, NQP>(p.u, pos, F);
+      for (int q = 0; q < NQP; ++q) b.set_F(m * NQP + q, F[q]);
+      bpos[m++] = pos;
+    }
+    b.n = m * NQP;
+    b.pad();
+    force_batch<NPE, NQP>(p, mat, cap == 1, b, bpos.data(), m);
+  }
+}
+
+// One batch of force_range: `m` elements at loop positions `bpos`, their F set in `b`.
+template <int NPE, int NQP>
+void Assembler::force_batch(const Pass& p, const Material& mat, bool with_state, StressBatch& b, const int* bpos,
+                            int m) const {
+  constexpr int L = StressBatch::kLanes;
+  constexpr int kPerBatch = L / NQP;
+  // det F of every point (Eigen's 3x3 formula); an inverted element is reported after the
+  // loop, and its points are replaced by F = I so that the law sees valid input.
+  const auto& Fb = b.F;
+  double J[L];
+  for (int l = 0; l < L; ++l)
+    J[l] = (Fb[0][l] * (Fb[4][l] * Fb[8][l] - Fb[7][l] * Fb[5][l]) -
+            Fb[3][l] * (Fb[1][l] * Fb[8][l] - Fb[7][l] * Fb[2][l])) +
+           Fb[6][l] * (Fb[1][l] * Fb[5][l] - Fb[4][l] * Fb[2][l]);
+  std::array<bool, kPerBatch> ok;
+  for (int j = 0; j < m; ++j) {
+    ok[j] = true;
+    for (int q = 0; q < NQP; ++q) ok[j] = ok[j] && !inverted(J[j * NQP + q]);
+    if (ok[j]) continue;
+    atomic_min(p.bad, kelem_[bpos[j]]);
+    for (int q = 0; q < NQP; ++q) b.set_F(j * NQP + q, Mat3::Identity());
+  }
+  if (std::none_of(ok.begin(), ok.begin() + m, [](bool v) { return v; })) return;  // e.g. no trial state
+  std::span<const double> s_old;
+  std::span<double> s_new;
+  if (with_state) element_states(p, bpos[0], s_old, s_new);
+  mat.stress(b, p.ts, s_old, s_new);
+  double P[9][L], psi[L], nonfinite[L];
+  for (int l = 0; l < L; ++l) {
+    psi[l] = b.psi_iso[l] + b.psi_vol[l];
+    nonfinite[l] = 0.0;
+  }
+  for (int k = 0; k < 9; ++k)
+    for (int l = 0; l < L; ++l) {
+      P[k][l] = b.P_iso[k][l] + b.P_vol[k][l];
+      nonfinite[l] = nonfinite[l] + (P[k][l] - P[k][l]);  // 0 for a finite entry, NaN otherwise
+    }
+  for (int j = 0; j < m; ++j) {
+    if (!ok[j]) continue;
+    const int pj = bpos[j], e = kelem_[pj];
+    const double* grad = kgrad_.data() + static_cast<std::size_t>(pj) * NQP * NPE * 3;
+    const double* wq = kw_.data() + static_cast<std::size_t>(pj) * NQP;
+    Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
+    double psi_e = 0.0;
+    for (int q = 0; q < NQP; ++q) {
+      const int l = j * NQP + q;
+      if (!(nonfinite[l] == 0.0)) {
+        ok[j] = false;
+        break;
+      }
+      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+      const Eigen::Map<const Mat3, 0, Eigen::InnerStride<L>> Pl(&P[0][l]);
+      const double w = wq[q];
+      fe.noalias() += w * Pl * g;
+      psi_e += w * psi[l];
+    }
+    if (!ok[j]) {
+      atomic_min(p.bad, e);
+      continue;
+    }
+    if (p.elem_energy) p.elem_energy[e] = psi_e;
+    if (p.f_int) {
+      const int* n = knodes_.data() + static_cast<std::size_t>(pj) * NPE;
+      for (int a = 0; a < NPE; ++a) p.f_int->template segment<3>(3 * n[a]) += fe.col(a);
+    }
+  }
+}
+
+namespace {
+
+// Element stiffness K_ab(i,k) = sum_q w sum_JL g_a[J] A(iJ,kL) g_b[L], accumulated over the
+// points in a local matrix (upper blocks only, A has major symmetry).
+template <int NPE, int NQP>
+void element_stiffness(const double* grad, const double* wq, const std::array<PointResponse, NQP>& resp,
+                       Eigen::Matrix<double, 3 * NPE, 3 * NPE>& Ke) {
+  Ke.setZero();
+  for (int q = 0; q < NQP; ++q) {
+    const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+    // The symmetric part of the material tangent: K = sum G^T A G is then the symmetric part of
+    // the consistent tangent, which the symmetric solver (Cholesky, upper blocks here) needs.
+    // Hyperelastic tangents have major symmetry (A = A^T, and 0.5 (a + a) == a exactly, so
+    // nothing changes for them); a rate law's consistent tangent need not (fatigue driven by the
+    // principal stretch: dP/dF gains P (x) dlambda/dF), and using its upper half only would be
+    // neither the tangent nor its symmetric part.
+    const Mat9 Aq = resp[q].A();
+    const Mat9 A = (0.5 * wq[q]) * (Aq + Aq.transpose());
+    for (int b = 0; b < NPE; ++b) {
+      // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
+      Eigen::Matrix<double, 9, 3> T;
+      for (int k = 0; k < 3; ++k)
+        T.col(k) = A.col(flat(k, 0)) * g(0, b) + A.col(flat(k, 1)) * g(1, b) + A.col(flat(k, 2)) * g(2, b);
+      for (int a = 0; a <= b; ++a)
+        for (int k = 0; k < 3; ++k)
+          for (int i = 0; i < 3; ++i)
+            Ke(3 * a + i, 3 * b + k) +=
+                g(0, a) * T(flat(i, 0), k) + g(1, a) * T(flat(i, 1), k) + g(2, a) * T(flat(i, 2), k);
+    }
+  }
+}
+
+}  // namespace
+
+// Force and tangent of the element at loop position `pos` (colour order, see assembly.h).
+template <int NPE, int NQP>
+void Assembler::tangent_element(const Pass& p, int pos) const {
+  const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
+  const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
+  const double* wq = kw_.data() + static_cast<std::size_t>(pos) * NQP;
+  std::array<Mat3, NQP> F;
+  deformation_gradients<NPE, NQP>(p.u, pos, F);
+  for (int q = 0; q < NQP; ++q)
+    if (inverted(F[q].determinant())) {
+      atomic_min(p.bad, kelem_[pos]);
+      return;
+    }
+  std::array<PointResponse, NQP> resp;
+  std::span<const double> s_old;
+  std::span<double> s_new;
+  element_states(p, pos, s_old, s_new);
+  kmat_[pos]->evaluate(F, p.ts, s_old, s_new, resp, true);
+  const int e = kelem_[pos];
+  Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
+  double psi = 0.0;
+  for (int q = 0; q < NQP; ++q) {
+    const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
+    const double w = wq[q];
+    const Mat3 P = resp[q].P();
+    if (!P.allFinite()) {
+      atomic_min(p.bad, e);
+      return;
+    }
+    fe.noalias() += w * P * g;
+    psi += w * resp[q].psi();
+  }
+  if (p.elem_energy) p.elem_energy[e] = psi;
+  if (p.f_int)
+    for (int a = 0; a < NPE; ++a) p.f_int->template segment<3>(3 * n[a]) += fe.col(a);
+  // The element stiffness, scattered once.
+  Eigen::Matrix<double, 3 * NPE, 3 * NPE> Ke;
+  element_stiffness<NPE, NQP>(grad, wq, resp, Ke);
+  double* val = p.K->valuePtr();
+  for (int b = 0; b < NPE; ++b)
+    for (int a = 0; a < NPE; ++a) {
+      const int slot = pair_slot_[(static_cast<std::size_t>(pos) * NPE + a) * NPE + b];
+      for (int k = 0; k < 3; ++k) {
+        double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
+        for (int i = 0; i < 3; ++i) col[i] += a <= b ? Ke(3 * a + i, 3 * b + k) : Ke(3 * b + k, 3 * a + i);
+      }
+    }
 }
 
 template <int NPE, int NQP>
@@ -218,188 +441,7 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
   if (energy) elem_energy.assign(ne, 0.0);
   std::atomic<int> bad{INT_MAX};
   const bool tangent = K != nullptr;
-  const bool has_state = state_size() > 0;
-
-  // F = I + grad u at the element's points (not x grad N): at small strain the displacement
-  // gradient is computed to full relative precision, so stresses of a stiff layer (E = 6.5 GPa)
-  // carry no round-off floor.
-  const auto deformation_gradients = [&](int pos, std::array<Mat3, NQP>& F) {
-    const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
-    const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
-    Eigen::Matrix<double, 3, NPE> ue;
-    for (int a = 0; a < NPE; ++a) ue.col(a) = u.template segment<3>(3 * n[a]);
-    for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);  // column a = dN_a/dX
-      F[q] = Mat3::Identity() + ue * g.transpose();
-    }
-  };
-  const auto inverted = [](double J) { return !(J > 0.0) || !std::isfinite(J); };
-  // The element's slice of the material history (empty spans for a law without history).
-  const auto element_states = [&](int pos, std::span<const double>& s_old, std::span<double>& s_new) {
-    if (!has_state) return;
-    const int e = kelem_[pos];
-    const std::size_t o0 = state_offset_[e], o1 = state_offset_[e + 1];
-    s_old = state_old.subspan(o0, o1 - o0);
-    if (!state_new.empty()) s_new = state_new.subspan(o0, o1 - o0);
-  };
-
-  // Force only (explicit steps, residuals): consecutive elements of one material share a batch of
-  // StressBatch::kLanes points, hence one virtual call, and the law computes them with
-  // structure-of-arrays arithmetic (materials/material.h); a law with history gets one element per
-  // batch, with its state. F and fe stay element by element, with the tangent path's Eigen
-  // expressions (same bits); det F, P = P_iso + P_vol and the finiteness checks run on the batch.
-  // The Tet4 force became 2x faster (BENCHMARKS §4); arranging F and fe by lanes too was slower.
-  constexpr int L = StressBatch::kLanes;
-  constexpr int kPerBatch = L / NQP;
-  static_assert(L % NQP == 0, "a batch holds whole elements");
-  const auto force_range = [&](int begin, int end) {
-    StressBatch b;
-    std::array<int, kPerBatch> bpos;  // loop positions of the batch's elements
-    std::array<Mat3, NQP> F;
-    for (int pos = begin; pos < end;) {
-      const Material& mat = *kmat_[pos];
-      const int cap = has_state && mat.state_size() > 0 ? 1 : kPerBatch;
-      int m = 0;
-      for (; pos < end && m < cap && kmat_[pos] == &mat; ++pos) {
-        deformation_gradients(pos, F);
-        for (int q = 0; q < NQP; ++q) b.set_F(m * NQP + q, F[q]);
-        bpos[m++] = pos;
-      }
-      b.n = m * NQP;
-      b.pad();
-      // det F of every point (Eigen's 3x3 formula); an inverted element is reported after the
-      // loop, and its points are replaced by F = I so that the law sees valid input.
-      const auto& Fb = b.F;
-      double J[L];
-      for (int l = 0; l < L; ++l)
-        J[l] = (Fb[0][l] * (Fb[4][l] * Fb[8][l] - Fb[7][l] * Fb[5][l]) -
-                Fb[3][l] * (Fb[1][l] * Fb[8][l] - Fb[7][l] * Fb[2][l])) +
-               Fb[6][l] * (Fb[1][l] * Fb[5][l] - Fb[4][l] * Fb[2][l]);
-      std::array<bool, kPerBatch> ok;
-      for (int j = 0; j < m; ++j) {
-        ok[j] = true;
-        for (int q = 0; q < NQP; ++q) ok[j] = ok[j] && !inverted(J[j * NQP + q]);
-        if (ok[j]) continue;
-        atomic_min(bad, kelem_[bpos[j]]);
-        for (int q = 0; q < NQP; ++q) b.set_F(j * NQP + q, Mat3::Identity());
-      }
-      if (std::none_of(ok.begin(), ok.begin() + m, [](bool v) { return v; })) continue;  // e.g. no trial state
-      std::span<const double> s_old;
-      std::span<double> s_new;
-      if (cap == 1) element_states(bpos[0], s_old, s_new);
-      mat.stress(b, ts, s_old, s_new);
-      double P[9][L], psi[L], nonfinite[L];
-      for (int l = 0; l < L; ++l) {
-        psi[l] = b.psi_iso[l] + b.psi_vol[l];
-        nonfinite[l] = 0.0;
-      }
-      for (int k = 0; k < 9; ++k)
-        for (int l = 0; l < L; ++l) {
-          P[k][l] = b.P_iso[k][l] + b.P_vol[k][l];
-          nonfinite[l] = nonfinite[l] + (P[k][l] - P[k][l]);  // 0 for a finite entry, NaN otherwise
-        }
-      for (int j = 0; j < m; ++j) {
-        if (!ok[j]) continue;
-        const int p = bpos[j], e = kelem_[p];
-        const double* grad = kgrad_.data() + static_cast<std::size_t>(p) * NQP * NPE * 3;
-        const double* wq = kw_.data() + static_cast<std::size_t>(p) * NQP;
-        Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
-        double psi_e = 0.0;
-        for (int q = 0; q < NQP; ++q) {
-          const int l = j * NQP + q;
-          if (!(nonfinite[l] == 0.0)) {
-            ok[j] = false;
-            break;
-          }
-          const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
-          const Eigen::Map<const Mat3, 0, Eigen::InnerStride<L>> Pl(&P[0][l]);
-          const double w = wq[q];
-          fe.noalias() += w * Pl * g;
-          psi_e += w * psi[l];
-        }
-        if (!ok[j]) {
-          atomic_min(bad, e);
-          continue;
-        }
-        if (energy) elem_energy[e] = psi_e;
-        if (f_int) {
-          const int* n = knodes_.data() + static_cast<std::size_t>(p) * NPE;
-          for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
-        }
-      }
-    }
-  };
-
-  // Force and tangent, element by element.
-  const auto tangent_kernel = [&](int pos) {  // loop position (colour order), see assembly.h
-    const int* n = knodes_.data() + static_cast<std::size_t>(pos) * NPE;
-    const double* grad = kgrad_.data() + static_cast<std::size_t>(pos) * NQP * NPE * 3;  // [q][a][3]
-    const double* wq = kw_.data() + static_cast<std::size_t>(pos) * NQP;
-    std::array<Mat3, NQP> F;
-    deformation_gradients(pos, F);
-    for (int q = 0; q < NQP; ++q)
-      if (inverted(F[q].determinant())) {
-        atomic_min(bad, kelem_[pos]);
-        return;
-      }
-    std::array<PointResponse, NQP> resp;
-    std::span<const double> s_old;
-    std::span<double> s_new;
-    element_states(pos, s_old, s_new);
-    kmat_[pos]->evaluate(F, ts, s_old, s_new, resp, true);
-    const int e = kelem_[pos];
-    Eigen::Matrix<double, 3, NPE> fe = Eigen::Matrix<double, 3, NPE>::Zero();
-    double psi = 0.0;
-    for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
-      const double w = wq[q];
-      const Mat3 P = resp[q].P();
-      if (!P.allFinite()) {
-        atomic_min(bad, e);
-        return;
-      }
-      fe.noalias() += w * P * g;
-      psi += w * resp[q].psi();
-    }
-    if (energy) elem_energy[e] = psi;
-    if (f_int)
-      for (int a = 0; a < NPE; ++a) f_int->template segment<3>(3 * n[a]) += fe.col(a);
-    // Element stiffness K_ab(i,k) = sum_q w sum_JL g_a[J] A(iJ,kL) g_b[L], accumulated over the
-    // points in a local matrix (upper blocks only, A has major symmetry) and scattered once.
-    Eigen::Matrix<double, 3 * NPE, 3 * NPE> Ke;
-    Ke.setZero();
-    for (int q = 0; q < NQP; ++q) {
-      const Eigen::Map<const Eigen::Matrix<double, 3, NPE>> g(grad + q * NPE * 3);
-      // The symmetric part of the material tangent: K = sum G^T A G is then the symmetric part of
-      // the consistent tangent, which the symmetric solver (Cholesky, upper blocks here) needs.
-      // Hyperelastic tangents have major symmetry (A = A^T, and 0.5 (a + a) == a exactly, so
-      // nothing changes for them); a rate law's consistent tangent need not (fatigue driven by the
-      // principal stretch: dP/dF gains P (x) dlambda/dF), and using its upper half only would be
-      // neither the tangent nor its symmetric part.
-      const Mat9 Aq = resp[q].A();
-      const Mat9 A = (0.5 * wq[q]) * (Aq + Aq.transpose());
-      for (int b = 0; b < NPE; ++b) {
-        // T(iJ, k) = sum_L A(iJ, kL) g_b[L]
-        Eigen::Matrix<double, 9, 3> T;
-        for (int k = 0; k < 3; ++k)
-          T.col(k) = A.col(flat(k, 0)) * g(0, b) + A.col(flat(k, 1)) * g(1, b) + A.col(flat(k, 2)) * g(2, b);
-        for (int a = 0; a <= b; ++a)
-          for (int k = 0; k < 3; ++k)
-            for (int i = 0; i < 3; ++i)
-              Ke(3 * a + i, 3 * b + k) +=
-                  g(0, a) * T(flat(i, 0), k) + g(1, a) * T(flat(i, 1), k) + g(2, a) * T(flat(i, 2), k);
-      }
-    }
-    double* val = K->valuePtr();
-    for (int b = 0; b < NPE; ++b)
-      for (int a = 0; a < NPE; ++a) {
-        const int slot = pair_slot_[(static_cast<std::size_t>(pos) * NPE + a) * NPE + b];
-        for (int k = 0; k < 3; ++k) {
-          double* col = val + col_ptr_[3 * n[b] + k] + 3 * slot;
-          for (int i = 0; i < 3; ++i) col[i] += a <= b ? Ke(3 * a + i, 3 * b + k) : Ke(3 * b + k, 3 * a + i);
-        }
-      }
-  };
+  const Pass pass{u, ts, state_old, state_new, f_int, K, energy ? elem_energy.data() : nullptr, bad, state_size() > 0};
 
   // Tasks of 10 us or more: one costs ~0.5 us to schedule, and a linear tet's force only ~50 ns
   // (64-element tasks made the two-thread Tet4 force ~5 % slower than 256-element ones).
@@ -407,10 +449,10 @@ void Assembler::internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std:
   for (std::size_t c = 0; c + 1 < colour_ptr_.size(); ++c) {
     tbb::parallel_for(tbb::blocked_range<int>(colour_ptr_[c], colour_ptr_[c + 1], grain), [&](const tbb::blocked_range<int>& r) {
       if (!tangent) {
-        force_range(r.begin(), r.end());
+        force_range<NPE, NQP>(pass, r.begin(), r.end());
         return;
       }
-      for (int i = r.begin(); i < r.end(); ++i) tangent_kernel(i);
+      for (int i = r.begin(); i < r.end(); ++i) tangent_element<NPE, NQP>(pass, i);
     });
   }
   if (bad.load() != INT_MAX) {

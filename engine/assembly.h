@@ -9,6 +9,7 @@
 // results are bit-for-bit identical for 1 and N threads, without atomics or per-thread buffers.
 // Membrane layers (Model::membranes) are few triangles and are added serially after the
 // coloured loop, so they keep this property.
+#include <array>
 #include <memory>
 #include <span>
 #include <vector>
@@ -103,9 +104,26 @@ class Assembler {
 
  private:
   void build_nonlocal();  ///< sets nonlocal_ / nl_element_ (constructor)
+  // internal() for one element type: the coloured element loop, then the membranes. Its kernels
+  // (assembly.cpp) share a Pass, the call's inputs and outputs.
+  struct Pass;
   template <int NPE, int NQP>
   void internal_impl(const Eigen::VectorXd& u, const TimeStep& ts, std::span<const double> state_old,
                      std::span<double> state_new, Eigen::VectorXd* f_int, SparseMatrix* K, double* energy) const;
+  /// F at the points of the element at loop position `pos`.
+  template <int NPE, int NQP>
+  void deformation_gradients(const Eigen::VectorXd& u, int pos, std::array<Mat3, NQP>& F) const;
+  /// The history of the element at loop position `pos` (untouched spans when no law has history).
+  void element_states(const Pass& p, int pos, std::span<const double>& s_old, std::span<double>& s_new) const;
+  /// Force only: loop positions [begin, end), in batches of StressBatch::kLanes points.
+  template <int NPE, int NQP>
+  void force_range(const Pass& p, int begin, int end) const;
+  /// One batch of force_range: `m` elements at loop positions `bpos`, their F set in `b`.
+  template <int NPE, int NQP>
+  void force_batch(const Pass& p, const Material& mat, bool with_state, StressBatch& b, const int* bpos, int m) const;
+  /// Force and tangent of the element at loop position `pos`.
+  template <int NPE, int NQP>
+  void tangent_element(const Pass& p, int pos) const;
   /// Adds the membranes' internal force, tangent and energy (serial); throws PhysicsError.
   template <int NPF>
   void add_membranes(const Eigen::VectorXd& u, const TimeStep& ts, Eigen::VectorXd* f_int, SparseMatrix* K,

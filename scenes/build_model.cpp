@@ -31,6 +31,7 @@ namespace pneufem {
 
 namespace {
 
+using detail::choice;
 using detail::deck_tip_nodes;
 using detail::kkPa;
 using detail::kmm;
@@ -40,21 +41,6 @@ using detail::reject_ambiguous;
 using detail::require_keys;
 using detail::resolve_angle_frame;
 using detail::set_rig_gravity;
-
-/// The value of a string key that must be one of `options` (its name -> value), or a failure
-/// naming the key and every allowed name.
-template <class T>
-T choice(const Scene& scene, const std::string& key, std::initializer_list<std::pair<const char*, T>> options) {
-  const std::string v = scene.string(key);
-  std::string allowed;
-  std::size_t i = 0;
-  for (const auto& [name, value] : options) {
-    if (v == name) return value;
-    allowed += std::string(i == 0 ? "" : i + 1 == options.size() ? " or " : ", ") + "\"" + name + "\"";
-    ++i;
-  }
-  scene.fail(key, "must be " + allowed + ", got \"" + v + "\"");
-}
 
 // ---- Fabric as a membrane (mesh.fabric_model, engine/membrane.h) --------------------------------
 
@@ -194,9 +180,8 @@ Mesh built_in_mesh(const Scene& s) {
   return build_pneunet(p);
 }
 
-/// The deck of mesh.file, as read (mesh.source must be "inp" when it is not "pneunet" or "stl").
-InpDeck scene_deck(const Scene& s, const std::string& source) {
-  if (source != "inp") s.fail("mesh.source", "must be \"pneunet\", \"inp\" or \"stl\", got \"" + source + "\"");
+/// The deck of mesh.file (mesh.source = "inp"), as read.
+InpDeck scene_deck(const Scene& s) {
   const std::string file = s.string("mesh.file");
   if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
   return read_inp(s.resolve_path(file), length_unit(s));
@@ -206,10 +191,10 @@ InpDeck scene_deck(const Scene& s, const std::string& source) {
 /// (its *BOUNDARY dofs and pressure faces are read later) with its notes in `warnings`. Unlike
 /// build_mesh, a deck of several unconnected instances is refused, and a promotion to Tet10 carries
 /// the deck's *BOUNDARY dofs to the new mid-edge nodes.
-Mesh read_model_mesh(const Scene& s, const std::string& source, InpDeck& deck, std::vector<std::string>& warnings) {
-  if (source == "pneunet") return built_in_mesh(s);
-  if (source == "stl") return stl_scene_mesh(s, &warnings);
-  deck = scene_deck(s, source);
+Mesh read_model_mesh(const Scene& s, MeshSettings::Source source, InpDeck& deck, std::vector<std::string>& warnings) {
+  if (source == MeshSettings::Source::PneuNet) return built_in_mesh(s);
+  if (source == MeshSettings::Source::Stl) return stl_scene_mesh(s, &warnings);
+  deck = scene_deck(s);
   warnings = deck.warnings;
   if (deck.solid_instances.size() > 1)
     s.fail("mesh.file", "the deck's solid elements are in " + std::to_string(deck.solid_instances.size()) +
@@ -376,57 +361,6 @@ void set_cavity_faces(const Scene& s, Model& model, const InpDeck& deck, bool is
   }
 }
 
-/// The [solver] keys, each checked.
-SolverSettings solver_settings(const Scene& s) {
-  SolverSettings sv;
-  sv.mode = choice<SolverSettings::Mode>(s, "solver.mode", {{"quasi_static", SolverSettings::Mode::QuasiStatic},
-                                                           {"explicit", SolverSettings::Mode::Explicit}});
-  sv.quasi_static.method = choice<EquilibriumMethod>(s, "solver.method", {{"newton", EquilibriumMethod::Newton},
-                                                                          {"relaxation", EquilibriumMethod::Relaxation}});
-  sv.quasi_static.newton.rel_tol = positive(s, "solver.rel_tol");
-  sv.quasi_static.relaxation.rel_tol = sv.quasi_static.newton.rel_tol;
-  sv.quasi_static.newton.max_iterations = s.integer("solver.max_iterations");
-  if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
-  sv.quasi_static.newton.stiff_relaxation_steps = s.integer("solver.stiff_relaxation_steps");
-  if (sv.quasi_static.newton.stiff_relaxation_steps < 0) s.fail("solver.stiff_relaxation_steps", "must be >= 0 (0 = off)");
-  sv.quasi_static.newton.indefinite = choice<StaticOptions::Indefinite>(
-      s, "solver.indefinite_tangent",
-      {{"last_factor", StaticOptions::Indefinite::LastFactor}, {"shift", StaticOptions::Indefinite::Shift}});
-  sv.quasi_static.newton.energy_line_search = choice<bool>(s, "solver.line_search", {{"energy", true}, {"slope", false}});
-  sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
-  sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
-  sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
-  sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
-  sv.quasi_static.time_tol = positive(s, "solver.time_tol");
-  sv.quasi_static.time_control =
-      choice<TimeControl>(s, "solver.time_control", {{"change", TimeControl::Change}, {"error", TimeControl::Error}});
-  sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
-  sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
-  if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
-  sv.quasi_static.max_segment_steps = s.integer("solver.max_segment_steps");
-  if (sv.quasi_static.max_segment_steps < 1) s.fail("solver.max_segment_steps", "must be >= 1");
-  sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
-  if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
-  sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");
-  if (sv.explicit_dynamics.dt_safety > 1.0) s.fail("solver.dt_safety", "must be <= 1 (fraction of the stable step)");
-  sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");
-  sv.explicit_dynamics.damping_alpha_1_s = s.number("solver.damping_1_s");
-  if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
-  sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
-  sv.time_scale = positive(s, "solver.time_scale");
-  sv.model = choice<SolverSettings::Model>(s, "solver.model", {{"full", SolverSettings::Model::Full},
-                                                             {"reduced", SolverSettings::Model::Reduced}});
-  sv.reduced.max_modes = s.integer("solver.reduced_modes");
-  if (sv.reduced.max_modes < 1) s.fail("solver.reduced_modes", "must be >= 1");
-  sv.reduced.ecsw_tolerance = positive(s, "solver.reduced_ecsw_tol");
-  sv.reduced.softened_levels = s.integer("solver.reduced_softened_levels");
-  if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
-  sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
-  if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)
-    s.fail("solver.model", "\"reduced\" needs solver.mode = \"quasi_static\"");
-  return sv;
-}
-
 }  // namespace
 
 Scene elastic_reference_scene(const Scene& scene) {
@@ -448,17 +382,18 @@ LoadHistory chamber_load(const Scene& s) {
   // 0.05 kPa, a fifth of the simplification tolerance the CSV itself is read with.
   // First order, or second (load.pressure_lag2_s > 0) with the same tolerance.
   const PressureLag lag = scene_pressure_lag(s);
-  if (lag.on())
-    load = apply_pressure_lag(load, lag,
-                              s.string("load.protocol") == "staircase" ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+  if (lag.on()) {
+    const bool staircase = load_settings(s).protocol == LoadSettings::Protocol::Staircase;
+    load = apply_pressure_lag(load, lag, staircase ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+  }
   return load;
 }
 
 Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
-  const std::string source = s.string("mesh.source");
-  if (source == "pneunet") return built_in_mesh(s);
-  if (source == "stl") return stl_scene_mesh(s, warnings);
-  InpDeck deck = scene_deck(s, source);
+  const MeshSettings::Source source = mesh_settings(s).source;
+  if (source == MeshSettings::Source::PneuNet) return built_in_mesh(s);
+  if (source == MeshSettings::Source::Stl) return stl_scene_mesh(s, warnings);
+  InpDeck deck = scene_deck(s);
   if (warnings) warnings->insert(warnings->end(), deck.warnings.begin(), deck.warnings.end());
   Mesh mesh = std::move(deck.mesh);
   if (s.boolean("mesh.promote_to_tet10")) mesh = promote_to_tet10(mesh);
@@ -467,8 +402,8 @@ Mesh build_mesh(const Scene& s, std::vector<std::string>* warnings) {
 
 LoadHistory inlet_load(const Scene& s) {
   LoadHistory load;
-  const std::string protocol = s.string("load.protocol");
-  if (protocol == "staircase") {
+  const LoadSettings settings = load_settings(s);
+  if (settings.protocol == LoadSettings::Protocol::Staircase) {
     const double p_max = s.number("load.max_kPa") * kkPa, dp = s.number("load.step_kPa") * kkPa;
     const double hold_s = s.number("load.hold_s"), every_s = s.number("load.output_every_s");
     const int trials = s.integer("load.trials");
@@ -485,8 +420,8 @@ LoadHistory inlet_load(const Scene& s) {
                  " per level); the limit is " + short_num(kMaxReports) +
                  "; report less often (load.output_every_s) or run fewer trials");
     load = staircase(p_max, dp, hold_s, s.number("load.ramp_s"), trials, s.number("load.mark_s"),
-                     s.number("load.rest_s"), every_s);
-  } else if (protocol == "csv") {
+                     settings.rest_s, every_s);
+  } else {  // LoadSettings::Protocol::Csv
     const std::string csv = s.string("load.csv");
     if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
     try {
@@ -495,9 +430,7 @@ LoadHistory inlet_load(const Scene& s) {
       if (std::string(e.what()).find("load.output_every_s") == std::string::npos) throw;
       s.fail("load.output_every_s", e.what());
     }
-    load.rest_between_trials_s = s.number("load.rest_s");
-  } else {
-    s.fail("load.protocol", "must be \"staircase\" or \"csv\", got \"" + protocol + "\"");
+    load.rest_between_trials_s = settings.rest_s;
   }
   return load;
 }
@@ -505,7 +438,7 @@ LoadHistory inlet_load(const Scene& s) {
 std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   auto out = std::make_unique<BuiltModel>();
   Model& model = out->model;
-  const std::string source = s.string("mesh.source");
+  const MeshSettings::Source source = mesh_settings(s).source;
   InpDeck deck;
   model.mesh = read_model_mesh(s, source, deck, out->warnings);
   Mesh& mesh = model.mesh;
@@ -515,7 +448,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
 
   // Boundary conditions.
   model.fixed.assign(3 * mesh.num_nodes(), 0);
-  const bool is_inp = source == "inp";
+  const bool is_inp = source == MeshSettings::Source::Inp;
   const std::string fixed_key = "mesh.fixed_set";
   if (!is_inp || !s.string(fixed_key).empty() || deck.fixed_dofs.empty())
     for (int n : node_set(s, mesh, fixed_key))
@@ -545,7 +478,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   model.gravity_m_s2 = s.vec3("gravity.g_m_s2");
   if (membrane_fabric) model.membranes.push_back(fabric_membrane(s, mesh));
   validate(model);
-  resolve_angle_frame(s, model, is_inp || source == "stl", out->warnings);
+  resolve_angle_frame(s, model, is_inp || source == MeshSettings::Source::Stl, out->warnings);
   if (model.angle.bend_direction.cross(model.angle.fixed_normal_out).norm() < 1e-9 * model.angle.bend_direction.norm())
     s.fail("angle.bend_direction", "must not be parallel to angle.fixed_normal");
   set_rig_gravity(s, model);
@@ -555,9 +488,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
 
   out->solver = solver_settings(s);
 
-  out->output.vtu = s.string("output.vtu");
-  if (out->output.vtu != "steps" && out->output.vtu != "all" && out->output.vtu != "none")
-    s.fail("output.vtu", "must be \"steps\", \"all\" or \"none\"");
+  out->output = output_settings(s);
   return out;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Scene -> discrete problem: mesh (built-in pneu-net or an Abaqus/CalculiX deck), materials,
 // parts, boundary conditions, cavity faces, bending-angle definition, load history and solver
-// settings. This is the only place that turns scene keys into engine objects.
+// settings. This is the only place that turns scene keys into engine objects; the settings that
+// are typed structs (mesh source, load protocol, solver, output) are read by scenes/scene_settings.h.
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,24 +13,9 @@
 #include "engine/quasi_static.h"
 #include "engine/rom.h"
 #include "scenes/scene.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
-
-struct SolverSettings {
-  enum class Mode { QuasiStatic, Explicit };
-  Mode mode = Mode::QuasiStatic;
-  enum class Model { Full, Reduced };  ///< quasi-static: the full FEM or the reduced model (engine/rom.h)
-  Model model = Model::Full;
-  RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels
-  double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
-  QuasiStaticOptions quasi_static;
-  ExplicitOptions explicit_dynamics;
-  double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time
-};
-
-struct OutputSettings {
-  std::string vtu = "steps";  ///< "steps", "all" or "none"
-};
 
 /// Everything a run needs. Held by pointer: the engine keeps references into `model`.
 struct BuiltModel {

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/json_writer.h"
+#include "viz/xml_escape.h"
 
 namespace pneufem::svg {
 
@@ -245,23 +246,7 @@ std::string tick_label(double v, double step) {
   return s;
 }
 
-std::string escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default:
-        // XML 1.0 forbids control characters other than tab, newline and carriage return.
-        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n' || c == '\r') out += c;
-    }
-  }
-  return out;
-}
+std::string escape(const std::string& text) { return xml_escape(text); }
 
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n\r") == std::string::npos && (text.empty() || text[0] != '#')) return text;
@@ -518,30 +503,66 @@ std::vector<std::array<double, 2>> Figure::ink_samples(const Axes& a, const Scal
   return ink;
 }
 
+/// One axes being drawn: its data, layout, scales and text sizes.
+struct Figure::Panel {
+  const Axes& a;
+  Layout L;
+  double k, tick_font, label_font;
+  double left, right, top, bottom;  ///< the plot area's edges (px)
+  bool xlog;
+  Scale X, Y, Y2;
+  std::string clip;  ///< the id of the plot area's clip path
+};
+
 std::string Figure::render_axes(int row, int col) const {
   const Axes& a = at(row, col);
   const Layout L = layout(row, col);
   const Rect& R = L.area;
-  const double k = text_scale(), tick_font = k * kTickFont, label_font = k * kLabelFont;
+  const double k = text_scale();
   const double left = R.x, right = R.x + R.width, top = R.y, bottom = R.y + R.height;
   const bool xlog = a.xlog_ && !L.categorical;
-  const Scale X(L.x.lo, L.x.hi, left, right, xlog);
-  const Scale Y(L.y.lo, L.y.hi, bottom, top, false);
-  const Scale Y2(L.y2_on ? L.y2.lo : 0.0, L.y2_on ? L.y2.hi : 1.0, bottom, top, false);
-  const std::string clip = std::string(kIdToken) + "-clip-" + std::to_string(row * cols_ + col);
-
-  std::string s = "<g>\n<defs><clipPath id=\"" + clip + "\"><rect x=\"" + px(left) + "\" y=\"" + px(top) + "\" width=\"" +
+  const Panel p{a,
+                L,
+                k,
+                k * kTickFont,
+                k * kLabelFont,
+                left,
+                right,
+                top,
+                bottom,
+                xlog,
+                Scale(L.x.lo, L.x.hi, left, right, xlog),
+                Scale(L.y.lo, L.y.hi, bottom, top, false),
+                Scale(L.y2_on ? L.y2.lo : 0.0, L.y2_on ? L.y2.hi : 1.0, bottom, top, false),
+                std::string(kIdToken) + "-clip-" + std::to_string(row * cols_ + col)};
+  std::string s = "<g>\n<defs><clipPath id=\"" + p.clip + "\"><rect x=\"" + px(left) + "\" y=\"" + px(top) + "\" width=\"" +
                   px(R.width) + "\" height=\"" + px(R.height) + "\"/></clipPath></defs>\n";
+  s += draw_grid(p);
+  s += draw_data(p);
+  s += draw_markers(p);
+  s += draw_frame_and_text(p);
+  s += draw_legend(p);
+  return s + "</g>\n";
+}
 
-  // Grid at the major ticks.
-  std::string grid;
+std::string Figure::draw_grid(const Panel& p) {
+  const Layout& L = p.L;
+  const double left = p.left, right = p.right, top = p.top, bottom = p.bottom;
+  const Scale &X = p.X, &Y = p.Y;
+  std::string grid;  // std::string("M"): "M" + px(...) here draws GCC 12's false -Wrestrict (GCC bug 105329)
   if (!L.categorical)
-    for (double v : L.x.major) grid += "M" + px(X(v)) + " " + px(top) + "V" + px(bottom);
-  for (double v : L.y.major) grid += "M" + px(left) + " " + px(Y(v)) + "H" + px(right);
-  if (!grid.empty()) s += "<path d=\"" + grid + "\" fill=\"none\" stroke=\"#e6e6e6\" stroke-width=\"1\"/>\n";
+    for (double v : L.x.major) grid += std::string("M") + px(X(v)) + " " + px(top) + "V" + px(bottom);
+  for (double v : L.y.major) grid += std::string("M") + px(left) + " " + px(Y(v)) + "H" + px(right);
+  if (grid.empty()) return "";
+  return "<path d=\"" + grid + "\" fill=\"none\" stroke=\"#e6e6e6\" stroke-width=\"1\"/>\n";
+}
 
+std::string Figure::draw_data(const Panel& p) {
+  const Axes& a = p.a;
+  const Scale &X = p.X, &Y = p.Y, &Y2 = p.Y2;
+  std::string s;
   // Data, clipped to the plot area: bars, range bars, lines.
-  s += "<g clip-path=\"url(#" + clip + ")\">\n";
+  s += "<g clip-path=\"url(#" + p.clip + ")\">\n";
   const int G = static_cast<int>(a.bars_.size());
   for (int g = 0; g < G; ++g) {
     const BarGroup& b = a.bars_[g];
@@ -593,7 +614,15 @@ std::string Figure::render_axes(int row, int col) const {
     }
   }
   s += "</g>\n";
+  return s;
+}
 
+std::string Figure::draw_markers(const Panel& p) {
+  const Axes& a = p.a;
+  const Layout& L = p.L;
+  const bool xlog = p.xlog;
+  const Scale &X = p.X, &Y = p.Y, &Y2 = p.Y2;
+  std::string s;
   // Markers are not clipped (a point on the frame stays whole) but points outside are left out.
   for (const Axes::Series& ser : a.series_) {
     if (ser.kind == Axes::Kind::Range || ser.style.marker == Marker::None) continue;
@@ -607,7 +636,18 @@ std::string Figure::render_axes(int row, int col) const {
     }
     if (!m.empty()) s += marker_group(ser.style) + m + "</g>\n";
   }
+  return s;
+}
 
+std::string Figure::draw_frame_and_text(const Panel& p) const {
+  const Axes& a = p.a;
+  const Layout& L = p.L;
+  const Rect& R = L.area;
+  const double k = p.k, tick_font = p.tick_font, label_font = p.label_font;
+  const double left = p.left, right = p.right, top = p.top, bottom = p.bottom;
+  const bool xlog = p.xlog;
+  const Scale &X = p.X, &Y = p.Y, &Y2 = p.Y2;
+  std::string s;
   // Frame, ticks and tick labels.
   s += "<rect x=\"" + px(left) + "\" y=\"" + px(top) + "\" width=\"" + px(R.width) + "\" height=\"" + px(R.height) +
        "\" fill=\"none\" stroke=\"#333333\" stroke-width=\"1\"/>\n";
@@ -658,7 +698,15 @@ std::string Figure::render_axes(int row, int col) const {
   if (!a.title_.empty()) s += text_el(0.5 * (left + right), top - 9 * k, "middle", k * kTitleFont, escape(a.title_));
   if (!a.note_.empty()) s += text_el(0.5 * (left + right), 0.5 * (top + bottom), "middle", label_font, escape(a.note_), " fill=\"#777777\"");
   s += "</g>\n";
+  return s;
+}
 
+std::string Figure::draw_legend(const Panel& p) {
+  const Axes& a = p.a;
+  const double k = p.k, tick_font = p.tick_font;
+  const double left = p.left, right = p.right, top = p.top, bottom = p.bottom;
+  const Scale &X = p.X, &Y = p.Y, &Y2 = p.Y2;
+  std::string s;
   // Legend: series, then bar groups, in the order they were added.
   struct Entry {
     std::string label;
@@ -690,8 +738,8 @@ std::string Figure::render_axes(int row, int col) const {
       std::size_t fewest = std::numeric_limits<std::size_t>::max();
       for (Legend c : {Legend::UpperRight, Legend::UpperLeft, Legend::LowerRight, Legend::LowerLeft}) {
         const Rect r = corner(c);
-        const auto n = static_cast<std::size_t>(std::count_if(ink.begin(), ink.end(), [&](const std::array<double, 2>& p) {
-          return p[0] >= r.x && p[0] <= r.x + r.width && p[1] >= r.y && p[1] <= r.y + r.height;
+        const auto n = static_cast<std::size_t>(std::count_if(ink.begin(), ink.end(), [&](const std::array<double, 2>& pt) {
+          return pt[0] >= r.x && pt[0] <= r.x + r.width && pt[1] >= r.y && pt[1] <= r.y + r.height;
         }));
         if (n < fewest) fewest = n, where = c;
       }
@@ -722,7 +770,7 @@ std::string Figure::render_axes(int row, int col) const {
     }
     s += "</g>\n";
   }
-  return s + "</g>\n";
+  return s;
 }
 
 std::string Figure::svg_element() const {

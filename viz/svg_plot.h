@@ -53,8 +53,8 @@ Ticks linear_ticks(double lo, double hi, int target = 5, bool widen = true, bool
 Ticks log_ticks(double lo, double hi, bool widen = true);
 /// Label of a linear tick: as many decimals as the step needs, no "-0".
 std::string tick_label(double v, double step);
-/// Text made safe for SVG/XML character data and attribute values (& < > " ' escaped, control
-/// characters other than tab and newline dropped).
+/// Text made safe for SVG/XML character data and attribute values: xml_escape (viz/xml_escape.h),
+/// the one escape of viz/'s XML (& < > " ' escaped, the control characters XML 1.0 forbids dropped).
 std::string escape(const std::string& text);
 
 /// A CSV field: quoted (quotes doubled) when it holds a comma, a quote or a newline, or starts with '#'.
@@ -210,6 +210,13 @@ class Figure {
   const Axes& at(int row, int col) const;
   Layout layout(int row, int col) const;
   std::string render_axes(int row, int col) const;
+  // The parts of render_axes, in drawing order (svg_plot.cpp): one axes being drawn is a Panel.
+  struct Panel;
+  static std::string draw_grid(const Panel& p);            ///< grid lines at the major ticks
+  static std::string draw_data(const Panel& p);            ///< bars, range bars, lines (clipped)
+  static std::string draw_markers(const Panel& p);         ///< markers (not clipped)
+  std::string draw_frame_and_text(const Panel& p) const;   ///< frame, ticks, tick and axis labels, title, note
+  static std::string draw_legend(const Panel& p);
   /// Pixel positions covered by the data of `a` (for the legend's Best corner).
   static std::vector<std::array<double, 2>> ink_samples(const Axes& a, const Scale& X, const Scale& Y, const Scale& Y2);
 

@@ -36,6 +36,7 @@
 
 #include "core/errors.h"
 #include "engine/static_solver.h"
+#include "viz/xml_escape.h"
 
 namespace pneufem {
 
@@ -201,21 +202,6 @@ void add_field_strings(vtkFieldData* fd, const char* name, const std::vector<std
   a->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
   for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
   fd->AddArray(a);
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 /// Shortest decimal text that reads back to exactly `v` (std::to_chars round-trip guarantee).
@@ -402,6 +388,10 @@ PvdSeries::PvdSeries(std::string pvd_path) : path_(std::move(pvd_path)) {}
 
 void PvdSeries::add(double time_s, const std::string& vtu_file_relative) {
   if (!std::isfinite(time_s)) throw std::invalid_argument("PvdSeries::add: time_s must be finite");
+  // XML 1.0 cannot hold a control character, escaped or not: dropped, the index would name another file.
+  if (has_xml_forbidden_char(vtu_file_relative))
+    throw std::invalid_argument("PvdSeries::add: the file name '" + xml_escape(vtu_file_relative) +
+                                "' holds a control character, which a .pvd (XML) cannot name");
   // ParaView resolves "file" against the .pvd's directory; an absolute path is made relative to it.
   fs::path file(vtu_file_relative);
   if (file.is_absolute()) {

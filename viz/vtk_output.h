@@ -45,6 +45,9 @@ void write_vtu(const std::string& path, const Model& model, const StateFields& f
 class PvdSeries {
  public:
   explicit PvdSeries(std::string pvd_path);
+  /// Adds a state (an absolute file name is made relative to the .pvd's directory) and rewrites the
+  /// index. std::invalid_argument for a non-finite time or a file name with a control character
+  /// (XML 1.0 cannot hold one); the series is unchanged when the write fails.
   void add(double time_s, const std::string& vtu_file_relative);
   const std::string& path() const { return path_; }
 

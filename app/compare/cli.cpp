@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "scenes/scene_settings.h"
+
 namespace pneufem {
 
 std::unique_ptr<CompareCommand> add_compare_command(CLI::App& app) {
@@ -55,7 +57,7 @@ int run_compare_command(CompareCommand& c, const std::string& command_line) {
   std::vector<std::string> sets = c.sets;
   if (!c.model.empty()) sets.push_back("solver.model=\"" + c.model + "\"");  // after --set: the option decides
   const Scene scene = Scene::load(c.scene_path, sets);
-  if (scene.string("solver.model") == "reduced" && c.options.cache_dir.empty())
+  if (solver_settings(scene).model == SolverSettings::Model::Reduced && c.options.cache_dir.empty())
     c.options.cache_dir = (std::filesystem::path(c.options.out_dir) / "cache").string();
   const CompareRunResult r = run_compare(scene, c.options);
   std::printf("compare: NRMSE %.4f (noise floor %.4f) over %zu trials, %ld states, model %s, %.1f s; report "

@@ -137,18 +137,19 @@ void write_report_figures(const std::string& dir, const std::vector<ReportFigure
   write_file_atomic((d / "model_vs_measured.csv").string(), model_vs_measured_csv(c));
 }
 
-std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRunResult& r,
-                                          const std::vector<HistoryEntry>& history) {
+namespace {
+
+// One colour per trial, in every figure: measured and model of a trial alike (viz/svg_plot.h).
+svg::Style trial_style(std::size_t k) {
+  svg::Style st;
+  st.color = svg::palette_color(k);
+  return st;
+}
+
+// 1. Pressure and angle against time, per trial.
+std::vector<ReportFigure> trial_figures(const Recording& rec, const CompareRunResult& r) {
   std::vector<ReportFigure> out;
   const Comparison& c = r.comparison;
-  // One colour per trial, in every figure: measured and model of a trial alike (viz/svg_plot.h).
-  auto trial_style = [](std::size_t k) {
-    svg::Style st;
-    st.color = svg::palette_color(k);
-    return st;
-  };
-
-  // 1. Pressure and angle against time, per trial.
   for (std::size_t k = 0; k < rec.trials.size(); ++k) {
     const TrialRecording& tr = rec.trials[k];
     svg::Figure fig(svg::kColumnWidthPx, 320);
@@ -177,65 +178,68 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
                        "pressure (line, in the dots' colour).",
                        "figures", fig));
   }
+  return out;
+}
 
-  // 2. Angle vs pressure at the marks, with the spread to the end of the hold.
-  {
-    svg::Figure fig(svg::kColumnWidthPx, 360);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("pressure step level (kPa)").ylabel("bending angle at the mark (deg)");
-    for (std::size_t k = 0; k < c.trials.size(); ++k) {
-      const TrialComparison& t = c.trials[k];
-      const std::string trial = "trial " + std::to_string(t.trial);
-      const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
-      const std::vector<double> mm = field(t.steps, &StepComparison::measured_mark_deg);
-      const std::vector<double> me = field(t.steps, &StepComparison::measured_end_deg);
-      const std::vector<double> pm = field(t.steps, &StepComparison::model_mark_deg);
-      svg::Style dots = trial_style(k);
-      dots.marker = svg::Marker::Circle;
-      dots.line_width = 0;
-      ax.line(lv, mm, trial + " measured", dots);
-      std::vector<double> lo(mm.size()), hi(mm.size());
-      for (std::size_t i = 0; i < mm.size(); ++i) lo[i] = std::min(mm[i], me[i]), hi[i] = std::max(mm[i], me[i]);
-      svg::Style bars = trial_style(k);
-      bars.line_width = 1.0;
-      bars.in_legend = false;
-      ax.range_bars(lv, lo, hi, trial + " spread to the end of the hold", bars);
-      svg::Style line = trial_style(k);
-      line.dash = "5 3";
-      line.in_legend = false;
-      ax.line(lv, pm, trial + " model", line);
-    }
-    out.push_back(make("fig_angle_pressure", "Angle vs pressure",
-                       "Measured angle at the 2.5 s mark of each step (dots) with the spread to the end of the hold "
-                       "(bars), and the model at the marks (dashed), each trial in its own colour.",
-                       "figures", fig));
+// 2. Angle vs pressure at the marks, with the spread to the end of the hold.
+ReportFigure angle_pressure_figure(const Comparison& c) {
+  svg::Figure fig(svg::kColumnWidthPx, 360);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("pressure step level (kPa)").ylabel("bending angle at the mark (deg)");
+  for (std::size_t k = 0; k < c.trials.size(); ++k) {
+    const TrialComparison& t = c.trials[k];
+    const std::string trial = "trial " + std::to_string(t.trial);
+    const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
+    const std::vector<double> mm = field(t.steps, &StepComparison::measured_mark_deg);
+    const std::vector<double> me = field(t.steps, &StepComparison::measured_end_deg);
+    const std::vector<double> pm = field(t.steps, &StepComparison::model_mark_deg);
+    svg::Style dots = trial_style(k);
+    dots.marker = svg::Marker::Circle;
+    dots.line_width = 0;
+    ax.line(lv, mm, trial + " measured", dots);
+    std::vector<double> lo(mm.size()), hi(mm.size());
+    for (std::size_t i = 0; i < mm.size(); ++i) lo[i] = std::min(mm[i], me[i]), hi[i] = std::max(mm[i], me[i]);
+    svg::Style bars = trial_style(k);
+    bars.line_width = 1.0;
+    bars.in_legend = false;
+    ax.range_bars(lv, lo, hi, trial + " spread to the end of the hold", bars);
+    svg::Style line = trial_style(k);
+    line.dash = "5 3";
+    line.in_legend = false;
+    ax.line(lv, pm, trial + " model", line);
   }
+  return make("fig_angle_pressure", "Angle vs pressure",
+              "Measured angle at the 2.5 s mark of each step (dots) with the spread to the end of the hold "
+              "(bars), and the model at the marks (dashed), each trial in its own colour.",
+              "figures", fig);
+}
 
-  // 3. NRMSE per trial.
-  {
-    svg::Figure fig(svg::kColumnWidthPx, 320);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("trial").ylabel("NRMSE").xinteger();
-    std::vector<double> x, full, mark, floor;
-    for (const TrialComparison& t : c.trials) {
-      x.push_back(t.trial);
-      full.push_back(t.nrmse);
-      mark.push_back(t.nrmse_mark);
-      floor.push_back(c.noise_floor_nrmse);
-    }
-    svg::Style a, b, f;
-    a.marker = svg::Marker::Circle;
-    b.marker = svg::Marker::Square;
-    f.dash = "4 3";
-    f.color = "#999999";
-    ax.line(x, full, "full time series", a).line(x, mark, "at the 2.5 s marks (paper)", b).line(x, floor, "noise floor", f);
-    out.push_back(make("fig_nrmse", "NRMSE per trial",
-                       "NRMSE of each trial over all frames and at the marks; the dashed line is the best a perfect "
-                       "model could reach given the tracking noise.",
-                       "figures", fig));
+// 3. NRMSE per trial.
+ReportFigure nrmse_figure(const Comparison& c) {
+  svg::Figure fig(svg::kColumnWidthPx, 320);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("trial").ylabel("NRMSE").xinteger();
+  std::vector<double> x, full, mark, floor;
+  for (const TrialComparison& t : c.trials) {
+    x.push_back(t.trial);
+    full.push_back(t.nrmse);
+    mark.push_back(t.nrmse_mark);
+    floor.push_back(c.noise_floor_nrmse);
   }
+  svg::Style a, b, f;
+  a.marker = svg::Marker::Circle;
+  b.marker = svg::Marker::Square;
+  f.dash = "4 3";
+  f.color = "#999999";
+  ax.line(x, full, "full time series", a).line(x, mark, "at the 2.5 s marks (paper)", b).line(x, floor, "noise floor", f);
+  return make("fig_nrmse", "NRMSE per trial",
+              "NRMSE of each trial over all frames and at the marks; the dashed line is the best a perfect "
+              "model could reach given the tracking noise.",
+              "figures", fig);
+}
 
-  // 4. Absolute error per step, grouped by trial; 5. error and spread per step.
+/// The step axis' labels: the first trial's step levels (kPa), "step k" beyond them.
+std::vector<std::string> step_labels(const Comparison& c) {
   std::size_t nsteps = 0;
   for (const TrialComparison& t : c.trials) nsteps = std::max(nsteps, t.steps.size());
   std::vector<std::string> cats;
@@ -249,121 +253,144 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
     }
     cats.push_back(lab);
   }
-  {
-    svg::Figure fig(svg::kColumnWidthPx, 320);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("pressure step (kPa)").ylabel("absolute error at the mark (deg)");
-    std::vector<svg::BarGroup> groups;
-    for (std::size_t k = 0; k < c.trials.size(); ++k) {
-      svg::BarGroup g;
-      g.label = "trial " + std::to_string(c.trials[k].trial);
-      g.values = field(c.trials[k].steps, &StepComparison::abs_error_deg);
-      g.values.resize(nsteps, std::nan(""));
-      g.color = svg::palette_color(k);
-      groups.push_back(g);
-    }
-    ax.grouped_bars(cats, groups);
-    out.push_back(make("fig_abs_error", "Absolute error per step",
-                       "|model - measured| at the 2.5 s mark of each step, grouped by trial.", "figures", fig));
-  }
-  {
-    svg::Figure fig(2 * svg::kColumnWidthPx, 320, 1, 2);
-    svg::Axes& e = fig.axes(0, 0);
-    svg::Axes& sp = fig.axes(0, 1);
-    e.title("absolute error at the mark").xlabel("pressure (kPa)").ylabel("deg");
-    sp.title("spread: end of hold - mark").xlabel("pressure (kPa)").ylabel("deg");
-    for (std::size_t k = 0; k < c.trials.size(); ++k) {
-      const TrialComparison& t = c.trials[k];
-      const std::string trial = "trial " + std::to_string(t.trial);
-      const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
-      svg::Style m = trial_style(k);
-      m.marker = svg::Marker::Circle;
-      e.line(lv, field(t.steps, &StepComparison::abs_error_deg), trial, m);
-      sp.line(lv, field(t.steps, &StepComparison::spread_measured_deg), trial + " measured", m);
-      svg::Style d = trial_style(k);
-      d.dash = "5 3";
-      sp.line(lv, field(t.steps, &StepComparison::spread_model_deg), trial + " model", d);
-    }
-    out.push_back(make("fig_error_spread", "Error and spread per step",
-                       "Left: absolute error at the mark. Right: creep after the mark, measured (solid) and model "
-                       "(dashed), each trial in its own colour — a model without time dependence has zero spread.",
-                       "figures", fig));
-  }
+  return cats;
+}
 
-  // 6. Residual map (step x trial).
-  {
-    std::vector<std::string> rows, trials;
-    for (const TrialComparison& t : c.trials) {
-      rows.push_back("trial " + std::to_string(t.trial));
-      trials.push_back(std::to_string(t.trial));
-    }
-    out.push_back({"fig_residual_map", "Residual map",
-                   "Mean residual (model - measured) over each step of each trial. A pattern along a row is a "
-                   "trial-to-trial drift (fatigue, softening); along a column a pressure-dependent error (stiffness "
-                   "curve).",
-                   "fails", heatmap_svg(c.residual_map_deg, rows, cats, "mean residual per step (deg)", "deg", "pressure step (kPa)"),
-                   heatmap_csv(c.residual_map_deg, trials, cats, "trial", "step_kPa", "mean_residual_deg")});
-  }
-
-  // 7. Residual vs time since the step start.
-  {
-    svg::Figure fig(svg::kColumnWidthPx, 320);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("time since the step start (s)").ylabel("mean residual (deg)");
-    svg::Style a, e, l;
-    a.color = "#000000";
-    e.color = "#0072B2";
-    e.dash = "5 3";
-    l.color = "#D55E00";
-    l.dash = "2 2";
-    ax.line(c.profile.t_s, c.profile.mean_deg, "all steps", a)
-        .line(c.profile_early_trials.t_s, c.profile_early_trials.mean_deg, "early trials", e)
-        .line(c.profile_late_trials.t_s, c.profile_late_trials.mean_deg, "late trials", l);
-    out.push_back(make("fig_residual_profile", "Residual vs time in step",
-                       "Mean residual against the time since each step started: a transient after the start is "
-                       "lag or rate dependence the model lacks; a slope after the mark is creep; a constant offset "
-                       "is static stiffness.",
-                       "fails", fig));
-  }
-
-  // 8. Region sensitivity.
-  if (!r.regions.empty()) {
-    svg::Figure fig(svg::kColumnWidthPx, 320);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("region").ylabel("fraction of residual removed");
-    std::vector<std::string> names;
+// 4. Absolute error per step, grouped by trial.
+ReportFigure abs_error_figure(const Comparison& c, const std::vector<std::string>& cats) {
+  const std::size_t nsteps = cats.size();
+  svg::Figure fig(svg::kColumnWidthPx, 320);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("pressure step (kPa)").ylabel("absolute error at the mark (deg)");
+  std::vector<svg::BarGroup> groups;
+  for (std::size_t k = 0; k < c.trials.size(); ++k) {
     svg::BarGroup g;
-    g.label = "variance fraction";
-    for (const RegionSensitivity& s : r.regions) {
-      names.push_back(s.region);
-      g.values.push_back(s.variance_fraction);
-    }
-    ax.grouped_bars(names, {g}).legend(svg::Legend::None);
-    out.push_back(make("fig_regions", "Region sensitivity",
-                       "Share of the residual's sum of squares that rescaling one region's stiffness (best scale, "
-                       "linearised) would remove. Similar shares mean the regions cannot be told apart by this "
-                       "record; a best scale far from 1 (or negative) means that region alone cannot explain it.",
-                       "regions", fig));
+    g.label = "trial " + std::to_string(c.trials[k].trial);
+    g.values = field(c.trials[k].steps, &StepComparison::abs_error_deg);
+    g.values.resize(nsteps, std::nan(""));
+    g.color = svg::palette_color(k);
+    groups.push_back(g);
   }
+  ax.grouped_bars(cats, groups);
+  return make("fig_abs_error", "Absolute error per step",
+              "|model - measured| at the 2.5 s mark of each step, grouped by trial.", "figures", fig);
+}
 
-  // 9. History of the study: one bar per run, labelled "#i label" (the x axis is the run order).
-  {
-    svg::Figure fig(std::max(svg::kColumnWidthPx, 70.0 * static_cast<double>(history.size())), 320);
-    svg::Axes& ax = fig.axes();
-    ax.xlabel("run (in order)").ylabel("pooled NRMSE").legend(svg::Legend::None);
-    std::vector<std::string> names;
-    svg::BarGroup g;
-    g.label = "pooled NRMSE";
-    for (std::size_t i = 0; i < history.size(); ++i) {
-      names.push_back("#" + std::to_string(i + 1) + " " + history[i].label);
-      g.values.push_back(history[i].nrmse);
-    }
-    ax.grouped_bars(names, {g});
-    out.push_back(make("fig_history", "Study history",
-                       "Pooled NRMSE of every compared model variant, in the order they were run (details in the "
-                       "table below).",
-                       "history", fig));
+// 5. Error and spread per step.
+ReportFigure error_spread_figure(const Comparison& c) {
+  svg::Figure fig(2 * svg::kColumnWidthPx, 320, 1, 2);
+  svg::Axes& e = fig.axes(0, 0);
+  svg::Axes& sp = fig.axes(0, 1);
+  e.title("absolute error at the mark").xlabel("pressure (kPa)").ylabel("deg");
+  sp.title("spread: end of hold - mark").xlabel("pressure (kPa)").ylabel("deg");
+  for (std::size_t k = 0; k < c.trials.size(); ++k) {
+    const TrialComparison& t = c.trials[k];
+    const std::string trial = "trial " + std::to_string(t.trial);
+    const std::vector<double> lv = field(t.steps, &StepComparison::level_kPa);
+    svg::Style m = trial_style(k);
+    m.marker = svg::Marker::Circle;
+    e.line(lv, field(t.steps, &StepComparison::abs_error_deg), trial, m);
+    sp.line(lv, field(t.steps, &StepComparison::spread_measured_deg), trial + " measured", m);
+    svg::Style d = trial_style(k);
+    d.dash = "5 3";
+    sp.line(lv, field(t.steps, &StepComparison::spread_model_deg), trial + " model", d);
   }
+  return make("fig_error_spread", "Error and spread per step",
+              "Left: absolute error at the mark. Right: creep after the mark, measured (solid) and model "
+              "(dashed), each trial in its own colour — a model without time dependence has zero spread.",
+              "figures", fig);
+}
+
+// 6. Residual map (step x trial).
+ReportFigure residual_map_figure(const Comparison& c, const std::vector<std::string>& cats) {
+  std::vector<std::string> rows, trials;
+  for (const TrialComparison& t : c.trials) {
+    rows.push_back("trial " + std::to_string(t.trial));
+    trials.push_back(std::to_string(t.trial));
+  }
+  return {"fig_residual_map", "Residual map",
+          "Mean residual (model - measured) over each step of each trial. A pattern along a row is a "
+          "trial-to-trial drift (fatigue, softening); along a column a pressure-dependent error (stiffness "
+          "curve).",
+          "fails", heatmap_svg(c.residual_map_deg, rows, cats, "mean residual per step (deg)", "deg", "pressure step (kPa)"),
+          heatmap_csv(c.residual_map_deg, trials, cats, "trial", "step_kPa", "mean_residual_deg")};
+}
+
+// 7. Residual vs time since the step start.
+ReportFigure residual_profile_figure(const Comparison& c) {
+  svg::Figure fig(svg::kColumnWidthPx, 320);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("time since the step start (s)").ylabel("mean residual (deg)");
+  svg::Style a, e, l;
+  a.color = "#000000";
+  e.color = "#0072B2";
+  e.dash = "5 3";
+  l.color = "#D55E00";
+  l.dash = "2 2";
+  ax.line(c.profile.t_s, c.profile.mean_deg, "all steps", a)
+      .line(c.profile_early_trials.t_s, c.profile_early_trials.mean_deg, "early trials", e)
+      .line(c.profile_late_trials.t_s, c.profile_late_trials.mean_deg, "late trials", l);
+  return make("fig_residual_profile", "Residual vs time in step",
+              "Mean residual against the time since each step started: a transient after the start is "
+              "lag or rate dependence the model lacks; a slope after the mark is creep; a constant offset "
+              "is static stiffness.",
+              "fails", fig);
+}
+
+// 8. Region sensitivity.
+ReportFigure regions_figure(const std::vector<RegionSensitivity>& regions) {
+  svg::Figure fig(svg::kColumnWidthPx, 320);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("region").ylabel("fraction of residual removed");
+  std::vector<std::string> names;
+  svg::BarGroup g;
+  g.label = "variance fraction";
+  for (const RegionSensitivity& s : regions) {
+    names.push_back(s.region);
+    g.values.push_back(s.variance_fraction);
+  }
+  ax.grouped_bars(names, {g}).legend(svg::Legend::None);
+  return make("fig_regions", "Region sensitivity",
+              "Share of the residual's sum of squares that rescaling one region's stiffness (best scale, "
+              "linearised) would remove. Similar shares mean the regions cannot be told apart by this "
+              "record; a best scale far from 1 (or negative) means that region alone cannot explain it.",
+              "regions", fig);
+}
+
+// 9. History of the study: one bar per run, labelled "#i label" (the x axis is the run order).
+ReportFigure history_figure(const std::vector<HistoryEntry>& history) {
+  svg::Figure fig(std::max(svg::kColumnWidthPx, 70.0 * static_cast<double>(history.size())), 320);
+  svg::Axes& ax = fig.axes();
+  ax.xlabel("run (in order)").ylabel("pooled NRMSE").legend(svg::Legend::None);
+  std::vector<std::string> names;
+  svg::BarGroup g;
+  g.label = "pooled NRMSE";
+  for (std::size_t i = 0; i < history.size(); ++i) {
+    names.push_back("#" + std::to_string(i + 1) + " " + history[i].label);
+    g.values.push_back(history[i].nrmse);
+  }
+  ax.grouped_bars(names, {g});
+  return make("fig_history", "Study history",
+              "Pooled NRMSE of every compared model variant, in the order they were run (details in the "
+              "table below).",
+              "history", fig);
+}
+
+}  // namespace
+
+std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRunResult& r,
+                                          const std::vector<HistoryEntry>& history) {
+  const Comparison& c = r.comparison;
+  std::vector<ReportFigure> out = trial_figures(rec, r);
+  out.push_back(angle_pressure_figure(c));
+  out.push_back(nrmse_figure(c));
+  const std::vector<std::string> cats = step_labels(c);
+  out.push_back(abs_error_figure(c, cats));
+  out.push_back(error_spread_figure(c));
+  out.push_back(residual_map_figure(c, cats));
+  out.push_back(residual_profile_figure(c));
+  if (!r.regions.empty()) out.push_back(regions_figure(r.regions));
+  out.push_back(history_figure(history));
   return out;
 }
 

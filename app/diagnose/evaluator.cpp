@@ -17,6 +17,7 @@
 #include "app/simulate/result_cache.h"
 #include "core/errors.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem::diagnose_detail {
 
@@ -60,8 +61,8 @@ PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, 
   p_max_Pa_ = std::max(1e3, p_max * 1e3);
   DriveOptions d;
   d.max_report_gap_s = 0.5;  // creep and damage inside holds: 0.5 s states, linear in between
-  inlet_ = measured_load(rec, d, base.number("load.rest_s"), true, offset_);
-  rest_s_ = base.number("load.rest_s");
+  rest_s_ = load_settings(base).rest_s;
+  inlet_ = measured_load(rec, d, rest_s_, true, offset_);
   double inlet_max_Pa = 0.0, scene_peak_Pa = 0.0;
   for (const TrialLoad& tr : inlet_.trials)
     for (double p : tr.pressure_Pa) inlet_max_Pa = std::max(inlet_max_Pa, p);

@@ -11,6 +11,7 @@
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
 #include "core/version.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem::diagnose_detail {
 
@@ -59,8 +60,9 @@ std::string recording_section(const Recording& rec, const DiagnoseOptions& opt) 
 }
 
 std::string scene_section(const Scene& scene, const PathModelEvaluator& rom, const DiagnoseOptions& opt) {
-  std::string mesh = scene.string("mesh.source") == "pneunet" ? "built-in pneu-net, h = " + fmt("%g", scene.number("mesh.h_mm")) + " mm"
-                                                              : "deck `" + scene.string("mesh.file") + "`";
+  const MeshSettings ms = mesh_settings(scene);
+  std::string mesh = ms.source == MeshSettings::Source::PneuNet ? "built-in pneu-net, h = " + fmt("%g", ms.h_mm) + " mm"
+                                                                : "deck `" + ms.file + "`";
   std::string out = "- Scene: hash `" + scene_hash(scene) + "` (its full text is in diagnosis.json), mesh " + mesh + ".\n";
   out += "- Calibrated with the reduced path model: " + std::to_string(rom.path().num_points()) + " material points, " +
          (opt.calibration_h_mm > 0.0 ? "on the built-in mesher at h = " + fmt("%g", opt.calibration_h_mm) +

@@ -16,6 +16,7 @@
 #include "scenes/calculix_deck.h"
 #include "scenes/scene.h"
 #include "scenes/scene_reference.h"
+#include "scenes/scene_settings.h"
 #include "scenes/stl_scene.h"
 #include "viz/vtk_output.h"
 
@@ -120,7 +121,7 @@ int run_mesh_command(const MeshCommand& c) {
     write_vtu(c.out, bm->model, compute_fields(asmb, u, asmb.initial_state()), 0.0, 0, 0.0, 0.0);
   }
   for (const std::string& w : bm->warnings) std::printf("note: %s\n", w.c_str());
-  if (scene.string("mesh.source") == "stl") {
+  if (mesh_settings(scene).source == MeshSettings::Source::Stl) {
     StlMeshReport rep;
     (void)stl_scene_mesh(scene, nullptr, &rep);  // the report of the same (deterministic) mesh
     std::printf("%s", describe(rep).c_str());

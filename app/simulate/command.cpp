@@ -24,6 +24,7 @@
 #include "engine/assembly.h"
 #include "engine/explicit.h"
 #include "scenes/build_model.h"
+#include "scenes/scene_settings.h"
 #include "viz/vtk_output.h"
 
 namespace pneufem {
@@ -222,6 +223,273 @@ std::string reduced_summary(const ReducedSetup& setup, const ReducedRunResult& r
   return o.str(2);
 }
 
+/// A fresh run starts over: an earlier run's checkpoint goes before this run's scene.toml
+/// replaces that run's, so no later --resume can pair them.
+void start_fresh_run(const fs::path& dir, const RunOptions& opt, const Scene& scene, BuiltModel& bm) {
+  if (fs::exists(dir / "checkpoint.bin")) {
+    fs::remove(dir / "checkpoint.bin");
+    const std::string note = "removed checkpoint.bin of an earlier run in " + opt.out_dir +
+                             " (a fresh run starts over; simulate --resume DIR continues a killed run)";
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+    bm.warnings.push_back(note);
+  }
+  write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
+}
+
+/// The ideal elastic model (effects off, one trial) of the paper's metrics, and where it came from.
+struct IdealModel {
+  std::vector<StateRecord> records;  ///< empty when not run
+  std::string source = "computed";
+};
+
+/// The ideal model of a quasi-static staircase with effects (else none): read back from a resumed
+/// run, computed (by the reduced model when `rsetup` is given) or taken from the ideal cache; written
+/// to ideal_angles.csv.
+IdealModel ideal_model(const Scene& scene, const RunOptions& opt, const fs::path& dir, BuiltModel& bm,
+                       const ReducedSetup* rsetup) {
+  IdealModel ideal;
+  const bool reduced = rsetup != nullptr;
+  bool any_effect = false;
+  const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
+  const bool staircase = load_settings(scene).protocol == LoadSettings::Protocol::Staircase;
+  if (!(opt.compare_ideal && any_effect && staircase && bm.solver.mode == SolverSettings::Mode::QuasiStatic)) return ideal;
+  if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
+    ideal.records = read_angles_csv((dir / "ideal_angles.csv").string());
+    ideal.source = "ideal_angles.csv of the resumed run";
+    return ideal;
+  }
+  std::vector<std::string> sets = ideal_sets;
+  sets.push_back("load.trials=1");
+  const Scene ideal_scene = scene.with(sets);
+  auto compute = [&] {
+    if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
+    if (!reduced) return records_of(ideal_scene);
+    std::vector<StateRecord> recs;
+    for (const ReducedReport& r : run_reduced(*rsetup, *build_model(ideal_scene), nullptr, false).reports) recs.push_back(r.record);
+    return recs;
+  };
+  if (opt.ideal_cache_dir.empty()) {
+    ideal.records = compute();
+    if (reduced) ideal.source = "computed by the reduced model";
+  } else if (reduced) {
+    ideal.records = compute();  // seconds; the ideal cache holds full-FEM results only
+    ideal.source = "computed by the reduced model";
+  } else {
+    IdealResult r = cached_ideal(opt.ideal_cache_dir, ideal_cache_key(ideal_scene, bm.model, version_string()),
+                                 ideal_scene, bm.load.trials[0].output_s, compute, bm.warnings);
+    ideal.records = std::move(r.records);
+    ideal.source = r.source;
+  }
+  write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal.records, true));
+  return ideal;
+}
+
+/// What a run keeps as it goes: the reports, the VTU files and their .pvd series (the solvers'
+/// observer), and the checkpoints (their sink); on --resume, read back from the checkpoint.
+class RunRecorder {
+ public:
+  RunRecorder(const fs::path& dir, const BuiltModel& bm, const Assembler& asmb, const RunOptions& opt,
+              const RunIdentity& identity, ProgressLine& progress, const std::string& resume_body)
+      : dir_(dir), bm_(bm), asmb_(asmb), opt_(opt), identity_(identity), progress_(progress),
+        ntrials_(static_cast<int>(bm.load.trials.size())), want_vtu_(bm.output.vtu != "none"),
+        pvd_((dir / "results.pvd").string()) {
+    if (want_vtu_) fs::create_directories(dir / "vtu");
+    if (opt.resume) {
+      std::istringstream in(resume_body, std::ios::binary);
+      resume_from_ = std::make_unique<QuasiStaticCheckpoint>(
+          QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
+      app_ = read_app_section(in);
+      for (const auto& [t, f] : app_.vtu) pvd_.add(t, f);
+    }
+    last_ckpt_ = std::chrono::steady_clock::now();
+  }
+
+  std::vector<StateRecord>& records() { return app_.records; }
+  /// The solver state to resume from (null for a fresh run).
+  const QuasiStaticCheckpoint* resume_from() const { return resume_from_.get(); }
+
+  QuasiStaticRun::Observer observer() {
+    return [this](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) { observe(r, u, state); };
+  }
+  QuasiStaticRun::CheckpointSink sink() {
+    return [this](const QuasiStaticCheckpoint& c) { checkpoint(c); };
+  }
+
+  /// Drops the reports and VTU files so far (another model's run replaces them).
+  void restart() {
+    app_.records.clear();
+    app_.vtu.clear();
+    pvd_ = PvdSeries((dir_ / "results.pvd").string());
+  }
+
+ private:
+  bool is_step_end(const StateRecord& r) const {
+    const TrialLoad& tl = bm_.load.trials[r.trial - 1];
+    for (double e : tl.step_end_s)
+      if (std::abs(e - r.time_s) < 1e-9) return true;
+    return tl.step_end_s.empty();
+  }
+
+  void observe(const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
+    app_.records.push_back(r);
+    if (want_vtu_ && (bm_.output.vtu == "all" || is_step_end(r))) {
+      char name[64];
+      std::snprintf(name, sizeof name, "vtu/state_%04zu.vtu", app_.vtu.size());
+      write_vtu((dir_ / name).string(), bm_.model, compute_fields(asmb_, u, state), r.global_time_s, r.trial,
+                r.pressure_Pa * 1e-3, r.angle_deg);
+      pvd_.add(r.global_time_s, name);
+      app_.vtu.emplace_back(r.global_time_s, name);
+    }
+    progress_.update(r, ntrials_, "");
+  }
+
+  void checkpoint(const QuasiStaticCheckpoint& c) {
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt_).count();
+    if (since < opt_.checkpoint_every_s) return;
+    std::ostringstream os(std::ios::binary);
+    c.write(os);
+    write_app_section(os, app_);
+    write_file_atomic((dir_ / "checkpoint.bin").string(), checkpoint_file_text(identity_, os.str()));
+    write_file_atomic((dir_ / "angles.csv").string(), angles_csv(app_.records));
+    last_ckpt_ = std::chrono::steady_clock::now();
+    if (opt_.abort_after_checkpoints >= 0 && ++checkpoints_ >= opt_.abort_after_checkpoints) std::_Exit(137);
+  }
+
+  const fs::path& dir_;
+  const BuiltModel& bm_;
+  const Assembler& asmb_;
+  const RunOptions& opt_;
+  const RunIdentity& identity_;
+  ProgressLine& progress_;
+  const int ntrials_;
+  const bool want_vtu_;
+  PvdSeries pvd_;
+  AppCheckpoint app_;
+  std::unique_ptr<QuasiStaticCheckpoint> resume_from_;
+  int checkpoints_ = 0;
+  std::chrono::steady_clock::time_point last_ckpt_;
+};
+
+/// solver.model = "reduced": runs the reduced model and checks it (reduced_check.csv). When the
+/// check fails, the run falls back to the full FEM: its reports are dropped and true returned; else
+/// the solver statistics go to `solver_stats`. `reduced_json` gets summary.json's reduced_model part.
+bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& rec, ProgressLine& progress,
+                       const RunOptions& opt, const fs::path& dir, json::Object& solver_stats, std::string& reduced_json) {
+  const ReducedRunResult rr = run_reduced(setup, bm, rec.observer());
+  const double tol = bm.solver.reduced_check_deg;
+  std::string fallback = "none";
+  bool full = true;
+  if (const std::string why = reduced_check_failure(rr, tol); !why.empty()) {
+    fallback = "full FEM: " + why;
+    bm.warnings.push_back(fallback);
+    progress.done();
+    if (opt.progress) std::fprintf(stderr, "  %s\n", fallback.c_str());
+    rec.restart();  // the FEM's reports and VTU files replace the reduced ones
+  } else {
+    full = false;
+    solver_stats.add_str("mode", "quasi_static")
+        .add_str("model", "reduced")
+        .add("states", static_cast<double>(rr.stats.states))
+        .add("rejected_time_steps", static_cast<double>(rr.stats.rejected_steps))
+        .add("newton_iterations", static_cast<double>(rr.stats.newton_iterations));
+  }
+  write_file_atomic((dir / "reduced_check.csv").string(), reduced_check_csv(rr.reports));
+  reduced_json = reduced_summary(setup, rr, tol, fallback);
+  return full;
+}
+
+/// The quasi-static march of the full FEM (from the checkpoint on --resume); its statistics to `solver_stats`.
+void run_full_fem(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
+                  json::Object& solver_stats) {
+  QuasiStaticRun run(asmb, bm.solver.quasi_static);
+  try {
+    run.run(bm.load, rec.observer(), rec.sink(), rec.resume_from());
+  } catch (...) {
+    solver_stats.add("states", static_cast<double>(run.stats().states));
+    throw;
+  }
+  const StaticStats& st = run.static_solver().stats();
+  solver_stats.add_str("mode", "quasi_static")
+      .add_str("model", "full")
+      .add_str("method", bm.solver.quasi_static.method == EquilibriumMethod::Newton ? "newton" : "relaxation")
+      .add("states", static_cast<double>(run.stats().states))
+      .add("rejected_time_steps", static_cast<double>(run.stats().rejected_steps))
+      .add("increments", static_cast<double>(st.increments))
+      .add("cutbacks", static_cast<double>(st.cutbacks))
+      .add("newton_iterations", static_cast<double>(st.iterations))
+      .add("chord_steps", static_cast<double>(st.chord_steps))
+      .add("factorizations", static_cast<double>(st.factorizations))
+      .add("krylov_iterations", static_cast<double>(st.krylov_iterations))
+      .add("stiff_layer_relaxations", static_cast<double>(st.stiff_relaxations))
+      .add("stiff_layer_factorizations", static_cast<double>(st.stiff_factorizations))
+      .add("last_factor_steps", static_cast<double>(st.last_factor_steps))
+      .add("energy_line_search_cuts", static_cast<double>(st.energy_cuts))
+      .add("release_attempts", static_cast<double>(st.release_attempts))
+      .add("direct_releases", static_cast<double>(st.direct_releases))
+      .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
+      .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
+      .add("assembly_s", st.assembly_s)
+      .add("factor_solve_s", st.factor_s)
+      .add("resumed", opt.resume ? 1.0 : 0.0);
+}
+
+/// Explicit dynamics through the concatenated trials; time_scale > 1 compresses the protocol
+/// (quasi-static by time scaling) and the reported times are protocol times.
+void run_explicit(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
+                  json::Object& solver_stats) {
+  if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
+  const QuasiStaticRun::Observer observe = rec.observer();
+  const int ntrials = static_cast<int>(bm.load.trials.size());
+  ExplicitIntegrator ex(asmb, bm.solver.explicit_dynamics);
+  const double ts = bm.solver.time_scale;
+  double t0_protocol = 0.0, last_angle = 0.0;
+  for (int k = 0; k < ntrials; ++k) {
+    const TrialLoad& tl = bm.load.trials[k];
+    const double trial_start = t0_protocol;
+    auto pressure = [&](double tau) { return tl.pressure(tau * ts - trial_start); };
+    for (double t_out : tl.output_s) {
+      ex.run((trial_start + t_out) / ts, pressure, 1 << 30, nullptr);
+      StateRecord r;
+      r.trial = k + 1;
+      r.time_s = t_out;
+      r.global_time_s = trial_start + t_out;
+      r.pressure_Pa = tl.pressure(t_out);
+      const AngleResult a = bending_angle(bm.model, ex.u());
+      r.angle_deg = unwrap_deg(a.angle_deg, last_angle);
+      last_angle = r.angle_deg;
+      r.plane_rms_m = a.plane_rms_m;
+      r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
+      observe(r, ex.u(), ex.state());
+    }
+    t0_protocol += tl.duration() + bm.load.rest_between_trials_s;
+  }
+  solver_stats.add_str("mode", "explicit")
+      .add("steps", static_cast<double>(ex.stats().steps))
+      .add("dt_s", ex.stats().dt_s)
+      .add("dt_min_s", ex.stats().dt_min_s)
+      .add("time_scale", ts)
+      .add("physical_mass_kg", ex.stats().physical_mass_kg)
+      .add("added_mass_kg", ex.stats().added_mass_kg)
+      .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
+      .add("energy_kinetic_J", ex.energy().kinetic_J)
+      .add("energy_internal_J", ex.energy().internal_J)
+      .add("energy_external_work_J", ex.energy().external_work_J)
+      .add("energy_damping_J", ex.energy().damping_J)
+      .add("energy_balance_relative_error", ex.energy().relative_error());
+}
+
+/// metrics.json (the paper's metrics of every trial against the ideal model); its summary.json
+/// entry ("null" when there is no ideal model).
+std::string write_metrics(const fs::path& dir, const BuiltModel& bm, const std::vector<StateRecord>& ideal,
+                          const std::vector<StateRecord>& records) {
+  const int ntrials = static_cast<int>(bm.load.trials.size());
+  const StepAngles ref = step_angles(bm.load.trials[0], 1, ideal);
+  std::vector<TrialMetrics> per_trial;
+  for (int k = 0; k < ntrials; ++k) per_trial.push_back(paper_metrics(step_angles(bm.load.trials[k], k + 1, records), ref));
+  write_file_atomic((dir / "metrics.json").string(), metrics_json(per_trial, ref.level_kPa));
+  return json::quote("metrics.json");
+}
+
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
@@ -237,18 +505,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   std::unique_ptr<BuiltModel> bm = build_model(scene);
   const Assembler asmb(bm->model);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
-  if (!opt.resume) {
-    // A fresh run starts over: an earlier run's checkpoint goes before this run's scene.toml
-    // replaces that run's, so no later --resume can pair them.
-    if (fs::exists(dir / "checkpoint.bin")) {
-      fs::remove(dir / "checkpoint.bin");
-      const std::string note = "removed checkpoint.bin of an earlier run in " + opt.out_dir +
-                               " (a fresh run starts over; simulate --resume DIR continues a killed run)";
-      std::fprintf(stderr, "note: %s\n", note.c_str());
-      bm->warnings.push_back(note);
-    }
-    write_file_atomic((dir / "scene.toml").string(), scene.to_toml());
-  }
+  if (!opt.resume) start_fresh_run(dir, opt, scene, *bm);
   const RunIdentity identity = run_identity(scene, bm->model, bm->load);
   const std::string resume_body =  // checked now, before any work
       opt.resume ? read_checkpoint_body(dir / "checkpoint.bin", identity, opt.out_dir) : std::string();
@@ -263,192 +520,20 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
 
   RunResult result;
   ProgressLine progress(opt.progress);
-  const int ntrials = static_cast<int>(bm->load.trials.size());
-  json::Object solver_stats;
   std::exception_ptr failure;
-
-  // The ideal elastic model (effects off, one trial) for the paper's metrics.
-  bool any_effect = false;
-  const std::vector<std::string> ideal_sets = ideal_overrides(scene, any_effect);
-  const bool staircase = scene.string("load.protocol") == "staircase";
-  std::vector<StateRecord> ideal;
-  std::string ideal_source = "computed";
-  if (opt.compare_ideal && any_effect && staircase && bm->solver.mode == SolverSettings::Mode::QuasiStatic) {
-    if (opt.resume && fs::exists(dir / "ideal_angles.csv")) {
-      ideal = read_angles_csv((dir / "ideal_angles.csv").string());
-      ideal_source = "ideal_angles.csv of the resumed run";
-    } else {
-      std::vector<std::string> sets = ideal_sets;
-      sets.push_back("load.trials=1");
-      const Scene ideal_scene = scene.with(sets);
-      auto compute = [&] {
-        if (opt.progress) std::fprintf(stderr, "  ideal elastic model (effects off) ...\n");
-        if (!reduced) return records_of(ideal_scene);
-        std::vector<StateRecord> recs;
-        for (const ReducedReport& r : run_reduced(*rsetup, *build_model(ideal_scene), nullptr, false).reports) recs.push_back(r.record);
-        return recs;
-      };
-      if (opt.ideal_cache_dir.empty()) {
-        ideal = compute();
-        if (reduced) ideal_source = "computed by the reduced model";
-      } else if (reduced) {
-        ideal = compute();  // seconds; the ideal cache holds full-FEM results only
-        ideal_source = "computed by the reduced model";
-      } else {
-        IdealResult r = cached_ideal(opt.ideal_cache_dir, ideal_cache_key(ideal_scene, bm->model, version_string()),
-                                     ideal_scene, bm->load.trials[0].output_s, compute, bm->warnings);
-        ideal = std::move(r.records);
-        ideal_source = r.source;
-      }
-      write_file_atomic((dir / "ideal_angles.csv").string(), angles_csv(ideal, true));
-    }
-  }
-
-  const bool want_vtu = bm->output.vtu != "none";
-  if (want_vtu) fs::create_directories(dir / "vtu");
-  PvdSeries pvd((dir / "results.pvd").string());
-  AppCheckpoint app;
-  std::unique_ptr<QuasiStaticCheckpoint> resume_from;
-  if (opt.resume) {
-    std::istringstream in(resume_body, std::ios::binary);
-    resume_from = std::make_unique<QuasiStaticCheckpoint>(
-        QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
-    app = read_app_section(in);
-    for (const auto& [t, f] : app.vtu) pvd.add(t, f);
-  }
-  std::vector<StateRecord>& records = app.records;
-
-  auto is_step_end = [&](const StateRecord& r) {
-    const TrialLoad& tl = bm->load.trials[r.trial - 1];
-    for (double e : tl.step_end_s)
-      if (std::abs(e - r.time_s) < 1e-9) return true;
-    return tl.step_end_s.empty();
-  };
-  auto observe = [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
-    records.push_back(r);
-    if (want_vtu && (bm->output.vtu == "all" || is_step_end(r))) {
-      char name[64];
-      std::snprintf(name, sizeof name, "vtu/state_%04zu.vtu", app.vtu.size());
-      write_vtu((dir / name).string(), bm->model, compute_fields(asmb, u, state), r.global_time_s, r.trial,
-                r.pressure_Pa * 1e-3, r.angle_deg);
-      pvd.add(r.global_time_s, name);
-      app.vtu.emplace_back(r.global_time_s, name);
-    }
-    progress.update(r, ntrials, "");
-  };
-  int checkpoints = 0;
-  auto last_ckpt = std::chrono::steady_clock::now();
-  auto sink = [&](const QuasiStaticCheckpoint& c) {
-    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt).count();
-    if (since < opt.checkpoint_every_s) return;
-    std::ostringstream os(std::ios::binary);
-    c.write(os);
-    write_app_section(os, app);
-    write_file_atomic((dir / "checkpoint.bin").string(), checkpoint_file_text(identity, os.str()));
-    write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
-    last_ckpt = std::chrono::steady_clock::now();
-    if (opt.abort_after_checkpoints >= 0 && ++checkpoints >= opt.abort_after_checkpoints) std::_Exit(137);
-  };
+  const IdealModel ideal = ideal_model(scene, opt, dir, *bm, rsetup.get());
+  RunRecorder recorder(dir, *bm, asmb, opt, identity, progress, resume_body);
 
   const auto t_solve = std::chrono::steady_clock::now();
+  json::Object solver_stats;
   std::string reduced_json = "null";
   try {
     bool full = bm->solver.mode == SolverSettings::Mode::QuasiStatic;
-    if (reduced) {
-      const ReducedRunResult rr = run_reduced(*rsetup, *bm, observe);
-      const double tol = bm->solver.reduced_check_deg;
-      std::string fallback = "none";
-      if (const std::string why = reduced_check_failure(rr, tol); !why.empty()) {
-        fallback = "full FEM: " + why;
-        bm->warnings.push_back(fallback);
-        progress.done();
-        if (opt.progress) std::fprintf(stderr, "  %s\n", fallback.c_str());
-        records.clear();  // the FEM's reports and VTU files replace the reduced ones
-        app.vtu.clear();
-        pvd = PvdSeries((dir / "results.pvd").string());
-      } else {
-        full = false;
-        solver_stats.add_str("mode", "quasi_static")
-            .add_str("model", "reduced")
-            .add("states", static_cast<double>(rr.stats.states))
-            .add("rejected_time_steps", static_cast<double>(rr.stats.rejected_steps))
-            .add("newton_iterations", static_cast<double>(rr.stats.newton_iterations));
-      }
-      write_file_atomic((dir / "reduced_check.csv").string(), reduced_check_csv(rr.reports));
-      reduced_json = reduced_summary(*rsetup, rr, tol, fallback);
-    }
-    if (full) {
-      QuasiStaticRun run(asmb, bm->solver.quasi_static);
-      try {
-        run.run(bm->load, observe, sink, resume_from.get());
-      } catch (...) {
-        solver_stats.add("states", static_cast<double>(run.stats().states));
-        throw;
-      }
-      const StaticStats& st = run.static_solver().stats();
-      solver_stats.add_str("mode", "quasi_static")
-          .add_str("model", "full")
-          .add_str("method", bm->solver.quasi_static.method == EquilibriumMethod::Newton ? "newton" : "relaxation")
-          .add("states", static_cast<double>(run.stats().states))
-          .add("rejected_time_steps", static_cast<double>(run.stats().rejected_steps))
-          .add("increments", static_cast<double>(st.increments))
-          .add("cutbacks", static_cast<double>(st.cutbacks))
-          .add("newton_iterations", static_cast<double>(st.iterations))
-          .add("chord_steps", static_cast<double>(st.chord_steps))
-          .add("factorizations", static_cast<double>(st.factorizations))
-          .add("krylov_iterations", static_cast<double>(st.krylov_iterations))
-          .add("stiff_layer_relaxations", static_cast<double>(st.stiff_relaxations))
-          .add("stiff_layer_factorizations", static_cast<double>(st.stiff_factorizations))
-          .add("last_factor_steps", static_cast<double>(st.last_factor_steps))
-          .add("energy_line_search_cuts", static_cast<double>(st.energy_cuts))
-          .add("release_attempts", static_cast<double>(st.release_attempts))
-          .add("direct_releases", static_cast<double>(st.direct_releases))
-          .add("residual_evaluations", static_cast<double>(st.residual_evaluations))
-          .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
-          .add("assembly_s", st.assembly_s)
-          .add("factor_solve_s", st.factor_s)
-          .add("resumed", opt.resume ? 1.0 : 0.0);
-    } else if (bm->solver.mode == SolverSettings::Mode::Explicit) {
-      if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
-      // Explicit dynamics through the concatenated trials; time_scale > 1 compresses the
-      // protocol (quasi-static by time scaling) and the reported times are protocol times.
-      ExplicitIntegrator ex(asmb, bm->solver.explicit_dynamics);
-      const double ts = bm->solver.time_scale;
-      double t0_protocol = 0.0, last_angle = 0.0;
-      for (int k = 0; k < ntrials; ++k) {
-        const TrialLoad& tl = bm->load.trials[k];
-        const double trial_start = t0_protocol;
-        auto pressure = [&](double tau) { return tl.pressure(tau * ts - trial_start); };
-        for (double t_out : tl.output_s) {
-          ex.run((trial_start + t_out) / ts, pressure, 1 << 30, nullptr);
-          StateRecord r;
-          r.trial = k + 1;
-          r.time_s = t_out;
-          r.global_time_s = trial_start + t_out;
-          r.pressure_Pa = tl.pressure(t_out);
-          const AngleResult a = bending_angle(bm->model, ex.u());
-          r.angle_deg = unwrap_deg(a.angle_deg, last_angle);
-          last_angle = r.angle_deg;
-          r.plane_rms_m = a.plane_rms_m;
-          r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
-          observe(r, ex.u(), ex.state());
-        }
-        t0_protocol += tl.duration() + bm->load.rest_between_trials_s;
-      }
-      solver_stats.add_str("mode", "explicit")
-          .add("steps", static_cast<double>(ex.stats().steps))
-          .add("dt_s", ex.stats().dt_s)
-          .add("dt_min_s", ex.stats().dt_min_s)
-          .add("time_scale", ts)
-          .add("physical_mass_kg", ex.stats().physical_mass_kg)
-          .add("added_mass_kg", ex.stats().added_mass_kg)
-          .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
-          .add("energy_kinetic_J", ex.energy().kinetic_J)
-          .add("energy_internal_J", ex.energy().internal_J)
-          .add("energy_external_work_J", ex.energy().external_work_J)
-          .add("energy_damping_J", ex.energy().damping_J)
-          .add("energy_balance_relative_error", ex.energy().relative_error());
-    }
+    if (reduced) full = run_reduced_model(*rsetup, *bm, recorder, progress, opt, dir, solver_stats, reduced_json);
+    if (full)
+      run_full_fem(asmb, *bm, recorder, opt, solver_stats);
+    else if (bm->solver.mode == SolverSettings::Mode::Explicit)
+      run_explicit(asmb, *bm, recorder, opt, solver_stats);
   } catch (const std::exception& e) {
     result.status = e.what();
     failure = std::current_exception();
@@ -456,18 +541,12 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   progress.done();
   const double solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_solve).count();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const std::vector<StateRecord>& records = recorder.records();
   result.records = records;
 
   write_file_atomic((dir / "angles.csv").string(), angles_csv(records));
   write_file_atomic((dir / "states.csv").string(), states_csv(records));
-  std::string metrics_note = "null";
-  if (!ideal.empty() && !failure) {
-    const StepAngles ref = step_angles(bm->load.trials[0], 1, ideal);
-    std::vector<TrialMetrics> per_trial;
-    for (int k = 0; k < ntrials; ++k) per_trial.push_back(paper_metrics(step_angles(bm->load.trials[k], k + 1, records), ref));
-    write_file_atomic((dir / "metrics.json").string(), metrics_json(per_trial, ref.level_kPa));
-    metrics_note = json::quote("metrics.json");
-  }
+  const std::string metrics_note = !ideal.records.empty() && !failure ? write_metrics(dir, *bm, ideal.records, records) : "null";
   std::string warnings = "[";
   for (std::size_t i = 0; i < bm->warnings.size(); ++i) warnings += (i ? ", " : "") + json::quote(bm->warnings[i]);
   warnings += "]";
@@ -485,7 +564,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       .add("timings", timings.str(2))
       .add("warnings", warnings)
       .add("metrics", metrics_note)
-      .add_str("ideal_model", ideal.empty() ? "none" : ideal_source)
+      .add_str("ideal_model", ideal.records.empty() ? "none" : ideal.source)
       .add("states_reported", static_cast<double>(records.size()))
       .add("scene", scene.to_json());
   write_file_atomic((dir / "summary.json").string(), summary.str() + "\n");

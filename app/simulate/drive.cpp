@@ -21,6 +21,7 @@
 #include "engine/quasi_static.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/scene_settings.h"
 #include "viz/vtk_output.h"
 
 namespace pneufem {
@@ -323,7 +324,7 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
   const bool rate_dependent = asmb.state_size() > 0;
   std::vector<double> offset;
   DriveResult result;
-  LoadHistory load = measured_load(rec, opt, scene.number("load.rest_s"), rate_dependent, offset, &result.tolerance_kPa);
+  LoadHistory load = measured_load(rec, opt, load_settings(scene).rest_s, rate_dependent, offset, &result.tolerance_kPa);
   // The scene's chamber-pressure lag (load.pressure_lag_s, first or with load.pressure_lag2_s
   // second order) acts on the measured inlet exactly as on the scene's own load (same 0.05 kPa
   // breakpoint tolerance as build_model uses for a CSV inlet). Its breakpoints become reported

@@ -863,8 +863,9 @@ std::string format_value(double v, bool integer) {
 
 // ---------------------------------------------------------------------------------------------
 
-SweepResult run_sweep(const SweepOptions& o) {
-  const auto wall0 = std::chrono::steady_clock::now();
+namespace {
+
+void check_sweep_options(const SweepOptions& o) {
   if (o.params.empty())
     throw InputError("--param: give at least one parameter to sweep, e.g. --param materials.silicone.fatigue.tau_s=100:1000:5:log");
   if (o.jobs < 0) throw InputError("--jobs " + std::to_string(o.jobs) + ": the number of worker processes must be at least 1");
@@ -873,9 +874,10 @@ SweepResult run_sweep(const SweepOptions& o) {
   if (o.lhs < 0) throw InputError("--lhs " + std::to_string(o.lhs) + ": the number of samples must be at least 1");
   if (o.out_dir.empty() && !o.dry_run) throw InputError("--out DIR is required");
   if (!o.dry_run) check_output_dir(o.out_dir, "--out");  // before anything is read or run: a bad --out fails now
+}
 
-  // The parameters, checked against the scene: existing numeric keys, each once.
-  const Scene base = Scene::load(o.scene_path, o.sets);
+// The parameters, checked against the scene: existing numeric keys, each once.
+std::vector<ParamSpec> swept_params(const SweepOptions& o, const Scene& base) {
   std::vector<ParamSpec> params;
   for (const std::string& text : o.params) {
     ParamSpec p = parse_param_spec(text);
@@ -896,12 +898,14 @@ SweepResult run_sweep(const SweepOptions& o) {
     }
     params.push_back(p);
   }
-  const std::vector<std::vector<double>> values = o.lhs > 0 ? lhs_points(params, o.lhs, o.seed) : grid_points(params);
+  return params;
+}
 
-  // Each point: its overrides and its offline keys, which decide the model (plan_model).
-  SweepResult result;
-  std::vector<std::vector<std::string>> overrides;
-  std::vector<std::optional<OfflineKeys>> keys;
+/// The points of the sweep (in result.points), each with its scene overrides and, unless
+/// --model full, its offline keys, which decide the model (plan_model).
+void add_points(const SweepOptions& o, const Scene& base, const std::vector<ParamSpec>& params,
+                const std::vector<std::vector<double>>& values, SweepResult& result,
+                std::vector<std::vector<std::string>>& overrides, std::vector<std::optional<OfflineKeys>>& keys) {
   for (std::size_t i = 0; i < values.size(); ++i) {
     SweepPoint pt;
     pt.index = static_cast<int>(i) + 1;
@@ -924,6 +928,75 @@ SweepResult run_sweep(const SweepOptions& o) {
     overrides.push_back(ov);
     result.points.push_back(pt);
   }
+}
+
+/// Resume: the points already done by an earlier invocation with the same resolved scene are
+/// read back (skipped); the indices of the others, to run.
+std::vector<std::size_t> points_to_run(const SweepOptions& o, const fs::path& out, const std::vector<ParamSpec>& params,
+                                       const std::vector<std::string>& scene_text, SweepResult& result) {
+  std::vector<std::size_t> queue;
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    SweepPoint& pt = result.points[i];
+    const fs::path dir = out / "points" / point_name(pt.index);
+    if (done_before(dir, scene_text[i])) {
+      read_point(pt, dir, -1, 0.0);
+      pt.skipped = true;
+      ++result.ok;
+      ++result.skipped;
+      say(o.log, "point " + point_name(pt.index) + " skipped (already done): " + describe(params, pt));
+    } else {
+      queue.push_back(i);
+    }
+  }
+  return queue;
+}
+
+/// Runs the points of `queue` in worker processes (those building a reduced model's offline part
+/// first), each read back as it finishes, with sweep.csv (`csv`) rewritten.
+void run_queue(const SweepOptions& o, const WorkerSetup& setup, const ModelPlan& plan, const std::vector<ParamSpec>& params,
+               const std::vector<std::size_t>& queue, const std::vector<std::vector<std::string>>& overrides,
+               const fs::path& csv, int jobs, SweepResult& result) {
+  std::vector<Worker> workers;
+  for (std::size_t i : queue) {
+    const fs::path dir = setup.out / "points" / point_name(result.points[i].index);
+    workers.push_back({i, dir, setup.argv(dir, overrides[i], plan.reduced)});
+  }
+  const auto [first, rest] = offline_waves(std::move(workers), plan);
+  if (!first.empty() && !rest.empty()) {
+    std::string names;
+    for (const Worker& w : first) names += (names.empty() ? "" : ", ") + point_name(result.points[w.i].index);
+    say(o.log, "point" + std::string(first.size() > 1 ? "s " : " ") + names + " first, building the reduced model's offline part" +
+                   (first.size() > 1 ? "s" : "") + "; then the other " + std::to_string(rest.size()) + " read it");
+  }
+  int finished = result.skipped;
+  const int total = static_cast<int>(result.points.size());
+  const auto point_finished = [&](const Worker& w, int exit_code, double measured_s) {
+    SweepPoint& pt = result.points[w.i];
+    read_point(pt, w.dir, exit_code, measured_s);
+    (pt.status == "ok" ? result.ok : result.failed)++;
+    ++finished;
+    char head[64];
+    std::snprintf(head, sizeof head, "[%d/%d] ", finished, total);
+    say(o.log, head + outcome_line(params, pt, plan.reduced));
+    write_file_atomic(csv.string(), sweep_csv(params, result.points));
+  };
+  run_workers(first, jobs, point_finished);
+  run_workers(rest, jobs, point_finished);
+}
+
+}  // namespace
+
+SweepResult run_sweep(const SweepOptions& o) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  check_sweep_options(o);
+  const Scene base = Scene::load(o.scene_path, o.sets);
+  const std::vector<ParamSpec> params = swept_params(o, base);
+  const std::vector<std::vector<double>> values = o.lhs > 0 ? lhs_points(params, o.lhs, o.seed) : grid_points(params);
+
+  SweepResult result;
+  std::vector<std::vector<std::string>> overrides;
+  std::vector<std::optional<OfflineKeys>> keys;
+  add_points(o, base, params, values, result, overrides, keys);
   const std::set<int> fem_points = checked_fem_points(o.fem_points, result.points.size());
   for (int index : fem_points) result.points[static_cast<std::size_t>(index) - 1].fem.emplace();  // pending: sweep.csv's columns
   const ModelPlan plan = plan_model(o, base, params, overrides, keys);
@@ -958,54 +1031,12 @@ SweepResult run_sweep(const SweepOptions& o) {
   prepare_output_dir((out / "points").string(), "--out");
   const DirLock lock(out);
   const WorkerSetup setup{o, out, o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string(), jobs};
-
-  // Resume: points already done by an earlier invocation with the same resolved scene.
-  std::vector<std::size_t> queue;
-  for (std::size_t i = 0; i < result.points.size(); ++i) {
-    SweepPoint& pt = result.points[i];
-    const fs::path dir = out / "points" / point_name(pt.index);
-    if (done_before(dir, scene_text[i])) {
-      read_point(pt, dir, -1, 0.0);
-      pt.skipped = true;
-      ++result.ok;
-      ++result.skipped;
-      say(o.log, "point " + point_name(pt.index) + " skipped (already done): " + describe(params, pt));
-    } else {
-      queue.push_back(i);
-    }
-  }
+  const std::vector<std::size_t> queue = points_to_run(o, out, params, scene_text, result);
   const fs::path csv = out / "sweep.csv";
   write_file_atomic(csv.string(), sweep_csv(params, result.points));
   say(o.log, std::to_string(result.points.size()) + " points, " + std::to_string(queue.size()) + " to run with " +
                  std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s)");
-
-  std::vector<Worker> workers;
-  for (std::size_t i : queue) {
-    const fs::path dir = out / "points" / point_name(result.points[i].index);
-    workers.push_back({i, dir, setup.argv(dir, overrides[i], plan.reduced)});
-  }
-  const auto [first, rest] = offline_waves(std::move(workers), plan);
-  if (!first.empty() && !rest.empty()) {
-    std::string names;
-    for (const Worker& w : first) names += (names.empty() ? "" : ", ") + point_name(result.points[w.i].index);
-    say(o.log, "point" + std::string(first.size() > 1 ? "s " : " ") + names + " first, building the reduced model's offline part" +
-                   (first.size() > 1 ? "s" : "") + "; then the other " + std::to_string(rest.size()) + " read it");
-  }
-  int finished = result.skipped;
-  const int total = static_cast<int>(result.points.size());
-  const auto point_finished = [&](const Worker& w, int exit_code, double measured_s) {
-    SweepPoint& pt = result.points[w.i];
-    read_point(pt, w.dir, exit_code, measured_s);
-    (pt.status == "ok" ? result.ok : result.failed)++;
-    ++finished;
-    char head[64];
-    std::snprintf(head, sizeof head, "[%d/%d] ", finished, total);
-    say(o.log, head + outcome_line(params, pt, plan.reduced));
-    write_file_atomic(csv.string(), sweep_csv(params, result.points));
-  };
-  run_workers(first, jobs, point_finished);
-  run_workers(rest, jobs, point_finished);
-
+  run_queue(o, setup, plan, params, queue, overrides, csv, jobs, result);
   run_fem_points(setup, base, params, fem_points, overrides, result);
 
   std::vector<std::string> plots;

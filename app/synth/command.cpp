@@ -20,6 +20,7 @@
 #include "engine/assembly.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
 
@@ -196,8 +197,9 @@ std::vector<std::string> parse_hidden(const std::string& spec) {
   return out;
 }
 
-SynthResult run_synth(const SynthOptions& o) {
-  const auto wall0 = std::chrono::steady_clock::now();
+namespace {
+
+void check_options(const SynthOptions& o) {
   check(!o.out_csv.empty(), "--out", "give the output file, e.g. --out data.csv");
   check_output_file(o.out_csv, "--out");  // before the model runs: a bad --out fails now
   check(o.pressure_rate_Hz > 0 && std::isfinite(o.pressure_rate_Hz), "--pressure-rate", "must be > 0 Hz");
@@ -211,12 +213,21 @@ SynthResult run_synth(const SynthOptions& o) {
   check(o.outlier_min_deg >= 0 && o.outlier_max_deg >= o.outlier_min_deg, "--outlier-range", "needs 0 <= min <= max deg");
   check(o.report_every_s > 0, "--report-every", "must be > 0 s");
   check(o.inlet_tolerance_kPa > 0, "--inlet-tolerance", "must be > 0 kPa");
+}
 
-  // 1. The scene with the hidden effects; --set last so it overrides a hidden effect's value.
+/// The scene with the hidden effects (their overrides in res.hidden_sets), their names and what
+/// truth.json says of each.
+struct HiddenScene {
+  Scene scene;
+  std::vector<std::string> hidden;
+  json::Object effects;
+};
+
+// 1. The scene with the hidden effects; --set last so it overrides a hidden effect's value.
+HiddenScene hidden_scene(const SynthOptions& o, SynthResult& res) {
   const Scene base = Scene::load(o.scene_path, o.sets);
   std::vector<std::string> hidden = o.hidden;
   hidden.erase(std::remove(hidden.begin(), hidden.end(), std::string("none")), hidden.end());
-  SynthResult res;
   std::vector<std::pair<const CandidateEffect*, std::vector<std::string>>> effect_sets;
   for (const std::string& name : hidden) {
     const CandidateEffect& c = candidate_effect(name);
@@ -236,37 +247,45 @@ SynthResult run_synth(const SynthOptions& o) {
     user_sets.push_back("gravity.rig_angle_deg=-1.0");
     replaced_keys.insert("gravity.rig_angle_deg");
   }
-  const Scene scene = base.with(res.hidden_sets).with(user_sets);
-  json::Object effects;
-  for (const auto& [c, sets] : effect_sets) effects.add(c->name, effect_truth_json(*c, sets, base, scene, user_keys, replaced_keys, user_sets));
-  if (scene.string("load.protocol") != "staircase")
-    scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
-  if (scene.string("solver.mode") != "quasi_static")
-    scene.fail("solver.mode", "synth runs the quasi-static model; use \"quasi_static\"");
+  HiddenScene h{base.with(res.hidden_sets).with(user_sets), hidden, {}};
+  for (const auto& [c, sets] : effect_sets)
+    h.effects.add(c->name, effect_truth_json(*c, sets, base, h.scene, user_keys, replaced_keys, user_sets));
+  if (load_settings(h.scene).protocol != LoadSettings::Protocol::Staircase)
+    h.scene.fail("load.protocol", "synth commands the staircase protocol through its controller model; use \"staircase\"");
+  if (solver_settings(h.scene).mode != SolverSettings::Mode::QuasiStatic)
+    h.scene.fail("solver.mode", "synth runs the quasi-static model; use \"quasi_static\"");
+  return h;
+}
 
-  const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
-  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-  std::unique_ptr<BuiltModel> bm = build_model(scene);  // validates everything, staircase metadata
+/// The controller's inlet: per trial the commanded steps (start times t_cmd, jumps dL in kPa) and
+/// the piecewise-linear fit of the controller's response to them.
+struct ControllerInlet {
+  LoadHistory inlet;
+  std::vector<std::vector<double>> t_cmd, dL;
 
-  // 2-3. True inlet per trial, its piecewise-linear fit, reports. The commanded steps are those of the
-  // scene's staircase, built where every command builds it (inlet_load, before any chamber lag); the
-  // lag is applied below to the controller's inlet instead.
-  const LoadHistory commanded = inlet_load(scene);
-  LoadHistory inlet = commanded;
-  std::vector<std::vector<double>> t_cmd(commanded.trials.size()), dL(commanded.trials.size());
+  double pressure_kPa(std::size_t k, const SynthOptions& o, double t) const {
+    return controller_pressure_kPa(t_cmd[k], dL[k], o.controller_hz, o.controller_damping, t);
+  }
+};
+
+// 2. True inlet per trial and its piecewise-linear fit. The commanded steps are those of the
+// scene's staircase, built where every command builds it (inlet_load, before any chamber lag).
+ControllerInlet controller_inlet(const LoadHistory& commanded, const SynthOptions& o) {
+  ControllerInlet ci{commanded, std::vector<std::vector<double>>(commanded.trials.size()),
+                     std::vector<std::vector<double>>(commanded.trials.size())};
   for (std::size_t k = 0; k < commanded.trials.size(); ++k) {
     const TrialLoad& c = commanded.trials[k];
     const CommandedSteps steps = commanded_steps(c);
-    t_cmd[k] = steps.t_s;
-    dL[k] = steps.jump_kPa;
+    ci.t_cmd[k] = steps.t_s;
+    ci.dL[k] = steps.jump_kPa;
     const double T = c.duration();
     const long n = static_cast<long>(std::floor(T * o.pressure_rate_Hz + 1e-9));
     std::vector<double> ts, ps;
     for (long i = 0; i <= n; ++i) ts.push_back(static_cast<double>(i) / o.pressure_rate_Hz);
     if (ts.back() < T) ts.push_back(T);
-    for (double t : ts) ps.push_back(controller_pressure_kPa(t_cmd[k], dL[k], o.controller_hz, o.controller_damping, t));
+    for (double t : ts) ps.push_back(controller_pressure_kPa(ci.t_cmd[k], ci.dL[k], o.controller_hz, o.controller_damping, t));
     const std::vector<char> keep = rdp_keep(ts, ps, o.inlet_tolerance_kPa);
-    TrialLoad& tl = inlet.trials[k];
+    TrialLoad& tl = ci.inlet.trials[k];
     tl.time_s.clear();
     tl.pressure_Pa.clear();
     for (std::size_t i = 0; i < ts.size(); ++i)
@@ -275,6 +294,13 @@ SynthResult run_synth(const SynthOptions& o) {
         tl.pressure_Pa.push_back(ps[i] * 1e3);
       }
   }
+  return ci;
+}
+
+// 3. The chamber's pressure (the inlet through the scene's lag, first or second order) with a
+// report at every breakpoint (t = 0 included) and in holds every o.report_every_s.
+LoadHistory chamber_history(const Scene& scene, const LoadHistory& commanded, const LoadHistory& inlet,
+                            const SynthOptions& o) {
   const PressureLag lag = scene_pressure_lag(scene);  // first or second order (load.pressure_lag2_s)
   LoadHistory chamber = lag.on() ? apply_pressure_lag(inlet, lag, o.inlet_tolerance_kPa * 1e3) : inlet;
   for (TrialLoad& tl : chamber.trials) {
@@ -286,55 +312,65 @@ SynthResult run_synth(const SynthOptions& o) {
   }
   chamber.description = "synth: " + commanded.description + " through a second-order controller" +
                         (lag.on() ? " and a chamber lag" : "");
+  return chamber;
+}
 
-  std::vector<std::vector<double>> rec_t(chamber.trials.size()), rec_angle(chamber.trials.size());
-  {
-    const Assembler asmb(bm->model);
-    QuasiStaticRun run(asmb, bm->solver.quasi_static);
-    run.run(chamber, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
-      rec_t[r.trial - 1].push_back(r.time_s);
-      rec_angle[r.trial - 1].push_back(r.angle_deg);
-    });
-    res.states = run.stats().states;
+/// The model's angle at its reports, per trial.
+struct ModelAngles {
+  std::vector<std::vector<double>> t_s, angle_deg;
+};
+
+ModelAngles solve_angles(const BuiltModel& bm, const LoadHistory& chamber, SynthResult& res) {
+  ModelAngles m{std::vector<std::vector<double>>(chamber.trials.size()), std::vector<std::vector<double>>(chamber.trials.size())};
+  const Assembler asmb(bm.model);
+  QuasiStaticRun run(asmb, bm.solver.quasi_static);
+  run.run(chamber, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
+    m.t_s[r.trial - 1].push_back(r.time_s);
+    m.angle_deg[r.trial - 1].push_back(r.angle_deg);
+  });
+  res.states = run.stats().states;
+  return m;
+}
+
+// 4. Sampling and noise of trial k (0-based): its data and truth recordings into `res`.
+void sample_trial(std::size_t k, double T, const ControllerInlet& ci, const ModelAngles& m, const SynthOptions& o,
+                  SynthResult& res) {
+  const int trial = static_cast<int>(k) + 1;
+  TrialRecording data, truth;
+  data.trial = truth.trial = trial;
+  Noise pn(o.seed, trial, 0), an(o.seed, trial, 1), on(o.seed, trial, 2);
+  const long np = static_cast<long>(std::floor(T * o.pressure_rate_Hz + 1e-9));
+  for (long i = 0; i <= np; ++i) {
+    const double t = static_cast<double>(i) / o.pressure_rate_Hz;
+    const double p = ci.pressure_kPa(k, o, t);
+    data.pressure_kPa.t_s.push_back(t);
+    data.pressure_kPa.value.push_back(p + o.pressure_noise_kPa * pn.normal());
   }
-
-  // 4. Sampling and noise.
-  for (std::size_t k = 0; k < chamber.trials.size(); ++k) {
-    const int trial = static_cast<int>(k) + 1;
-    const double T = chamber.trials[k].duration();
-    TrialRecording data, truth;
-    data.trial = truth.trial = trial;
-    Noise pn(o.seed, trial, 0), an(o.seed, trial, 1), on(o.seed, trial, 2);
-    const long np = static_cast<long>(std::floor(T * o.pressure_rate_Hz + 1e-9));
-    for (long i = 0; i <= np; ++i) {
-      const double t = static_cast<double>(i) / o.pressure_rate_Hz;
-      const double p = controller_pressure_kPa(t_cmd[k], dL[k], o.controller_hz, o.controller_damping, t);
-      data.pressure_kPa.t_s.push_back(t);
-      data.pressure_kPa.value.push_back(p + o.pressure_noise_kPa * pn.normal());
+  const long na = static_cast<long>(std::floor(T * o.angle_rate_Hz + 1e-9));
+  for (long j = 0; j <= na; ++j) {
+    const double t = static_cast<double>(j) / o.angle_rate_Hz;
+    const double a = interpolate(m.t_s[k], m.angle_deg[k], t);
+    truth.pressure_kPa.t_s.push_back(t);
+    truth.pressure_kPa.value.push_back(ci.pressure_kPa(k, o, t));
+    truth.angle_deg.t_s.push_back(t);
+    truth.angle_deg.value.push_back(a);
+    double noisy = a + o.angle_noise_deg * an.normal();
+    // Outlier draws come from their own stream, so --outliers does not change the other noise.
+    const double u = on.uniform(), mag = on.uniform(), sign = on.uniform();
+    if (u < o.outlier_fraction) {
+      noisy += (sign < 0.5 ? -1.0 : 1.0) * (o.outlier_min_deg + mag * (o.outlier_max_deg - o.outlier_min_deg));
+      ++res.outliers;
     }
-    const long na = static_cast<long>(std::floor(T * o.angle_rate_Hz + 1e-9));
-    for (long j = 0; j <= na; ++j) {
-      const double t = static_cast<double>(j) / o.angle_rate_Hz;
-      const double a = interpolate(rec_t[k], rec_angle[k], t);
-      truth.pressure_kPa.t_s.push_back(t);
-      truth.pressure_kPa.value.push_back(controller_pressure_kPa(t_cmd[k], dL[k], o.controller_hz, o.controller_damping, t));
-      truth.angle_deg.t_s.push_back(t);
-      truth.angle_deg.value.push_back(a);
-      double noisy = a + o.angle_noise_deg * an.normal();
-      // Outlier draws come from their own stream, so --outliers does not change the other noise.
-      const double u = on.uniform(), mag = on.uniform(), sign = on.uniform();
-      if (u < o.outlier_fraction) {
-        noisy += (sign < 0.5 ? -1.0 : 1.0) * (o.outlier_min_deg + mag * (o.outlier_max_deg - o.outlier_min_deg));
-        ++res.outliers;
-      }
-      data.angle_deg.t_s.push_back(t);
-      data.angle_deg.value.push_back(noisy);
-    }
-    res.data.trials.push_back(std::move(data));
-    res.truth.trials.push_back(std::move(truth));
+    data.angle_deg.t_s.push_back(t);
+    data.angle_deg.value.push_back(noisy);
   }
+  res.data.trials.push_back(std::move(data));
+  res.truth.trials.push_back(std::move(truth));
+}
 
-  // Outputs.
+/// OUT.csv, OUT.truth.csv and OUT.truth.json.
+void write_outputs(const SynthOptions& o, const HiddenScene& h, SynthResult& res,
+                   std::chrono::steady_clock::time_point wall0) {
   const fs::path out(o.out_csv);
   prepare_output_file(o.out_csv, "--out");  // its directory, checked before the model ran, is made now
   const fs::path stem = out.parent_path() / out.stem();
@@ -343,7 +379,7 @@ SynthResult run_synth(const SynthOptions& o) {
   write_measurements_csv(out.string(), res.data);
   write_measurements_csv(stem.string() + ".truth.csv", res.truth);
   std::string names = "[";
-  for (std::size_t i = 0; i < hidden.size(); ++i) names += (i ? ", " : "") + json::quote(hidden[i]);
+  for (std::size_t i = 0; i < h.hidden.size(); ++i) names += (i ? ", " : "") + json::quote(h.hidden[i]);
   names += "]";
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   json::Object j;
@@ -351,14 +387,35 @@ SynthResult run_synth(const SynthOptions& o) {
       .add_str("command_line", o.command_line)
       .add("seed", static_cast<double>(o.seed))
       .add("hidden", names)
-      .add("effects", effects.str(2))
+      .add("effects", h.effects.str(2))
       .add("sampling_and_noise", noise_json(o))
       .add("outlier_frames", static_cast<double>(res.outliers))
       .add("solved_states", static_cast<double>(res.states))
       .add_str("data_csv", out.filename().string())
       .add_str("truth_csv", out.stem().string() + ".truth.csv")
-      .add("scene", scene.to_json());
+      .add("scene", h.scene.to_json());
   write_file_atomic(stem.string() + ".truth.json", j.str() + "\n");
+}
+
+}  // namespace
+
+SynthResult run_synth(const SynthOptions& o) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  check_options(o);
+  SynthResult res;
+  const HiddenScene h = hidden_scene(o, res);
+
+  const int threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  std::unique_ptr<BuiltModel> bm = build_model(h.scene);  // validates everything, staircase metadata
+
+  // The lag is applied to the controller's inlet (chamber_history), not to the commanded steps.
+  const LoadHistory commanded = inlet_load(h.scene);
+  const ControllerInlet ci = controller_inlet(commanded, o);
+  const LoadHistory chamber = chamber_history(h.scene, commanded, ci.inlet, o);
+  const ModelAngles m = solve_angles(*bm, chamber, res);
+  for (std::size_t k = 0; k < chamber.trials.size(); ++k) sample_trial(k, chamber.trials[k].duration(), ci, m, o, res);
+  write_outputs(o, h, res, wall0);
   return res;
 }
 

@@ -259,135 +259,149 @@ Eigen::Vector3d solid_point(SolidType t, const int* nodes, const std::vector<Eig
   return x;
 }
 
-void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where,
-                  const SplitSets& also) {
-  Mesh& mesh = deck.mesh;
-  const int ns = solids.size();
-  const bool quadratic = mesh.type == ElementType::Tet10;
-  const int npe = mesh.npe();
-  const int n_original = mesh.num_nodes();
+namespace {
 
+/// The largest id of each id scope (one scope when the mesh has none): new ids continue them.
+struct IdScopes {
+  bool element_scoped = false, node_scoped = false;
+  std::vector<long> last_element_id, last_node_id;  // per scope
+
+  static long& last_id(std::vector<long>& last, std::size_t scope) {
+    if (scope >= last.size()) last.resize(scope + 1, 0);
+    return last[scope];
+  }
+};
+
+IdScopes id_scopes(const Mesh& mesh, int ns, int n_original) {
+  IdScopes sc;
+  sc.element_scoped = mesh.element_scope.size() == static_cast<std::size_t>(ns);
+  sc.node_scoped = mesh.node_scope.size() == static_cast<std::size_t>(n_original);
+  for (std::size_t e = 0; e < mesh.element_ids.size(); ++e) {
+    long& last = IdScopes::last_id(sc.last_element_id, sc.element_scoped ? mesh.element_scope[e] : 0);
+    last = std::max(last, mesh.element_ids[e]);
+  }
+  for (std::size_t n = 0; n < mesh.node_ids.size(); ++n) {
+    long& last = IdScopes::last_id(sc.last_node_id, sc.node_scoped ? mesh.node_scope[n] : 0);
+    last = std::max(last, mesh.node_ids[n]);
+  }
+  return sc;
+}
+
+/// The solids as tetrahedra, solid after solid, as split_element builds them.
+struct Tetrahedra {
   std::vector<int> conn;
-  std::vector<int> first_tet(static_cast<std::size_t>(ns) + 1, 0);
+  std::vector<int> first_tet;  ///< per solid (and one past the last): its first tetrahedron
   std::vector<long> ids;
   std::vector<std::uint16_t> region;
   std::vector<ElementSource> sources;
   std::vector<std::uint16_t> element_scope;
-
-  // New ids continue the largest of their id scope (one scope when the mesh has none).
-  const bool element_scoped = mesh.element_scope.size() == static_cast<std::size_t>(ns);
-  const bool node_scoped = mesh.node_scope.size() == static_cast<std::size_t>(n_original);
-  std::vector<long> last_element_id, last_node_id;  // per scope
-  auto last_id = [](std::vector<long>& last, std::size_t scope) -> long& {
-    if (scope >= last.size()) last.resize(scope + 1, 0);
-    return last[scope];
-  };
-  for (std::size_t e = 0; e < mesh.element_ids.size(); ++e) {
-    long& last = last_id(last_element_id, element_scoped ? mesh.element_scope[e] : 0);
-    last = std::max(last, mesh.element_ids[e]);
-  }
-  for (std::size_t n = 0; n < mesh.node_ids.size(); ++n) {
-    long& last = last_id(last_node_id, node_scoped ? mesh.node_scope[n] : 0);
-    last = std::max(last, mesh.node_ids[n]);
-  }
-
   // New mid-nodes on cut diagonals, keyed by the diagonal's corner nodes, and the nodes of the face
   // (or element) each lies on, which decide its sets and boundary dofs.
   std::unordered_map<std::uint64_t, int> diagonal_node;
   std::vector<std::vector<int>> support;
   std::map<SolidType, std::pair<int, int>> split_count;  // type -> elements, tetrahedra
+};
 
-  for (int s = 0; s < ns; ++s) {
-    const SolidType t = solids.type[static_cast<std::size_t>(s)];
-    const TypeInfo& ti = info(t);
-    const ShapeTables& sh = *ti.shape;
-    const int* n = solids.element(s);
-    const long id = mesh.element_ids[static_cast<std::size_t>(s)];
-    const std::uint16_t scope = element_scoped ? mesh.element_scope[static_cast<std::size_t>(s)] : 0;
-    auto label = [&] { return "element " + std::to_string(id) + " (" + ti.name + ")"; };
-    for (int a = 0; a < ti.nodes; ++a)
-      for (int b = a + 1; b < ti.nodes; ++b)
-        if (n[a] == n[b])
-          throw InputError(where(s) + ": " + label() + " lists node " +
-                           std::to_string(mesh.node_ids[static_cast<std::size_t>(n[a])]) +
-                           " twice (a collapsed element); write it as the element it collapses to (C3D6 wedge, C3D5 "
-                           "pyramid or C3D4 tetrahedron) with distinct nodes");
-    first_tet[static_cast<std::size_t>(s)] = static_cast<int>(ids.size());
-    const std::uint16_t r = mesh.region[static_cast<std::size_t>(s)];
-    if (&sh == &kTet) {  // the deck's own tetrahedra stay as they are
-      conn.insert(conn.end(), n, n + npe);
-      ids.push_back(id);
-      region.push_back(r);
-      element_scope.push_back(scope);
-      sources.push_back(ElementSource{id, 0, 0, {}});
-      continue;
-    }
-    std::array<long, 8> cid{};
-    for (int c = 0; c < sh.corners; ++c) cid[static_cast<std::size_t>(c)] = mesh.node_ids[static_cast<std::size_t>(n[c])];
-    std::array<LocalTet, 6> tets{};
-    const int nt = decompose(sh, cid.data(), tets);
-    // Zero volume up to round-off relative to the element size: an inverted or flat element.
-    double size = 0.0;
-    for (int c = 1; c < sh.corners; ++c) size = std::max(size, (mesh.X[n[c]] - mesh.X[n[0]]).norm());
-    for (int k = 0; k < nt; ++k) {
-      const LocalTet& lt = tets[static_cast<std::size_t>(k)];
-      const double V = tet_volume(mesh.X[n[lt[0]]], mesh.X[n[lt[1]]], mesh.X[n[lt[2]]], mesh.X[n[lt[3]]]);
-      if (!(V > 1e-10 * size * size * size)) {
-        std::ostringstream msg;
-        msg << where(s) << ": " << label() << " is inverted or degenerate: its tetrahedron on nodes "
-            << mesh.node_ids[n[lt[0]]] << ", " << mesh.node_ids[n[lt[1]]] << ", " << mesh.node_ids[n[lt[2]]] << ", "
-            << mesh.node_ids[n[lt[3]]] << " has " << (V < 0.0 ? "negative" : "zero") << " volume; check the node order ("
-            << ti.name << ": " << node_order_hint(t) << ") or remesh this element (too distorted to split)";
-        throw InputError(msg.str());
+/// The mid-node of the diagonal (a, b) (local corners of solid `n`, not an edge of it): made at its
+/// first use, with the nodes of the face (or element) it lies on.
+int diagonal_mid_node(Mesh& mesh, SolidType t, const int* n, int a, int b, IdScopes& sc, Tetrahedra& out) {
+  const TypeInfo& ti = info(t);
+  const ShapeTables& sh = *ti.shape;
+  const auto [lo, hi] = std::minmax(n[a], n[b]);
+  const std::uint64_t key = (static_cast<std::uint64_t>(lo) << 32) | static_cast<std::uint32_t>(hi);
+  auto [it, fresh] = out.diagonal_node.try_emplace(key, mesh.num_nodes());
+  if (fresh) {
+    mesh.X.push_back(solid_point(t, n, mesh.X, 0.5 * (ref(sh, a) + ref(sh, b))));
+    const std::uint16_t node_scope = sc.node_scoped ? mesh.node_scope[static_cast<std::size_t>(n[0])] : 0;
+    mesh.node_ids.push_back(++IdScopes::last_id(sc.last_node_id, node_scope));
+    if (sc.node_scoped) mesh.node_scope.push_back(node_scope);
+    std::vector<int> on;
+    int f = 0;
+    while (f < sh.faces && !(face_has(sh, f, a) && face_has(sh, f, b))) ++f;
+    if (f == sh.faces) {
+      on.assign(n, n + ti.nodes);  // a body diagonal: inside the element
+    } else {
+      const auto& fc = sh.face[static_cast<std::size_t>(f)];
+      for (int j = 0; j < 4; ++j) {
+        on.push_back(n[fc[static_cast<std::size_t>(j)]]);
+        on.push_back(n[sh.corners + edge_index(sh, fc[static_cast<std::size_t>(j)], fc[(j + 1) % 4])]);
       }
-      for (int c : lt) conn.push_back(n[c]);
-      if (quadratic)
-        for (int k_tet = 0; k_tet < kTet.edges; ++k_tet) {
-          const auto& e = kTet.edge[static_cast<std::size_t>(k_tet)];
-          const int a = lt[static_cast<std::size_t>(e[0])], b = lt[static_cast<std::size_t>(e[1])];
-          const int k_edge = edge_index(sh, a, b);
-          if (k_edge >= 0) {
-            conn.push_back(n[sh.corners + k_edge]);
-            continue;
-          }
-          const auto [lo, hi] = std::minmax(n[a], n[b]);
-          const std::uint64_t key = (static_cast<std::uint64_t>(lo) << 32) | static_cast<std::uint32_t>(hi);
-          auto [it, fresh] = diagonal_node.try_emplace(key, mesh.num_nodes());
-          if (fresh) {
-            mesh.X.push_back(solid_point(t, n, mesh.X, 0.5 * (ref(sh, a) + ref(sh, b))));
-            const std::uint16_t node_scope = node_scoped ? mesh.node_scope[static_cast<std::size_t>(n[0])] : 0;
-            mesh.node_ids.push_back(++last_id(last_node_id, node_scope));
-            if (node_scoped) mesh.node_scope.push_back(node_scope);
-            std::vector<int> on;
-            int f = 0;
-            while (f < sh.faces && !(face_has(sh, f, a) && face_has(sh, f, b))) ++f;
-            if (f == sh.faces) {
-              on.assign(n, n + ti.nodes);  // a body diagonal: inside the element
-            } else {
-              const auto& fc = sh.face[static_cast<std::size_t>(f)];
-              for (int j = 0; j < 4; ++j) {
-                on.push_back(n[fc[static_cast<std::size_t>(j)]]);
-                on.push_back(n[sh.corners + edge_index(sh, fc[static_cast<std::size_t>(j)], fc[(j + 1) % 4])]);
-              }
-            }
-            support.push_back(std::move(on));
-          }
-          conn.push_back(it->second);
-        }
-      ids.push_back(k == 0 ? id : ++last_id(last_element_id, scope));
-      region.push_back(r);
-      element_scope.push_back(scope);
-      ElementSource src{id, static_cast<std::uint8_t>(k + 1), static_cast<std::uint8_t>(nt), {}};
-      std::strncpy(src.type.data(), ti.name, src.type.size() - 1);
-      sources.push_back(src);
     }
-    auto& count = split_count[t];
-    ++count.first;
-    count.second += nt;
+    out.support.push_back(std::move(on));
   }
-  first_tet[static_cast<std::size_t>(ns)] = static_cast<int>(ids.size());
+  return it->second;
+}
 
-  // Node sets and boundary dofs reach the new nodes whose face lies wholly in them.
+/// Solid `s` as tetrahedra appended to `out` (a deck's own tetrahedron as it is); InputError for a
+/// collapsed, inverted or degenerate element.
+void split_element(const SolidElements& solids, int s, Mesh& mesh, const std::function<std::string(int)>& where,
+                   IdScopes& sc, Tetrahedra& out) {
+  const bool quadratic = mesh.type == ElementType::Tet10;
+  const SolidType t = solids.type[static_cast<std::size_t>(s)];
+  const TypeInfo& ti = info(t);
+  const ShapeTables& sh = *ti.shape;
+  const int* n = solids.element(s);
+  const long id = mesh.element_ids[static_cast<std::size_t>(s)];
+  const std::uint16_t scope = sc.element_scoped ? mesh.element_scope[static_cast<std::size_t>(s)] : 0;
+  auto label = [&] { return "element " + std::to_string(id) + " (" + ti.name + ")"; };
+  for (int a = 0; a < ti.nodes; ++a)
+    for (int b = a + 1; b < ti.nodes; ++b)
+      if (n[a] == n[b])
+        throw InputError(where(s) + ": " + label() + " lists node " +
+                         std::to_string(mesh.node_ids[static_cast<std::size_t>(n[a])]) +
+                         " twice (a collapsed element); write it as the element it collapses to (C3D6 wedge, C3D5 "
+                         "pyramid or C3D4 tetrahedron) with distinct nodes");
+  out.first_tet[static_cast<std::size_t>(s)] = static_cast<int>(out.ids.size());
+  const std::uint16_t r = mesh.region[static_cast<std::size_t>(s)];
+  if (&sh == &kTet) {  // the deck's own tetrahedra stay as they are
+    out.conn.insert(out.conn.end(), n, n + mesh.npe());
+    out.ids.push_back(id);
+    out.region.push_back(r);
+    out.element_scope.push_back(scope);
+    out.sources.push_back(ElementSource{id, 0, 0, {}});
+    return;
+  }
+  std::array<long, 8> cid{};
+  for (int c = 0; c < sh.corners; ++c) cid[static_cast<std::size_t>(c)] = mesh.node_ids[static_cast<std::size_t>(n[c])];
+  std::array<LocalTet, 6> tets{};
+  const int nt = decompose(sh, cid.data(), tets);
+  // Zero volume up to round-off relative to the element size: an inverted or flat element.
+  double size = 0.0;
+  for (int c = 1; c < sh.corners; ++c) size = std::max(size, (mesh.X[n[c]] - mesh.X[n[0]]).norm());
+  for (int k = 0; k < nt; ++k) {
+    const LocalTet& lt = tets[static_cast<std::size_t>(k)];
+    const double V = tet_volume(mesh.X[n[lt[0]]], mesh.X[n[lt[1]]], mesh.X[n[lt[2]]], mesh.X[n[lt[3]]]);
+    if (!(V > 1e-10 * size * size * size)) {
+      std::ostringstream msg;
+      msg << where(s) << ": " << label() << " is inverted or degenerate: its tetrahedron on nodes "
+          << mesh.node_ids[n[lt[0]]] << ", " << mesh.node_ids[n[lt[1]]] << ", " << mesh.node_ids[n[lt[2]]] << ", "
+          << mesh.node_ids[n[lt[3]]] << " has " << (V < 0.0 ? "negative" : "zero") << " volume; check the node order ("
+          << ti.name << ": " << node_order_hint(t) << ") or remesh this element (too distorted to split)";
+      throw InputError(msg.str());
+    }
+    for (int c : lt) out.conn.push_back(n[c]);
+    if (quadratic)
+      for (int k_tet = 0; k_tet < kTet.edges; ++k_tet) {
+        const auto& e = kTet.edge[static_cast<std::size_t>(k_tet)];
+        const int a = lt[static_cast<std::size_t>(e[0])], b = lt[static_cast<std::size_t>(e[1])];
+        const int k_edge = edge_index(sh, a, b);
+        out.conn.push_back(k_edge >= 0 ? n[sh.corners + k_edge] : diagonal_mid_node(mesh, t, n, a, b, sc, out));
+      }
+    out.ids.push_back(k == 0 ? id : ++IdScopes::last_id(sc.last_element_id, scope));
+    out.region.push_back(r);
+    out.element_scope.push_back(scope);
+    ElementSource src{id, static_cast<std::uint8_t>(k + 1), static_cast<std::uint8_t>(nt), {}};
+    std::strncpy(src.type.data(), ti.name, src.type.size() - 1);
+    out.sources.push_back(src);
+  }
+  auto& count = out.split_count[t];
+  ++count.first;
+  count.second += nt;
+}
+
+// Node sets and boundary dofs reach the new nodes whose face lies wholly in them.
+void extend_node_sets(Mesh& mesh, InpDeck& deck, const SplitSets& also, int n_original,
+                      const std::vector<std::vector<int>>& support) {
   const int n_new = mesh.num_nodes() - n_original;
   auto remap_node_set = [&](std::vector<int>& nodes) {
     if (n_new == 0) return;
@@ -408,14 +422,19 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
         if (std::all_of(support[k].begin(), support[k].end(), [&](int i) { return fixed[static_cast<std::size_t>(i)][d] != 0; }))
           deck.fixed_dofs.emplace_back(n_original + k, d);
   }
+}
 
-  // Element sets, surfaces and pressure faces move to the tetrahedra.
+// Element sets, surfaces and pressure faces move to the tetrahedra.
+void move_sets_to_tetrahedra(const SolidElements& solids, const Tetrahedra& tets, Mesh& mesh, InpDeck& deck,
+                             const SplitSets& also) {
+  const std::vector<int>& first_tet = tets.first_tet;
+  const int npe = mesh.npe();
   auto remap_element_set = [&](std::vector<int>& members) {
-    std::vector<int> tets;
+    std::vector<int> out;
     for (int s : members)
       for (int e = first_tet[static_cast<std::size_t>(s)]; e < first_tet[static_cast<std::size_t>(s) + 1]; ++e)
-        tets.push_back(e);
-    members = std::move(tets);
+        out.push_back(e);
+    members = std::move(out);
   };
   for (auto& [name, members] : mesh.element_sets) remap_element_set(members);
   for (auto* sets : also.element_sets)
@@ -432,7 +451,7 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
     for (int e = e0; e < first_tet[static_cast<std::size_t>(s) + 1]; ++e)
       for (int lf = 0; lf < 4; ++lf) {
         const int* ln = kTet.face[static_cast<std::size_t>(lf)].data();
-        const int* tn = conn.data() + static_cast<std::size_t>(e) * npe;
+        const int* tn = tets.conn.data() + static_cast<std::size_t>(e) * npe;
         if (std::all_of(ln, ln + 3, [&](int j) {
               return std::any_of(fc.data(), fc_end, [&](int c) { return n[c] == tn[j]; });
             }))
@@ -451,17 +470,14 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   for (const InpPressure& p : deck.pressure_faces)
     tile(p.face, [&](const FaceRef& g) { pressure.push_back(InpPressure{g, p.magnitude}); });
   deck.pressure_faces = std::move(pressure);
+}
 
-  mesh.conn = std::move(conn);
-  mesh.element_ids = std::move(ids);
-  mesh.region = std::move(region);
-  if (element_scoped) mesh.element_scope = std::move(element_scope);
-  if (split_count.empty()) return;
-  mesh.element_sources = std::move(sources);
-
-  // A deck's own tetrahedra glued to a quadrilateral face along its other diagonal leave the mesh
-  // non-conforming there (a pyramid belongs between hexahedra and tetrahedra); split elements cut
-  // every shared face alike.
+// A deck's own tetrahedra glued to a quadrilateral face along its other diagonal leave the mesh
+// non-conforming there (a pyramid belongs between hexahedra and tetrahedra); split elements cut
+// every shared face alike. A warning names the first such face.
+void warn_nonconforming(const SolidElements& solids, const std::vector<int>& first_tet, const Mesh& mesh, InpDeck& deck,
+                        const std::function<std::string(int)>& where) {
+  const int ns = solids.size();
   auto sorted = [](std::array<int, 3> k) {
     std::sort(k.begin(), k.end());
     return k;
@@ -479,13 +495,12 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   auto deck_tet_face = [&](const std::array<int, 3>& k) {
     return std::binary_search(deck_tet_faces.begin(), deck_tet_faces.end(), k);
   };
-  int mismatched = 0, first_split = -1, first_mismatch = -1;
+  int mismatched = 0, first_mismatch = -1;
   std::string mismatch;
   for (int s = 0; s < ns; ++s) {
     const SolidType t = solids.type[static_cast<std::size_t>(s)];
     const ShapeTables& sh = *info(t).shape;
     if (&sh == &kTet) continue;
-    if (first_split < 0) first_split = s;
     const int* n = solids.element(s);
     for (int f = 0; f < sh.faces; ++f) {
       if (face_size(sh, f) != 4) continue;
@@ -509,9 +524,13 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
                             "(first: " + mismatch +
                             "), so the mesh does not conform there; put C3D5 pyramids between hexahedra or wedges and "
                             "tetrahedra, or mesh that region with one element shape");
+}
 
+/// The note of what was split into what (at the first split element, `first_split`).
+std::string split_note(const std::map<SolidType, std::pair<int, int>>& split_count, bool quadratic, int n_new,
+                       const std::string& first_split) {
   std::ostringstream note;
-  note << where(first_split) << ": split into tetrahedra for pneufem's engine:";
+  note << first_split << ": split into tetrahedra for pneufem's engine:";
   bool comma = false;
   for (const auto& [t, count] : split_count) {
     note << (comma ? "," : "") << " " << count.first << " " << solid_name(t) << " into " << count.second;
@@ -524,7 +543,37 @@ void split_solids(const SolidElements& solids, InpDeck& deck, const std::functio
   else
     note << "; linear tetrahedra lock for nearly incompressible silicone: mesh.promote_to_tet10 = true (recommended) "
             "makes them Tet10";
-  deck.warnings.push_back(note.str());
+  return note.str();
+}
+
+}  // namespace
+
+void split_solids(const SolidElements& solids, InpDeck& deck, const std::function<std::string(int)>& where,
+                  const SplitSets& also) {
+  Mesh& mesh = deck.mesh;
+  const int ns = solids.size();
+  const int n_original = mesh.num_nodes();
+  IdScopes sc = id_scopes(mesh, ns, n_original);
+  Tetrahedra tets;
+  tets.first_tet.assign(static_cast<std::size_t>(ns) + 1, 0);
+  for (int s = 0; s < ns; ++s) split_element(solids, s, mesh, where, sc, tets);
+  tets.first_tet[static_cast<std::size_t>(ns)] = static_cast<int>(tets.ids.size());
+
+  const int n_new = mesh.num_nodes() - n_original;
+  extend_node_sets(mesh, deck, also, n_original, tets.support);
+  move_sets_to_tetrahedra(solids, tets, mesh, deck, also);
+
+  mesh.conn = std::move(tets.conn);
+  mesh.element_ids = std::move(tets.ids);
+  mesh.region = std::move(tets.region);
+  if (sc.element_scoped) mesh.element_scope = std::move(tets.element_scope);
+  if (tets.split_count.empty()) return;
+  mesh.element_sources = std::move(tets.sources);
+
+  warn_nonconforming(solids, tets.first_tet, mesh, deck, where);
+  int first_split = 0;
+  while (info(solids.type[static_cast<std::size_t>(first_split)]).shape == &kTet) ++first_split;
+  deck.warnings.push_back(split_note(tets.split_count, mesh.type == ElementType::Tet10, n_new, where(first_split)));
 }
 
 void promote_deck_to_tet10(InpDeck& deck) {

@@ -507,6 +507,23 @@ TEST(PvdSeries, WritesCollectionAfterEachAdd) {
   EXPECT_STREQ(collection->GetNestedElement(1)->GetAttribute("file"), "frames/run&0001.vtu");
 }
 
+// XML 1.0 cannot hold a control character, escaped or not (dropping it would name another file):
+// such a name is refused and the index stays as it was.
+TEST(PvdSeries, RefusesAFileNameXmlCannotHold) {
+  const TempDir dir;
+  const fs::path pvd = dir.path / "run.pvd";
+  PvdSeries series(pvd.string());
+  series.add(0.0, "a<b>&'c'.vtu");
+  const std::string before = read_text(pvd);
+  EXPECT_NE(before.find("file=\"a&lt;b&gt;&amp;&apos;c&apos;.vtu\""), std::string::npos) << before;
+  EXPECT_THROW(series.add(1.0, std::string("state\x01.vtu")), std::invalid_argument);
+  EXPECT_EQ(read_text(pvd), before);
+  vtkNew<vtkXMLDataParser> parser;
+  parser->SetFileName(pvd.c_str());
+  ASSERT_EQ(parser->Parse(), 1);
+  EXPECT_STREQ(parser->GetRootElement()->GetNestedElement(0)->GetNestedElement(0)->GetAttribute("file"), "a<b>&'c'.vtu");
+}
+
 TEST(PvdSeries, MissingDirectoryThrows) {
   const TempDir dir;
   const fs::path pvd = dir.path / "missing" / "run.pvd";

@@ -1,0 +1,92 @@
+// The typed settings of scenes/scene_settings.h, read from their keys.
+#include "scenes/scene_settings.h"
+
+#include "scenes/scene_keys.h"
+
+namespace pneufem {
+
+using detail::choice;
+using detail::kkPa;
+using detail::positive;
+
+MeshSettings mesh_settings(const Scene& s) {
+  MeshSettings m;
+  m.source = choice<MeshSettings::Source>(s, "mesh.source", {{"pneunet", MeshSettings::Source::PneuNet},
+                                                             {"inp", MeshSettings::Source::Inp},
+                                                             {"stl", MeshSettings::Source::Stl}});
+  m.file = s.string("mesh.file");
+  if (m.source == MeshSettings::Source::PneuNet) m.h_mm = s.number("mesh.h_mm");
+  return m;
+}
+
+LoadSettings load_settings(const Scene& s) {
+  LoadSettings l;
+  l.protocol = choice<LoadSettings::Protocol>(s, "load.protocol", {{"staircase", LoadSettings::Protocol::Staircase},
+                                                                   {"csv", LoadSettings::Protocol::Csv}});
+  l.rest_s = s.number("load.rest_s");
+  return l;
+}
+
+/// The [solver] keys, each checked.
+SolverSettings solver_settings(const Scene& s) {
+  SolverSettings sv;
+  sv.mode = choice<SolverSettings::Mode>(s, "solver.mode", {{"quasi_static", SolverSettings::Mode::QuasiStatic},
+                                                           {"explicit", SolverSettings::Mode::Explicit}});
+  sv.quasi_static.method = choice<EquilibriumMethod>(s, "solver.method", {{"newton", EquilibriumMethod::Newton},
+                                                                          {"relaxation", EquilibriumMethod::Relaxation}});
+  sv.quasi_static.newton.rel_tol = positive(s, "solver.rel_tol");
+  sv.quasi_static.relaxation.rel_tol = sv.quasi_static.newton.rel_tol;
+  sv.quasi_static.newton.max_iterations = s.integer("solver.max_iterations");
+  if (sv.quasi_static.newton.max_iterations < 1) s.fail("solver.max_iterations", "must be >= 1");
+  sv.quasi_static.newton.stiff_relaxation_steps = s.integer("solver.stiff_relaxation_steps");
+  if (sv.quasi_static.newton.stiff_relaxation_steps < 0) s.fail("solver.stiff_relaxation_steps", "must be >= 0 (0 = off)");
+  sv.quasi_static.newton.indefinite = choice<StaticOptions::Indefinite>(
+      s, "solver.indefinite_tangent",
+      {{"last_factor", StaticOptions::Indefinite::LastFactor}, {"shift", StaticOptions::Indefinite::Shift}});
+  sv.quasi_static.newton.energy_line_search = choice<bool>(s, "solver.line_search", {{"energy", true}, {"slope", false}});
+  sv.quasi_static.newton.max_increment_Pa = positive(s, "solver.max_increment_kPa") * kkPa;
+  sv.quasi_static.newton.min_increment_Pa = positive(s, "solver.min_increment_kPa") * kkPa;
+  sv.quasi_static.relaxation.max_iterations = s.integer("solver.relaxation_max_iterations");
+  sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
+  sv.quasi_static.time_tol = positive(s, "solver.time_tol");
+  sv.quasi_static.time_control =
+      choice<TimeControl>(s, "solver.time_control", {{"change", TimeControl::Change}, {"error", TimeControl::Error}});
+  sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
+  sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
+  if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
+  sv.quasi_static.max_segment_steps = s.integer("solver.max_segment_steps");
+  if (sv.quasi_static.max_segment_steps < 1) s.fail("solver.max_segment_steps", "must be >= 1");
+  sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
+  if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
+  sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");
+  if (sv.explicit_dynamics.dt_safety > 1.0) s.fail("solver.dt_safety", "must be <= 1 (fraction of the stable step)");
+  sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");
+  sv.explicit_dynamics.damping_alpha_1_s = s.number("solver.damping_1_s");
+  if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
+  sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
+  sv.time_scale = positive(s, "solver.time_scale");
+  sv.model = choice<SolverSettings::Model>(s, "solver.model", {{"full", SolverSettings::Model::Full},
+                                                             {"reduced", SolverSettings::Model::Reduced}});
+  sv.reduced.max_modes = s.integer("solver.reduced_modes");
+  if (sv.reduced.max_modes < 1) s.fail("solver.reduced_modes", "must be >= 1");
+  sv.reduced.ecsw_tolerance = positive(s, "solver.reduced_ecsw_tol");
+  sv.reduced.softened_levels = s.integer("solver.reduced_softened_levels");
+  if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
+  sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
+  if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)
+    s.fail("solver.model", "\"reduced\" needs solver.mode = \"quasi_static\"");
+  return sv;
+}
+
+OutputSettings output_settings(const Scene& s) {
+  OutputSettings o;
+  o.vtu = s.string("output.vtu");
+  if (o.vtu != "steps" && o.vtu != "all" && o.vtu != "none") s.fail("output.vtu", "must be \"steps\", \"all\" or \"none\"");
+  return o;
+}
+
+std::string mode_name(SolverSettings::Mode mode) { return mode == SolverSettings::Mode::Explicit ? "explicit" : "quasi_static"; }
+
+std::string model_name(SolverSettings::Model model) { return model == SolverSettings::Model::Reduced ? "reduced" : "full"; }
+
+}  // namespace pneufem

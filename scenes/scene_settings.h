@@ -1,0 +1,66 @@
+#pragma once
+// A scene's settings as typed structs: where the mesh comes from ([mesh]), the load protocol
+// ([load]) and the solvers ([solver], [output]). Each struct is read from its keys here, once,
+// with the checks and messages of the scene reader (a failure names the key, where it was set
+// and the values allowed); build_model (scenes/build_model.h) and the commands (app/) read the
+// fields, not the keys. What is not here yet is read by build_model from its keys.
+#include <string>
+
+#include "engine/explicit.h"
+#include "engine/quasi_static.h"
+#include "engine/rom.h"
+#include "scenes/scene.h"
+
+namespace pneufem {
+
+/// [mesh]: where the mesh comes from.
+struct MeshSettings {
+  enum class Source { PneuNet, Inp, Stl };
+  Source source = Source::PneuNet;  ///< mesh.source: "pneunet" (built-in mesher), "inp" (a deck) or "stl"
+  std::string file;                 ///< mesh.file: the deck or surface ("" for the built-in mesher)
+  double h_mm = 0.0;                ///< mesh.h_mm: the built-in mesher's element size (mm); 0 for another source
+};
+
+/// The [mesh] settings above. Fails naming mesh.source for an unknown source.
+MeshSettings mesh_settings(const Scene& scene);
+
+/// [load]: the protocol of the pressure history (its levels and times are read into the
+/// LoadHistory by inlet_load, scenes/build_model.h).
+struct LoadSettings {
+  enum class Protocol { Staircase, Csv };
+  Protocol protocol = Protocol::Staircase;  ///< load.protocol: "staircase" or "csv" (load.csv)
+  double rest_s = 0.0;                      ///< load.rest_s: rest between trials (s)
+};
+
+/// The [load] settings above. Fails naming load.protocol for an unknown protocol.
+LoadSettings load_settings(const Scene& scene);
+
+/// [solver]: the solvers of a run, each key checked.
+struct SolverSettings {
+  enum class Mode { QuasiStatic, Explicit };
+  Mode mode = Mode::QuasiStatic;
+  enum class Model { Full, Reduced };  ///< quasi-static: the full FEM or the reduced model (engine/rom.h)
+  Model model = Model::Full;
+  RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels
+  double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
+  QuasiStaticOptions quasi_static;
+  ExplicitOptions explicit_dynamics;
+  double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time
+};
+
+/// The [solver] settings above.
+SolverSettings solver_settings(const Scene& scene);
+
+/// The scene's names of the solver's mode and model ("quasi_static", "explicit"; "full", "reduced").
+std::string mode_name(SolverSettings::Mode mode);
+std::string model_name(SolverSettings::Model model);
+
+/// [output].
+struct OutputSettings {
+  std::string vtu = "steps";  ///< output.vtu: "steps", "all" or "none"
+};
+
+/// The [output] settings above.
+OutputSettings output_settings(const Scene& scene);
+
+}  // namespace pneufem

@@ -1,0 +1,72 @@
+// scenes/scene_settings.h: the typed settings of a scene, read once from their keys, with the
+// scene reader's messages (the key, where it was set, the values allowed).
+#include "scenes/scene_settings.h"
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "scenes/build_model.h"
+#include "scenes/scene.h"
+#include "tests/support/input_error.h"
+
+namespace pneufem {
+namespace {
+
+using pneufem::test::error_of;
+
+TEST(SceneSettings, MeshSourceOfTheDefaultSceneAndOfADeck) {
+  const Scene base = Scene::load("");
+  const MeshSettings m = mesh_settings(base);
+  EXPECT_EQ(m.source, MeshSettings::Source::PneuNet);
+  EXPECT_EQ(m.h_mm, base.number("mesh.h_mm"));
+  EXPECT_EQ(mesh_settings(base.with({"mesh.h_mm=3.5"})).h_mm, 3.5);
+
+  const MeshSettings deck = mesh_settings(base.with({"mesh.source=\"inp\"", "mesh.file=\"actuator.inp\""}));
+  EXPECT_EQ(deck.source, MeshSettings::Source::Inp);
+  EXPECT_EQ(deck.file, "actuator.inp");
+  EXPECT_EQ(deck.h_mm, 0.0);  // a deck is its own mesh
+  EXPECT_EQ(mesh_settings(base.with({"mesh.source=\"stl\""})).source, MeshSettings::Source::Stl);
+}
+
+// The message build_model gave before the settings were typed: the key, where it was set, the values.
+TEST(SceneSettings, UnknownMeshSourceNamesTheKeyAndTheSources) {
+  const Scene s = Scene::load("", {"mesh.source=\"gmsh\""});
+  const std::string msg = error_of([&] { mesh_settings(s); });
+  EXPECT_NE(msg.find("mesh.source"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("--set"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("must be \"pneunet\", \"inp\" or \"stl\", got \"gmsh\""), std::string::npos) << msg;
+  EXPECT_EQ(error_of([&] { build_mesh(s); }), msg);
+}
+
+TEST(SceneSettings, LoadProtocolAndRest) {
+  const Scene base = Scene::load("");
+  const LoadSettings l = load_settings(base.with({"load.rest_s=12.5"}));
+  EXPECT_EQ(l.protocol, LoadSettings::Protocol::Staircase);
+  EXPECT_EQ(l.rest_s, 12.5);
+  EXPECT_EQ(inlet_load(base.with({"load.rest_s=12.5"})).rest_between_trials_s, 12.5);
+  EXPECT_EQ(load_settings(base.with({"load.protocol=\"csv\""})).protocol, LoadSettings::Protocol::Csv);
+  const std::string msg = error_of([&] { load_settings(base.with({"load.protocol=\"ramp\""})); });
+  EXPECT_NE(msg.find("load.protocol"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("must be \"staircase\" or \"csv\", got \"ramp\""), std::string::npos) << msg;
+}
+
+TEST(SceneSettings, SolverAndOutput) {
+  const Scene base = Scene::load("");
+  const SolverSettings sv = solver_settings(base.with({"solver.model=\"reduced\""}));
+  EXPECT_EQ(sv.mode, SolverSettings::Mode::QuasiStatic);
+  EXPECT_EQ(sv.model, SolverSettings::Model::Reduced);
+  EXPECT_EQ(mode_name(sv.mode), "quasi_static");
+  EXPECT_EQ(model_name(sv.model), "reduced");
+  EXPECT_EQ(mode_name(SolverSettings::Mode::Explicit), "explicit");
+  EXPECT_EQ(model_name(SolverSettings::Model::Full), "full");
+  const std::string msg =
+      error_of([&] { solver_settings(base.with({"solver.mode=\"explicit\"", "solver.model=\"reduced\""})); });
+  EXPECT_NE(msg.find("solver.model"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("needs solver.mode = \"quasi_static\""), std::string::npos) << msg;
+  EXPECT_EQ(output_settings(base.with({"output.vtu=\"all\""})).vtu, "all");
+  EXPECT_NE(error_of([&] { output_settings(base.with({"output.vtu=\"some\""})); }).find("output.vtu"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pneufem
