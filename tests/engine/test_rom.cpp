@@ -338,8 +338,11 @@ TEST(ReducedModel, SoftenedEquilibriaCarryTheFatigueFeedback) {
   EXPECT_GT(fem.angle.back() - fem.angle[fem.angle.size() / 3 - 1], 0.3) << "fatigue drifts the top angle (not a vacuous test)";
   EXPECT_LE(with_softened, 0.06);
   EXPECT_LE(with_softened, 0.6 * plain) << "plain basis " << plain << " deg";
-  for (std::size_t i = 0; i < rom.angle.size(); ++i)
-    if (std::abs(fem.angle[i]) < 0.01) EXPECT_GE(rom.angle[i], -0.01) << "report " << i << " at rest after a vent";
+  for (std::size_t i = 0; i < rom.angle.size(); ++i) {
+    if (std::abs(fem.angle[i]) < 0.01) {
+      EXPECT_GE(rom.angle[i], -0.01) << "report " << i << " at rest after a vent";
+    }
+  }
 }
 
 /// The isochoric part of a material scaled by s (written here from the definition in engine/rom.h,
