@@ -68,6 +68,7 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put(os, ramp_start_dp_Pa[1]);
   put_vec(os, drive_prev.data(), drive_prev.size());
   put_vec(os, drive_cur.data(), drive_cur.size());
+  put(os, static_cast<std::uint64_t>(damage_grew ? 1 : 0));
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
@@ -104,6 +105,9 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   if (magic == kMagic4) {
     c.drive_prev = get_vec(is);
     c.drive_cur = get_vec(is);
+    std::uint64_t grew = 0;
+    get(is, grew);
+    c.damage_grew = grew != 0;
   }
   if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size ||
       (!c.drive_cur.empty() && c.drive_cur.size() != c.hist_cur.size() * 3))
@@ -234,6 +238,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     hist_cur_.clear();
     drive_prev_.clear();
     drive_cur_.clear();
+    damage_grew_ = false;  // rates start afresh after a jump (a release stops the damage)
     ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
     return;
   }
@@ -258,7 +263,8 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   if (ramp_start && ramp_start_dp_[dir] > 0.0)
     dt_suggest_ = std::max(opt_.min_dt_s, std::min(dt_suggest_, ramp_start_dp_[dir] / std::abs(rate)));
   // Drive control: a hold or rest with no curvature known yet starts from the relaxation times.
-  const bool hold_start = drive_control && rate == 0.0 && !drive_kinds_.empty() && (hist_prev_.empty() || drive_prev_.empty());
+  const bool hold_start = drive_control && rate == 0.0 && !drive_kinds_.empty() && !damage_grew_ &&
+                          (hist_prev_.empty() || drive_prev_.empty());
   if (hold_start) dt_suggest_ = first_hold_step();
   bool first_step = true;
   double t = s.g0;
@@ -313,6 +319,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     // Drive control's prediction of the next step: the largest damage error and |D''| per kind.
     double ed_max = 0.0;
     std::vector<double> c_kind;
+    bool step_damage_grew = false;
     if (!drive_control) {
       estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
       static const std::vector<double> kNoPrevious;
@@ -330,16 +337,21 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       const bool damage_only = hold_start && !estimate;
       const int n = static_cast<int>(hist_new.size() / 2);
       int change_point = -1;
+      step_damage_grew = false;
       for (int p = 0; p < n; ++p) {
         const std::size_t i = 2 * static_cast<std::size_t>(p);
         const double dd = hist_new[i] - hist_cur_[i];
         const double c = std::abs(dd) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
         if (c > change) change = c, change_point = p;
+        if (dd != 0.0) step_damage_grew = true;
         double m = 0.0;
-        if (estimate) {
-          const double ed = std::abs(dd - r * (hist_cur_[i] - hist_prev_[i])) * r / (1.0 + r);  // Milne, damage
-          ed_max = std::max(ed_max, ed);
-          m = ed;
+        if (estimate && (dd != 0.0 || hist_cur_[i] != hist_prev_[i])) {
+          // A damaging point: Milne's estimate on damage and viscous strain, as the error control.
+          for (std::size_t k = i; k < i + 2; ++k)
+            m += std::abs((hist_new[k] - hist_cur_[k]) - r * (hist_cur_[k] - hist_prev_[k]));
+          m *= r / (1.0 + r);
+          ed_max = std::max(ed_max, m);
+        } else if (estimate) {
           const int k = drive_kind_[static_cast<std::size_t>(p)];
           if (k >= 0) {
             double c2 = 0.0;
@@ -394,6 +406,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     if (drive_control) {
       drive_prev_ = std::move(drive_cur_);
       drive_cur_ = std::move(drive_new);
+      damage_grew_ = step_damage_grew;
     }
     hist_cur_ = std::move(hist_new);
     rate_prev_ = rate;
@@ -446,6 +459,7 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     ramp_start_dp_[1] = resume->ramp_start_dp_Pa[1];
     drive_prev_ = resume->drive_prev;
     drive_cur_ = resume->drive_cur;
+    damage_grew_ = resume->damage_grew;
     wall_before = stats_.wall_s;
   }
   // The run starts from u = 0, which is an equilibrium only without load. When the load history
@@ -505,6 +519,7 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.ramp_start_dp_Pa[1] = ramp_start_dp_[1];
       c.drive_prev = drive_prev_;
       c.drive_cur = drive_cur_;
+      c.damage_grew = damage_grew_;
       sink(c);
     }
   }

@@ -390,27 +390,46 @@ StaircaseRun two_trials(TimeControl control, double tol, double max_dt, const Qu
 }
 
 TEST(DriveControl, CrossesReleaseAndRestInFewStatesAndAgreesWithAFineReference) {
-  // time_tol: ~2 % of the viscous strain the release leaves (~5e-5), the story's ratio.
+  // time_tol: ~2 % of the viscous strain the release leaves (~4e-5), the story's ratio.
   constexpr double tol = 1e-6;
   const StaircaseRun drive = two_trials(TimeControl::Drive, tol, 100.0);
+  const StaircaseRun tighter = two_trials(TimeControl::Drive, tol / 16, 100.0);
   const StaircaseRun error = two_trials(TimeControl::Error, tol, 100.0);
   const StaircaseRun ref = two_trials(TimeControl::Drive, tol / 100, 100.0);
   std::printf("release + rest: drive control %ld states (%ld in all, %ld rejected), error control %ld (%ld, %ld), "
               "reference (tol / 100) %ld (%ld)\n",
               drive.gap_states, drive.states, drive.rejected, error.gap_states, error.states, error.rejected,
               ref.gap_states, ref.states);
-  EXPECT_LE(drive.gap_states, 6);  // the release + 5 steps (measured: TBD)
+  // The release and 4 steps over the 5 tau of rest (measured 5; the error control takes 17: its
+  // first step falls back to the change limit and its estimate counts the exact decay of Q as error).
+  EXPECT_LE(drive.gap_states, 6);
   EXPECT_LT(drive.gap_states, error.gap_states);
   ASSERT_EQ(drive.strain.size(), ref.strain.size());
-  // At fixed load the isochoric stress S0 + Q is fixed, so an error dQ of the viscous update moves S0,
-  // i.e. the strain, by dQ / (2 mu_inf): the viscous-strain error itself (D = S0 / (2 mu_inf) is the
-  // strain's deviator). Each accepted step's error is <= time_tol and relaxation only damps earlier
-  // ones, so after N steps the strain is off by <= N time_tol (+ the reference's N' tol / 100).
-  double worst = 0.0;
-  for (std::size_t i = 0; i < ref.strain.size(); ++i) worst = std::max(worst, std::abs(drive.strain[i] - ref.strain[i]));
-  std::printf("largest strain difference to the reference %.3g (bound %.3g, strain %.3g)\n", worst,
-              (drive.states + ref.states / 100.0) * tol, sls_creep(1e9));
-  EXPECT_LT(worst, (drive.states + ref.states / 100.0) * tol);
+  ASSERT_EQ(tighter.strain.size(), ref.strain.size());
+  auto worst_of = [&](const StaircaseRun& r) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < ref.strain.size(); ++i) worst = std::max(worst, std::abs(r.strain[i] - ref.strain[i]));
+    return worst;
+  };
+  for (std::size_t i = 0; i < ref.strain.size(); ++i)
+    std::printf("  report %zu: reference %.6e, drive %+.3e, drive at time_tol / 16 %+.3e, error control %+.3e\n", i,
+                ref.strain[i], drive.strain[i] - ref.strain[i], tighter.strain[i] - ref.strain[i],
+                error.strain[i] - ref.strain[i]);
+  const double worst = worst_of(drive), worst_tighter = worst_of(tighter);
+  std::printf("largest strain difference to the reference: %.3g at time_tol, %.3g at time_tol / 16 (strain %.3g)\n", worst,
+              worst_tighter, sls_creep(1e9));
+  // At fixed load the isochoric stress S0 + Q is fixed, so an error dQ of the viscous update moves
+  // S0 = 2 mu_inf D, i.e. the strain's deviator, by dQ / (2 mu_inf): the error in viscous-strain units
+  // is the strain's error. An accepted step's estimate is <= 2 time_tol and the relaxation damps the
+  // earlier steps' errors, so a report is off by ~ a step's error: 2 time_tol bounds it (measured
+  // 0.19 time_tol). A control that crossed the rest in one step (10 s, 5 tau) would be off by
+  // ~0.34 x the released viscous strain, ~14 time_tol, and fail.
+  EXPECT_LT(worst, 2 * tol);
+  // ...and the error falls with the tolerance: for h << tau the local error grows like h^3, so a 16x
+  // tighter tolerance shortens the steps ~2.5x and the error ~6x (measured 5.8x); >= 4x is asserted.
+  // (A 4x tighter one happens to take the same steps here: a step estimated at 0.48 time_tol is
+  // accepted by both, since only estimates above 2 time_tol are rejected.)
+  EXPECT_LT(worst_tighter, 0.25 * worst);
 }
 
 // A run under the drive control resumed from a checkpoint taken after the rest (memory: the last
@@ -427,6 +446,39 @@ TEST(DriveControl, ResumedRunContinuesBitForBit) {
   const StaircaseRun resumed = two_trials(TimeControl::Drive, 1e-6, 100.0, &back);
   EXPECT_EQ(resumed.states, whole.states);
   EXPECT_TRUE(resumed.u == whole.u);
+}
+
+// The linear drive is D = S0 / (2 mu_inf) of the viscoelastic layer, the outermost of a stack (the
+// decorators enforce viscoelastic(fatigue(mullins(base)))); fatigue, Mullins and the stiffness scale
+// forward the calls to their base, and a stack without a Prony term has none. D is checked against S0
+// in the state, (11, 22, 33, 23, 13, 12) with the off-diagonals x sqrt 2.
+TEST(DriveControl, TheViscoelasticLayerReportsItsLinearDrive) {
+  FatigueParams fp;
+  fp.driver = FatigueDriver::max_principal_stretch;
+  fp.lambda_th = 1.01;
+  fp.tau_s = 100.0;
+  const MaterialPtr inner = make_fatigue(make_mullins(neo_hookean(kMu, 1e3 * kMu), MullinsParams{2.0, 2e3, 0.1}), fp);
+  EXPECT_EQ(inner->linear_drive().terms, 0);
+  EXPECT_EQ(neo_hookean(kMu, 1e3 * kMu)->linear_drive().terms, 0);
+  const MaterialPtr stack = make_viscoelastic(inner, ViscoParams{{kGamma}, {kTau}});
+  const Material::LinearDrive d = stack->linear_drive();
+  ASSERT_EQ(d.terms, 1);
+  EXPECT_EQ(d.a[0], kGamma);
+  EXPECT_EQ(d.tau_s[0], kTau);
+  EXPECT_EQ(d.recovery, 1.0);  // long-term moduli: beta = 1
+  const MaterialPtr inst = make_viscoelastic(neo_hookean(kMu, 1e3 * kMu), ViscoParams{{kGamma}, {kTau}, ViscoModuli::instantaneous});
+  EXPECT_NEAR(inst->linear_drive().recovery, 1.0 + kGamma, 1e-15);  // 1 / beta
+  EXPECT_NEAR(inst->linear_drive().a[0], kGamma / (1.0 + kGamma), 1e-15);  // Abaqus's g
+  Mat3 F;
+  F << 1.1, 0.05, 0.0, 0.02, 0.95, 0.01, 0.0, 0.03, 0.97;
+  std::vector<double> state(static_cast<std::size_t>(stack->state_size())), next(state.size());
+  stack->init_state(state);
+  PointResponse r;
+  stack->evaluate(std::span<const Mat3>(&F, 1), TimeStep{0.5, 0.5}, state, next, std::span<PointResponse>(&r, 1), false);
+  std::vector<double> D(6);
+  stack->linear_drive_value(next, D);
+  EXPECT_GT(std::abs(D[0]), 1e-3);  // a real stress, not zeros
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(D[k], (k < 3 ? 1.0 : std::sqrt(2.0)) * next[k] / (2 * kMu), 1e-15) << k;
 }
 
 // Bad options stop with a clear error before any step.
