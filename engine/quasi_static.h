@@ -21,8 +21,8 @@
 // rate: that step falls back to the change limit.
 //
 // time_control = Drive estimates the error of what each update actually gets wrong. The fatigue
-// damage is backward Euler (damage/fatigue.h): its error is Milne's estimate above, on the damage
-// alone. The viscous strain is NOT integrated to first order: the exponential Prony update
+// damage is backward Euler (damage/fatigue.h): first order, Milne's estimate above applies (see
+// below for the damaging points). The viscous strain is NOT integrated to first order: the exponential Prony update
 // (damage/viscoelastic.h) is exact whenever the elastic stress S0 that drives it varies linearly in
 // time over the step, whatever the step's length and however curved the relaxing overstress Q
 // itself is (Q ~ exp(-t/tau) has Q'' = Q/tau^2, which Milne's estimate on Q counts as error: after
@@ -49,9 +49,10 @@
 // |D''| <= recovery v / tau_min^2, and the step is the longest whose error bound
 // recovery v sum_i a_i (tau_i / tau_min)^2 G(h / tau_i) is 0.9 time_tol (at most max_dt_s); only its
 // damage change is limited (time_tol, as the change limit). The first step of a ramp, and of a hold
-// whose damage grew in the last step, keeps the change limit of damage and viscous strain. A segment of zero length that solves nothing (the zero-length
-// jump to a trial's first pressure when it equals the rest's) keeps the control's memory. Materials
-// without a linear drive (no Prony term) see Error's damage estimate.
+// whose damage grew in the last step, keeps the change limit of damage and viscous strain. A
+// segment of zero length that solves nothing (the zero-length jump to a trial's first pressure when
+// it equals the rest's) keeps the control's memory. Without a Prony term (no linear drive) the
+// control is Error's at damaging points and needs nothing elsewhere.
 //
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
