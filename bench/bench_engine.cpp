@@ -7,7 +7,8 @@
 //     inelastic effects, issue 3's performance target) with the breakdown the issue asks for: states
 //     solved, Newton iterations per state, time per iteration, and the wall time of every trial.
 // Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
-//                     [--checksum] [--scene-force FILE] [--protocol FILE [--trials N]] [--scene-force FILE]
+//                     [--checksum] [--scene-force FILE] [--protocol FILE [--trials N] [--set KEY=VALUE]... [--angles CSV]
+//                     [--save-after-first-trial CKPT | --resume CKPT]]
 // --checksum prints a hash of the bits of f_int, of K's values and of the energy (1 and N threads),
 // so two builds of the kernel can be compared bit for bit (A/B of an optimisation).
 // --scene-force FILE times the force-only kernel of a scene with history (e.g. the story's
@@ -19,6 +20,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -235,52 +238,99 @@ void orderings(double h_mm, int threads, int reps) {
 }
 
 /// The quasi-static protocol of `file` (its own mesh unless --h-mm is given, its own trials unless
-/// trials > 0), timed as a whole and per trial, with the solver's breakdown.
-void protocol(const std::string& file, double h_mm, bool set_h, int trials, int threads) {
+/// trials > 0, `sets` as simulate's --set), timed as a whole and per trial, with the solver's
+/// breakdown; with `angles` non-empty every report (trial, time, pressure, angle) goes to that CSV.
+void protocol(const std::string& file, double h_mm, bool set_h, int trials, int threads, std::vector<std::string> sets,
+              const std::string& angles, const std::string& save_after_first, const std::string& resume_file) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-  std::vector<std::string> sets;
   if (set_h) sets.push_back("mesh.h_mm=" + std::to_string(h_mm));
   if (trials > 0) sets.push_back("load.trials=" + std::to_string(trials));
   const Scene scene = Scene::load(file, sets);
   auto bm = build_model(scene);
   const Assembler A(bm->model);
   QuasiStaticRun run(A, bm->solver.quasi_static);
-  std::printf("protocol %s: %d nodes, %d elements, %d dofs, %zu trials, %d threads\n", file.c_str(),
+  std::printf("protocol %s: %d nodes, %d elements, %d dofs, %zu trials, %d threads", file.c_str(),
               bm->model.mesh.num_nodes(), bm->model.mesh.num_elements(), bm->model.num_dofs(), bm->load.trials.size(),
               threads);
+  for (const std::string& k : sets) std::printf(", --set %s", k.c_str());
+  std::printf("\n");
+  std::FILE* csv = angles.empty() ? nullptr : std::fopen(angles.c_str(), "w");
+  if (csv) std::fprintf(csv, "trial,time_s,pressure_kPa,angle_deg\n");
   const auto t0 = Clock::now();
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   // Per trial: from its first report (the 2.5 s mark of the 0 kPa step) to its last (the end of the
-  // top hold), and the gap before it: the release from the previous trial's top pressure, the rest
-  // and the first 2.5 s at 0 kPa. The gap's share says how much of a trial's cost is not the climb.
+  // top hold), and the gap before it: the release from the previous trial's top pressure and the
+  // rest (counted at the end of the rest segment), then the first 2.5 s at 0 kPa. The gap's share
+  // says how much of a trial's cost is not the climb.
   struct Mark {
     Clock::time_point wall;
-    long states, iterations;
+    long states, iterations, factorizations;
   };
-  auto mark = [&] { return Mark{Clock::now(), run.stats().states, run.static_solver().stats().iterations}; };
-  int trial = 0;
-  Mark first = mark(), last = first;
+  auto mark = [&] {
+    return Mark{Clock::now(), run.stats().states, run.static_solver().stats().iterations,
+                run.static_solver().stats().factorizations};
+  };
+  const std::vector<QuasiStaticRun::Segment> segs = QuasiStaticRun::segments(bm->load);
+  // --resume: continue from a checkpoint saved with --save-after-first-trial (e.g. by the other time
+  // control: the release clears the step control's memory, so the gap that follows is a clean A/B).
+  QuasiStaticCheckpoint resume;
+  if (!resume_file.empty()) {
+    std::ifstream in(resume_file, std::ios::binary);
+    resume = QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(A.num_dofs()), A.initial_state().size());
+    std::printf("  resumed from %s before segment %zu\n", resume_file.c_str(), resume.next_segment);
+  }
+  int trial = resume_file.empty() ? 0 : segs[resume.next_segment - 1].trial + 1;
+  Mark first = mark(), last = first, release_end = first, rest_end = first;
   auto seconds = [](const Mark& a, const Mark& b) { return std::chrono::duration<double>(b.wall - a.wall).count(); };
   auto report_trial = [&] {
-    std::printf("  trial %2d: climb %8.1f s, %5ld states, %6ld Newton its", trial, seconds(first, last),
-                last.states - first.states, last.iterations - first.iterations);
+    std::printf("  trial %2d: climb %8.1f s, %5ld states, %6ld Newton its, %5ld factorisations", trial, seconds(first, last),
+                last.states - first.states, last.iterations - first.iterations, last.factorizations - first.factorizations);
     std::fflush(stdout);
   };
-  run.run(bm->load, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
-    const Mark now = mark();
-    if (r.trial != trial) {
-      if (trial > 0) {
-        report_trial();
-        std::printf(" | then release + rest + 2.5 s at 0 kPa %7.1f s, %4ld states, %5ld Newton its\n",
-                    seconds(last, now), now.states - last.states, now.iterations - last.iterations);
-      }
-      trial = r.trial;
-      first = now;
+  auto sink = [&](const QuasiStaticCheckpoint& c) {
+    const QuasiStaticRun::Segment& sg = segs[c.next_segment - 1];
+    if (!save_after_first.empty() && sg.trial == 0 && c.next_segment < segs.size() && segs[c.next_segment].trial == 1) {
+      std::ofstream out(save_after_first, std::ios::binary);
+      c.write(out);
+      out.close();  // std::exit below does not destroy this scope's objects
+      report_trial();
+      std::printf("\n  saved the state after trial 1 to %s (%.1f s wall)\n", save_after_first.c_str(), since(t0));
+      if (csv) std::fclose(csv);
+      std::exit(0);
     }
-    last = now;
-  });
+    if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 == sg.g0 && sg.p1 == 0.0 && sg.p0 != 0.0)
+      release_end = mark();                                                                  // the release
+    if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 > sg.g0) rest_end = mark();  // the rest
+  };
+  run.run(
+      bm->load,
+      [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
+        const Mark now = mark();
+        if (csv) std::fprintf(csv, "%d,%.6f,%.4f,%.9f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg), std::fflush(csv);
+        if (r.trial != trial) {
+          if (trial > 0) {
+            report_trial();
+            std::printf(" | then release + rest %6.1f s, %3ld states, %4ld its, %4ld facts (release %5.1f s, %ld states, %ld its, "
+                        "%ld facts; rest %5.1f s, %ld states, %ld its, %ld facts); 2.5 s at 0 kPa %5.1f s, %2ld states, "
+                        "%3ld its, %3ld facts\n",
+                        seconds(last, rest_end), rest_end.states - last.states, rest_end.iterations - last.iterations,
+                        rest_end.factorizations - last.factorizations, seconds(last, release_end),
+                        release_end.states - last.states, release_end.iterations - last.iterations,
+                        release_end.factorizations - last.factorizations, seconds(release_end, rest_end),
+                        rest_end.states - release_end.states, rest_end.iterations - release_end.iterations,
+                        rest_end.factorizations - release_end.factorizations, seconds(rest_end, now), now.states - rest_end.states,
+                        now.iterations - rest_end.iterations, now.factorizations - rest_end.factorizations);
+            std::fflush(stdout);
+          }
+          trial = r.trial;
+          first = now;
+        }
+        last = now;
+      },
+      sink, resume_file.empty() ? nullptr : &resume);
   report_trial();
   std::printf("\n");
+  if (csv) std::fclose(csv);
   const double wall = since(t0);
   const StaticStats& st = run.static_solver().stats();
   const double states = static_cast<double>(run.stats().states), its = static_cast<double>(st.iterations);
@@ -303,6 +353,8 @@ int main(int argc, char** argv) {
   std::string scene_file, protocol_file;
   bool set_h = false, do_orderings = false;
   int trials = 0;
+  std::vector<std::string> sets;
+  std::string angles, save_after_first, resume_file;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]), set_h = true;
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
@@ -314,6 +366,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--scene-force") && i + 1 < argc) scene_file = argv[++i];
     else if (!std::strcmp(argv[i], "--protocol") && i + 1 < argc) protocol_file = argv[++i];
     else if (!std::strcmp(argv[i], "--trials") && i + 1 < argc) trials = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--set") && i + 1 < argc) sets.push_back(argv[++i]);
+    else if (!std::strcmp(argv[i], "--angles") && i + 1 < argc) angles = argv[++i];
+    else if (!std::strcmp(argv[i], "--save-after-first-trial") && i + 1 < argc) save_after_first = argv[++i];
+    else if (!std::strcmp(argv[i], "--resume") && i + 1 < argc) resume_file = argv[++i];
     else if (!std::strcmp(argv[i], "--orderings")) do_orderings = true;
   }
   if (do_orderings) {
@@ -322,7 +378,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!protocol_file.empty()) {
-    protocol(protocol_file, h, set_h, trials, threads);
+    protocol(protocol_file, h, set_h, trials, threads, sets, angles, save_after_first, resume_file);
     return 0;
   }
   if (!scene_file.empty()) {

@@ -114,6 +114,11 @@ class FatigueDamage final : public Material {
   PointFields fields(std::span<const double> state) const override;
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// Forwarded to the base (its slice of the state).
+  LinearDrive linear_drive() const override { return base_->linear_drive(); }
+  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
+    base_->linear_drive_value(state.subspan(static_cast<std::size_t>(own_state_size())), out);
+  }
   /// With nonlocal_radius_m > 0: kind "fatigue:energy" or "fatigue:stretch"; the driver X at the
   /// committed state; rho = average / X stored for the next increments.
   NonlocalSpec nonlocal() const override;

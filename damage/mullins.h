@@ -71,6 +71,11 @@ class Mullins final : public Material {
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
   /// Forwarded to the base (its slice of the state).
+  /// Forwarded to the base (its slice of the state).
+  LinearDrive linear_drive() const override { return base_->linear_drive(); }
+  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
+    base_->linear_drive_value(state.subspan(kOwnState), out);
+  }
   NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
     return base_->nonlocal_driver(F, state.subspan(kOwnState));

@@ -253,4 +253,19 @@ PointFields Viscoelastic::fields(std::span<const double> state) const {
   return f;
 }
 
+Material::LinearDrive Viscoelastic::linear_drive() const {
+  LinearDrive d;
+  d.terms = n_;
+  for (int i = 0; i < n_; ++i) d.a[i] = a_[i], d.tau_s[i] = tau_[i];
+  d.recovery = 1.0 / beta_;
+  return d;
+}
+
+void Viscoelastic::linear_drive_value(std::span<const double> state, std::span<double> out) const {
+  // S0 is stored packed as (11, 22, 33, 23, 13, 12): the off-diagonal entries count twice in the
+  // Frobenius norm, hence sqrt(2).
+  const double s = 1.0 / (2.0 * long_term_shear_modulus()), r2 = std::sqrt(2.0);
+  for (int k = 0; k < 6; ++k) out[k] = (k < 3 ? s : r2 * s) * state[k];
+}
+
 }  // namespace pneufem

@@ -105,6 +105,12 @@ class Viscoelastic final : public Material {
               std::span<double> state_new) const override;
   /// viscous_strain from this law, the rest from the base.
   PointFields fields(std::span<const double> state) const override;
+  /// The Prony update above is exact for a linearly varying S0 (Material::LinearDrive): D = S0 / (2 mu_inf)
+  /// (strain units, the scale of viscous_strain), a_i and tau_i the branches', recovery = 1 / beta:
+  /// at fixed load the isochoric stress beta S0 + sum Q_i is fixed, so while the branches relax
+  /// fully S0 changes by |sum Q_i| / beta, i.e. D by viscous_strain / beta.
+  LinearDrive linear_drive() const override;
+  void linear_drive_value(std::span<const double> state, std::span<double> out) const override;
   /// The INSTANTANEOUS shear modulus (beta + sum a_i) mu_base = (1 + sum gamma) mu_inf: stable-step
   /// estimates need the stiffest response (mu_base itself in the instantaneous convention).
   double initial_shear_modulus() const override {

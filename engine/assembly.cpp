@@ -529,6 +529,21 @@ std::vector<double> Assembler::history_scalars(std::span<const double> state) co
   return out;
 }
 
+std::vector<double> Assembler::linear_drives(std::span<const double> state) const {
+  const int ne = model_.mesh.num_elements();
+  std::vector<double> out(static_cast<std::size_t>(ne) * geom_.nqp * 6, 0.0);
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = model_.material_of(e);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    if (ss == 0 || mat.linear_drive().terms == 0) continue;
+    for (int q = 0; q < geom_.nqp; ++q) {
+      const std::size_t i = 6 * (static_cast<std::size_t>(e) * geom_.nqp + q);
+      mat.linear_drive_value(state.subspan(state_offset_[e] + q * ss, ss), std::span<double>(out.data() + i, 6));
+    }
+  }
+  return out;
+}
+
 Assembler::RegionFailures Assembler::failed_points(std::span<const double> state) const {
   const Mesh& mesh = model_.mesh;
   // A mesh without region tags counts as one region (index 0).

@@ -81,6 +81,12 @@ class Assembler {
   std::vector<double> history_scalars(std::span<const double> state) const;
   /// Element of point i of history_scalars.
   int element_of_point(int i) const { return i / geom_.nqp; }
+  /// Material points of history_scalars (every element's quadrature points).
+  int num_points() const { return model_.mesh.num_elements() * geom_.nqp; }
+  /// Per material point, in history_scalars' order: the linear drive D of its law
+  /// (Material::linear_drive_value, 6 values per point; zeros where the law has none). The
+  /// time_control = "drive" step control compares these between states (engine/quasi_static.h).
+  std::vector<double> linear_drives(std::span<const double> state) const;
 
   /// Material points whose law reports failure (PointFields::failed, e.g. fatigue damage >= d_fail)
   /// and all material points, per region (index = mesh region id; one entry for an untagged mesh).

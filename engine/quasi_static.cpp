@@ -20,6 +20,7 @@ namespace {
 constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;   // "PNEFCKP1"
 constexpr std::uint64_t kMagic2 = 0x32504b4346454e50ULL;  // "PNEFCKP2": + error-control memory
 constexpr std::uint64_t kMagic3 = 0x33504b4346454e50ULL;  // "PNEFCKP3": + ramp-start memory
+constexpr std::uint64_t kMagic4 = 0x34504b4346454e50ULL;  // "PNEFCKP4": + drive-control memory
 
 template <class T>
 void put(std::ostream& os, const T& v) {
@@ -47,7 +48,7 @@ std::vector<double> get_vec(std::istream& is) {
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
-  put(os, kMagic3);
+  put(os, kMagic4);
   put(os, static_cast<std::uint64_t>(next_segment));
   put(os, dt_suggest_s);
   put(os, last_angle_deg);
@@ -65,13 +66,16 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put(os, rate_prev_Pa_s);
   put(os, ramp_start_dp_Pa[0]);
   put(os, ramp_start_dp_Pa[1]);
+  put_vec(os, drive_prev.data(), drive_prev.size());
+  put_vec(os, drive_cur.data(), drive_cur.size());
+  put(os, static_cast<std::uint64_t>(damage_grew ? 1 : 0));
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
   QuasiStaticCheckpoint c;
   std::uint64_t magic = 0, seg = 0;
   get(is, magic);
-  if (magic != kMagic && magic != kMagic2 && magic != kMagic3) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  if (magic != kMagic && magic != kMagic2 && magic != kMagic3 && magic != kMagic4) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
   get(is, seg);
   c.next_segment = static_cast<std::size_t>(seg);
   get(is, c.dt_suggest_s);
@@ -88,17 +92,25 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   get(is, c.stats.rejected_steps);
   get(is, c.stats.relaxation_iterations);
   get(is, c.stats.wall_s);
-  if (magic == kMagic2 || magic == kMagic3) {
+  if (magic == kMagic2 || magic == kMagic3 || magic == kMagic4) {
     c.hist_prev = get_vec(is);
     c.hist_cur = get_vec(is);
     get(is, c.h_prev_s);
     get(is, c.rate_prev_Pa_s);
   }
-  if (magic == kMagic3) {
+  if (magic == kMagic3 || magic == kMagic4) {
     get(is, c.ramp_start_dp_Pa[0]);
     get(is, c.ramp_start_dp_Pa[1]);
   }
-  if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size)
+  if (magic == kMagic4) {
+    c.drive_prev = get_vec(is);
+    c.drive_cur = get_vec(is);
+    std::uint64_t grew = 0;
+    get(is, grew);
+    c.damage_grew = grew != 0;
+  }
+  if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size ||
+      (!c.drive_cur.empty() && c.drive_cur.size() != c.hist_cur.size() * 3))
     throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
                      "resume with the run's own scene.toml");
   return c;
@@ -110,6 +122,53 @@ QuasiStaticRun::QuasiStaticRun(const Assembler& assembler, QuasiStaticOptions op
   u_ = Eigen::VectorXd::Zero(asm_.num_dofs());
   state_ = asm_.initial_state();
   rate_dependent_ = !state_.empty();
+  if (!(opt_.time_tol > 0.0) || !std::isfinite(opt_.time_tol))
+    throw InputError("quasi-static run: time_tol must be a finite number > 0");
+  if (!(opt_.min_dt_s > 0.0) || !(opt_.max_dt_s >= opt_.min_dt_s) || !std::isfinite(opt_.max_dt_s))
+    throw InputError("quasi-static run: need 0 < min_dt_s <= max_dt_s (finite)");
+  if (opt_.time_control == TimeControl::Drive && rate_dependent_) {
+    // Each point's law's linear drive, as an index into the distinct kinds (a few per model).
+    drive_kind_.assign(static_cast<std::size_t>(asm_.num_points()), -1);
+    for (int p = 0; p < asm_.num_points(); ++p) {
+      const Material::LinearDrive d = asm_.model().material_of(asm_.element_of_point(p)).linear_drive();
+      if (d.terms == 0) continue;
+      auto it = std::find(drive_kinds_.begin(), drive_kinds_.end(), d);
+      if (it == drive_kinds_.end()) it = drive_kinds_.insert(drive_kinds_.end(), d);
+      drive_kind_[static_cast<std::size_t>(p)] = static_cast<int>(it - drive_kinds_.begin());
+    }
+  }
+}
+
+double QuasiStaticRun::drive_step(double h, double ed, const std::vector<double>& c_kind, double target, double lo,
+                                  double hi) const {
+  auto predicted = [&](double x) {
+    double e = ed * (x / h) * (x / h);
+    double ev = 0.0;
+    for (std::size_t k = 0; k < drive_kinds_.size(); ++k) ev = std::max(ev, linear_drive_error(drive_kinds_[k], c_kind[k], x));
+    return e + ev;
+  };
+  if (predicted(hi) <= target) return hi;
+  if (predicted(lo) >= target) return lo;
+  // The prediction increases with the step: bisection in log h, to 0.1 % of the step.
+  double a = lo, b = hi;
+  while (b > 1.001 * a) {
+    const double m = std::sqrt(a * b);
+    (predicted(m) <= target ? a : b) = m;
+  }
+  return a;
+}
+
+double QuasiStaticRun::first_hold_step() const {
+  const std::vector<double> hs = hist_cur_.empty() ? asm_.history_scalars(state_) : hist_cur_;
+  std::vector<double> c(drive_kinds_.size(), 0.0);
+  for (std::size_t p = 0; p < drive_kind_.size(); ++p)
+    if (drive_kind_[p] >= 0) c[static_cast<std::size_t>(drive_kind_[p])] = std::max(c[static_cast<std::size_t>(drive_kind_[p])], hs[2 * p + 1]);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const Material::LinearDrive& d = drive_kinds_[k];
+    const double tau_min = *std::min_element(d.tau_s.begin(), d.tau_s.begin() + d.terms);
+    c[k] *= d.recovery / (tau_min * tau_min);  // the bound |D''| <= recovery v / tau_min^2
+  }
+  return drive_step(1.0, 0.0, c, 0.9 * opt_.time_tol, opt_.min_dt_s, opt_.max_dt_s);
 }
 
 std::vector<QuasiStaticRun::Segment> QuasiStaticRun::segments(const LoadHistory& load) {
@@ -170,10 +229,16 @@ void QuasiStaticRun::equilibrium(double p0, double p1, double t0, double t1) {
 
 void QuasiStaticRun::solve_segment(const Segment& s) {
   const double span = s.g1 - s.g0;
+  const bool drive_control = opt_.time_control == TimeControl::Drive;
   if (!rate_dependent_ || span <= 0.0) {
-    if (span > 0.0 || s.p0 != s.p1) equilibrium(s.p0, s.p1, s.g0, s.g1);
+    const bool solved = span > 0.0 || s.p0 != s.p1;
+    if (solved) equilibrium(s.p0, s.p1, s.g0, s.g1);
+    if (drive_control && !solved) return;  // nothing changed: the control's memory is still valid
     hist_prev_.clear();  // a jump or an elastic state: the history memory is stale
     hist_cur_.clear();
+    drive_prev_.clear();
+    drive_cur_.clear();
+    damage_grew_ = false;  // rates start afresh after a jump (a release stops the damage)
     ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
     return;
   }
@@ -183,7 +248,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   const double rate = (s.p1 - s.p0) / span;
   // A kink of the load (its rate changes): the last step's rate says nothing about this one.
   const bool kink = std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_));
-  if (kink) hist_prev_.clear();
+  if (kink) hist_prev_.clear(), drive_prev_.clear();
   // A ramp that starts after a hold would otherwise be tried in the hold's long step, i.e. over the
   // whole ramp: a full Newton solve of the load increment, then rejected for its history change
   // and cut down by at most 5x per try (2-3 rejected solves per ramp of the staircase, ~27 % of a
@@ -197,6 +262,10 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   const bool ramp_start = kink && rate != 0.0 && rate_prev_ == 0.0;
   if (ramp_start && ramp_start_dp_[dir] > 0.0)
     dt_suggest_ = std::max(opt_.min_dt_s, std::min(dt_suggest_, ramp_start_dp_[dir] / std::abs(rate)));
+  // Drive control: a hold or rest with no curvature known yet starts from the relaxation times.
+  const bool hold_start = drive_control && rate == 0.0 && !drive_kinds_.empty() && !damage_grew_ &&
+                          (hist_prev_.empty() || drive_prev_.empty());
+  if (hold_start) dt_suggest_ = first_hold_step();
   bool first_step = true;
   double t = s.g0;
   long steps = 0;
@@ -243,36 +312,101 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     // otherwise time_tol bounds the change. `order`: how the measure scales with h.
     std::vector<double> hist_new = asm_.history_scalars(state_);
     if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
-    const bool estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
-    static const std::vector<double> kNoPrevious;
-    const HistoryStep hs = history_step(estimate ? hist_prev_ : kNoPrevious, hist_cur_, hist_new, estimate ? h / h_prev_ : 0.0);
-    const double change = hs.change, measure = estimate ? hs.error : hs.change, order = estimate ? 2.0 : 1.0;
-    const int worst_point = estimate ? hs.error_point : hs.change_point;
+    std::vector<double> drive_new;
+    double change = 0.0, measure = 0.0, order = 1.0;
+    int worst_point = -1;
+    bool estimate = false;
+    // Drive control's prediction of the next step: the largest damage error and |D''| per kind.
+    double ed_max = 0.0;
+    std::vector<double> c_kind;
+    bool step_damage_grew = false;
+    if (!drive_control) {
+      estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
+      static const std::vector<double> kNoPrevious;
+      const HistoryStep hs = history_step(estimate ? hist_prev_ : kNoPrevious, hist_cur_, hist_new, estimate ? h / h_prev_ : 0.0);
+      change = hs.change, measure = estimate ? hs.error : hs.change, order = estimate ? 2.0 : 1.0;
+      worst_point = estimate ? hs.error_point : hs.change_point;
+    } else {
+      drive_new = asm_.linear_drives(state_);
+      if (drive_cur_.empty()) drive_cur_ = asm_.linear_drives(state_saved);
+      estimate = !hist_prev_.empty() && !drive_prev_.empty() && h_prev_ > 0.0;
+      c_kind.assign(drive_kinds_.size(), 0.0);
+      const double r = estimate ? h / h_prev_ : 0.0;
+      // Only the damage's change counts on a hold's first step: the viscous strain's is bounded by
+      // the step's length (first_hold_step).
+      const bool damage_only = hold_start && !estimate;
+      const int n = static_cast<int>(hist_new.size() / 2);
+      int change_point = -1;
+      step_damage_grew = false;
+      for (int p = 0; p < n; ++p) {
+        const std::size_t i = 2 * static_cast<std::size_t>(p);
+        const double dd = hist_new[i] - hist_cur_[i];
+        const double c = std::abs(dd) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
+        if (c > change) change = c, change_point = p;
+        if (dd != 0.0) step_damage_grew = true;
+        double m = 0.0;
+        if (estimate && (dd != 0.0 || hist_cur_[i] != hist_prev_[i])) {
+          // A damaging point: Milne's estimate on damage and viscous strain, as the error control.
+          for (std::size_t k = i; k < i + 2; ++k)
+            m += std::abs((hist_new[k] - hist_cur_[k]) - r * (hist_cur_[k] - hist_prev_[k]));
+          m *= r / (1.0 + r);
+          ed_max = std::max(ed_max, m);
+        } else if (estimate) {
+          const int k = drive_kind_[static_cast<std::size_t>(p)];
+          if (k >= 0) {
+            double c2 = 0.0;
+            for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j) {
+              const double d2 = 2.0 * ((drive_new[j] - drive_cur_[j]) / h - (drive_cur_[j] - drive_prev_[j]) / h_prev_) / (h + h_prev_);
+              c2 += d2 * d2;
+            }
+            const double curvature = std::sqrt(c2);
+            c_kind[static_cast<std::size_t>(k)] = std::max(c_kind[static_cast<std::size_t>(k)], curvature);
+            m += linear_drive_error(drive_kinds_[static_cast<std::size_t>(k)], curvature, h);
+          }
+        } else {
+          m = damage_only ? std::abs(dd) : c;
+        }
+        if (m > measure) measure = m, worst_point = p;
+      }
+      if (!estimate && worst_point < 0) worst_point = change_point;
+    }
     last_element = worst_point >= 0 ? asm_.element_of_point(worst_point) : -1;
     last_change = change;
     last_h = h;
     const bool reject = measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
     if (opt_.newton.verbose)
       std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history %s %.3g (tol %.3g) at %s%s\n",
-                   t + h, h, p_at(t + h) * 1e-3, order > 1.0 ? "error estimate" : "change", measure, opt_.time_tol,
+                   t + h, h, p_at(t + h) * 1e-3, estimate ? "error estimate" : "change", measure, opt_.time_tol,
                    last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-", reject ? " (rejected)" : "");
     if (reject) {
       u_ = u_saved;
       state_ = state_saved;
       newton_.set_path(path_saved);
-      dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, std::pow(0.9 * opt_.time_tol / measure, 1.0 / order)));
+      if (drive_control && estimate)
+        dt_suggest_ = std::max(opt_.min_dt_s, drive_step(h, ed_max, c_kind, 0.9 * opt_.time_tol, 0.2 * h, h));
+      else
+        dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, std::pow(0.9 * opt_.time_tol / measure, 1.0 / order)));
       ++stats_.rejected_steps;
       continue;
     }
-    const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
-    dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+    if (drive_control && estimate) {
+      dt_suggest_ = std::clamp(drive_step(h, ed_max, c_kind, 0.9 * opt_.time_tol, 0.5 * h, 2.0 * h), opt_.min_dt_s, opt_.max_dt_s);
+    } else {
+      const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
+      dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+    }
     // The ramp's first step, when the control (not the segment's end) set its length: the step
     // the control would now take, as a pressure increment, starts the next ramp.
     if (ramp_start && first_step && by_control) ramp_start_dp_[dir] = dt_suggest_ * std::abs(rate);
     first_step = false;
-    if (error_control) {
+    if (error_control || drive_control) {
       hist_prev_ = std::move(hist_cur_);
       h_prev_ = h;
+    }
+    if (drive_control) {
+      drive_prev_ = std::move(drive_cur_);
+      drive_cur_ = std::move(drive_new);
+      damage_grew_ = step_damage_grew;
     }
     hist_cur_ = std::move(hist_new);
     rate_prev_ = rate;
@@ -323,6 +457,9 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     rate_prev_ = resume->rate_prev_Pa_s;
     ramp_start_dp_[0] = resume->ramp_start_dp_Pa[0];
     ramp_start_dp_[1] = resume->ramp_start_dp_Pa[1];
+    drive_prev_ = resume->drive_prev;
+    drive_cur_ = resume->drive_cur;
+    damage_grew_ = resume->damage_grew;
     wall_before = stats_.wall_s;
   }
   // The run starts from u = 0, which is an equilibrium only without load. When the load history
@@ -380,6 +517,9 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.rate_prev_Pa_s = rate_prev_;
       c.ramp_start_dp_Pa[0] = ramp_start_dp_[0];
       c.ramp_start_dp_Pa[1] = ramp_start_dp_[1];
+      c.drive_prev = drive_prev_;
+      c.drive_cur = drive_cur_;
+      c.damage_grew = damage_grew_;
       sink(c);
     }
   }

@@ -20,6 +20,40 @@
 // tenths. Where the load rate jumps (the first step after a kink) there is no valid previous
 // rate: that step falls back to the change limit.
 //
+// time_control = Drive estimates the error of what each update actually gets wrong. The fatigue
+// damage is backward Euler (damage/fatigue.h): first order, Milne's estimate above applies (see
+// below for the damaging points). The viscous strain is NOT integrated to first order: the exponential Prony update
+// (damage/viscoelastic.h) is exact whenever the elastic stress S0 that drives it varies linearly in
+// time over the step, whatever the step's length and however curved the relaxing overstress Q
+// itself is (Q ~ exp(-t/tau) has Q'' = Q/tau^2, which Milne's estimate on Q counts as error: after
+// a release that gave 0.04 s steps growing 4-10 % per step, ~30 states for 30 s of recovery). Its
+// local error comes from the curvature of the drive only (history_step.h, linear_drive_error):
+//   e_v = |D''| sum_i a_i tau_i^2 G(h / tau_i),   D = S0 / (2 mu_inf) (Material::LinearDrive),
+// with D'' from the second divided difference of the committed D of the last three states,
+//   D'' = 2 (dD_n / h_n - dD_(n-1) / h_(n-1)) / (h_n + h_(n-1)).
+// At a point whose fatigue damage grows (in this step or the last) the control keeps Error's
+// estimate on damage AND viscous strain: the damage update is backward Euler in a driver (the
+// stretch) that creeps with the viscous relaxation, and its errors, unlike the viscous ones, are
+// not damped but add up over the trials. Measured on the h = 6 story (bench/notes/2026-11-27-gap-
+// drive-control.md): with the drive estimate there too the 45 kPa holds took 4 s steps and the
+// reported angles drifted from the error control's by 0.004, 0.010, 0.018, 0.028 deg in trials 1-4
+// at time_tol 0.02 (0.005, 0.004, 0.010 deg at time_tol 0.002), the drift of the damage.
+// A step is accepted when max over points of the error <= time_tol (retried shorter above
+// 2 time_tol); the next step is the longest within [0.5, 2] h whose predicted error (the damaging
+// points' growing like h^2, e_v with G at each kind's largest |D''|) is 0.9 time_tol.
+// The first step of a hold or rest (no curvature known yet: after a kink, a release, the run's
+// start) is sized from the shortest relaxation time instead of the change limit: at fixed load the
+// stress a point's branches carry passes to S0 as they relax, so S0 changes in all by at most
+// `recovery` x viscous strain (Material::LinearDrive), on the time scale of the relaxation (>= the
+// shortest tau_i; the structure's creep time (1 + gamma) tau is longer), i.e.
+// |D''| <= recovery v / tau_min^2, and the step is the longest whose error bound
+// recovery v sum_i a_i (tau_i / tau_min)^2 G(h / tau_i) is 0.9 time_tol (at most max_dt_s); only its
+// damage change is limited (time_tol, as the change limit). The first step of a ramp, and of a hold
+// whose damage grew in the last step, keeps the change limit of damage and viscous strain. A
+// segment of zero length that solves nothing (the zero-length jump to a trial's first pressure when
+// it equals the rest's) keeps the control's memory. Without a Prony term (no linear drive) the
+// control is Error's at damaging points and needs nothing elsewhere.
+//
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
 // resuming from a checkpoint continues bit-for-bit as the uninterrupted run would.
@@ -37,13 +71,13 @@
 namespace pneufem {
 
 enum class EquilibriumMethod { Newton, Relaxation };
-enum class TimeControl { Change, Error };
+enum class TimeControl { Change, Error, Drive };
 
 struct QuasiStaticOptions {
   EquilibriumMethod method = EquilibriumMethod::Newton;
   StaticOptions newton;
   RelaxationOptions relaxation;
-  double time_tol = 0.01;   ///< max change (Change) or local-error estimate (Error) of damage / viscous strain per physical step
+  double time_tol = 0.01;   ///< max change (Change) or local-error estimate (Error, Drive) of damage / viscous strain per physical step
   TimeControl time_control = TimeControl::Change;
   double min_dt_s = 1e-3;   ///< smallest physical step
   double max_dt_s = 4.0;    ///< largest physical step (rate-dependent materials only)
@@ -85,6 +119,10 @@ struct QuasiStaticCheckpoint {
   /// (damage, viscous strain) at its start (error control only) and end, its length and load rate.
   std::vector<double> hist_prev, hist_cur;
   double h_prev_s = 0.0, rate_prev_Pa_s = 0.0;
+  /// Drive control only: per point the linear drive D (Assembler::linear_drives) at the last accepted
+  /// step's start and end (empty when there is none).
+  std::vector<double> drive_prev, drive_cur;
+  bool damage_grew = false;  ///< drive control: some point's damage grew in the last accepted step
   /// The first step of the last falling [0] and rising [1] ramp since the last release, as the
   /// pressure increment the control suggested after it (Pa; 0 = none): the next ramp's first guess.
   double ramp_start_dp_Pa[2] = {0.0, 0.0};
@@ -110,7 +148,9 @@ class QuasiStaticRun {
   const StaticSolver& static_solver() const { return newton_; }
   const QuasiStaticStats& stats() const { return stats_; }
 
- private:
+  /// The run's load segments (QuasiStaticCheckpoint::next_segment counts them): between trials a
+  /// release (t0 = t1 = 0, g0 = g1, p1 = 0), the rest (t0 = t1 = 0, g1 > g0) and the jump to the
+  /// trial's first pressure; then the intervals between the trial's breakpoints and report times.
   struct Segment {
     int trial;               ///< 0-based
     double t0, t1;           ///< trial-local times
@@ -119,9 +159,16 @@ class QuasiStaticRun {
     bool report;             ///< a report is due at t1
   };
   static std::vector<Segment> segments(const LoadHistory& load);
+
+ private:
   std::string failure_note() const;  ///< where damage laws report failed points ("" = none)
   void solve_segment(const Segment& s);
   void equilibrium(double p0, double p1, double t0, double t1);
+  /// Drive control: the first step of a hold or rest, from the current viscous strains (see above).
+  double first_hold_step() const;
+  /// Drive control: the longest step within [lo, hi] whose predicted error is `target`, given the
+  /// last step h's damage error ed (~ h^2) and each drive kind's largest |D''| (c_kind).
+  double drive_step(double h, double ed, const std::vector<double>& c_kind, double target, double lo, double hi) const;
 
   const Assembler& asm_;
   QuasiStaticOptions opt_;
@@ -136,6 +183,12 @@ class QuasiStaticRun {
   std::vector<double> hist_prev_, hist_cur_;
   double h_prev_ = 0.0, rate_prev_ = 0.0;
   double ramp_start_dp_[2] = {0.0, 0.0};  // as QuasiStaticCheckpoint::ramp_start_dp_Pa
+  // Drive control: per point the index of its law's LinearDrive in drive_kinds_ (-1: none), and D at
+  // the last accepted step's start and end (as the checkpoint's drive_prev, drive_cur).
+  std::vector<int> drive_kind_;
+  std::vector<Material::LinearDrive> drive_kinds_;
+  std::vector<double> drive_prev_, drive_cur_;
+  bool damage_grew_ = false;
 };
 
 }  // namespace pneufem

@@ -13,6 +13,7 @@
 // everything in "iso" and report is_split() == false.
 //
 // Units: SI (Pa for stresses and energy densities J/m^3, s for time).
+#include <array>
 #include <memory>
 #include <span>
 #include <string>
@@ -140,6 +141,32 @@ class Material {
   /// and its F) and hands back the average (set_nonlocal_driver), which the law keeps in its state
   /// for the following increments. Decorators forward the three calls to their base (with the base's
   /// slice of the state). Default: local (radius 0), and the calls do nothing.
+  /// Linear-drive history (engine/quasi_static.h, solver.time_control = "drive"). A law whose history
+  /// update over a physical step is EXACT when a quantity D of its state varies linearly in time over
+  /// the step (the exponential Prony update and the elastic stress S0, damage/viscoelastic.h) says
+  /// here how the update's local error depends on D's curvature: over a step of length h at a
+  /// point where |D''| = c,
+  ///   e(h) = c sum_i a_i tau_i^2 G(h / tau_i)      (in units of PointFields::viscous_strain),
+  /// with G(x) = (x/2 - 1)(1 - exp(-x)) + x exp(-x) (engine/history_step.h, linear_drive_error).
+  /// terms = 0 (the default): the law has no such history. `recovery` bounds D's total change while
+  /// the history relaxes fully at fixed load, in units of the point's viscous strain (the step
+  /// control's first step after a kink, where no curvature is known yet).
+  struct LinearDrive {
+    int terms = 0;
+    std::array<double, 3> a{}, tau_s{};
+    double recovery = 1.0;
+    bool operator==(const LinearDrive&) const = default;
+  };
+  virtual LinearDrive linear_drive() const { return {}; }
+  /// D at a committed state of one point: 6 doubles, a symmetric tensor as (11, 22, 33, sqrt2 23,
+  /// sqrt2 13, sqrt2 12), so that its Euclidean norm is the tensor's Frobenius norm; in units of
+  /// viscous_strain. Only called when linear_drive().terms > 0. Decorators forward both calls to
+  /// their base (with the base's slice of the state); at most one layer of a stack has a drive.
+  virtual void linear_drive_value(std::span<const double> state, std::span<double> out) const {
+    (void)state;
+    (void)out;
+  }
+
   struct NonlocalSpec {
     double radius_m = 0.0;
     std::string kind;

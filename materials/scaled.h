@@ -32,6 +32,10 @@ class ScaledMaterial final : public Material {
   double initial_bulk_modulus() const override { return scale_ * base_->initial_bulk_modulus(); }
   bool is_split() const override { return base_->is_split(); }
   /// Forwarded to the base.
+  LinearDrive linear_drive() const override { return base_->linear_drive(); }
+  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
+    base_->linear_drive_value(state, out);
+  }
   NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
     return base_->nonlocal_driver(F, state);

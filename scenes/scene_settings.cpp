@@ -50,7 +50,7 @@ SolverSettings solver_settings(const Scene& s) {
   sv.quasi_static.newton.verbose = s.boolean("solver.verbose");
   sv.quasi_static.time_tol = positive(s, "solver.time_tol");
   sv.quasi_static.time_control =
-      choice<TimeControl>(s, "solver.time_control", {{"change", TimeControl::Change}, {"error", TimeControl::Error}});
+      choice<TimeControl>(s, "solver.time_control", {{"change", TimeControl::Change}, {"error", TimeControl::Error}, {"drive", TimeControl::Drive}});
   sv.quasi_static.min_dt_s = positive(s, "solver.min_dt_s");
   sv.quasi_static.max_dt_s = positive(s, "solver.max_dt_s");
   if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");

@@ -90,11 +90,11 @@ TEST(Cli, HelpListsTheSubcommands) {
 TEST(Cli, KilledRunResumesToTheUninterruptedResult) {
   // Two trials with creep and fatigue (history-dependent, adaptive time steps). The interrupted
   // run dies abruptly after its 5th checkpoint (as if killed: no clean-up, exit 137); resuming
-  // must give byte-identical angles and metrics. Both physical-time controls: the error control
+  // must give byte-identical angles and metrics. All physical-time controls: the error controls
   // carries its last step across checkpoints (a checkpoint inside a hold, between report times).
   // Two ramps per trial and a time_tol that rejects a whole ramp: the first ramp's start is
   // remembered for the second (engine/quasi_static.cpp), and the cut falls between the two.
-  for (const std::string control : {"change", "error"}) {
+  for (const std::string control : {"change", "error", "drive"}) {
   SCOPED_TRACE(control);
   const std::string fx = kTiny + " --set load.trials=2 --set materials.silicone.viscoelastic.enabled=true"
                          " --set materials.silicone.fatigue.enabled=true --set materials.silicone.fatigue.W_th_MPa=0.001"
