@@ -499,7 +499,7 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
     if (!jacobian_) jacobian_ = std::make_unique<Eigen::MatrixXd>();
     *jacobian_ = Jm;
   };
-  if (jacobian_ && jacobian_->rows() == n) {
+  if (reuse_jacobian_ && jacobian_ && jacobian_->rows() == n) {
     Jm = *jacobian_;
     factor();
   } else {
@@ -567,7 +567,7 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
       ++reused;
       ++stats_.reused_tangents;
     }
-    if (reused >= kMaxReuse || f1 > kContract * f0) refresh();  // contracting too slowly with the kept one
+    if (!reuse_jacobian_ || reused >= kMaxReuse || f1 > kContract * f0) refresh();  // contracting too slowly with the kept one
   }
   if (!converged) {
     std::ostringstream m;

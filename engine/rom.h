@@ -265,6 +265,8 @@ class ReducedRun {
   ~ReducedRun();
 
   void run(const LoadHistory& load, const Observer& observer);
+  /// Off: a fresh Jacobian at every Newton iteration (plain Newton; for verification of the kept one).
+  void set_jacobian_reuse(bool on) { reuse_jacobian_ = on; }
 
   const std::vector<ReducedStep>& trajectory() const { return steps_; }
   const ReducedRunStats& stats() const { return stats_; }
@@ -283,6 +285,7 @@ class ReducedRun {
   /// The last factorised reduced Jacobian, reused by later iterations and steps while it still
   /// contracts (equilibrium()); reset where the state jumps (a release, a zero-time load).
   std::unique_ptr<Eigen::MatrixXd> jacobian_;
+  bool reuse_jacobian_ = true;
   ReducedCoordinates z_, z_prev_;
   ReducedCoordinates z_seg_prev_;   ///< the committed state before the last one in this segment (predictor)
   double h_seg_prev_ = 0.0;         ///< the last committed step's length in this segment
