@@ -435,6 +435,9 @@ struct ReducedRun::Segment {
 };
 
 ReducedRun::ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options) : rom_(rom), opt_(options) {
+  // The reduced run has no linear-drive control (it compares the kept points' history scalars
+  // only): "drive" keeps the error control it refines, as before the choice existed.
+  if (opt_.time_control == TimeControl::Drive) opt_.time_control = TimeControl::Error;
   z_.q = Eigen::VectorXd::Zero(rom.num_modes());
   z_prev_ = z_;
   hist_ = rom.initial_history();

@@ -255,7 +255,7 @@ class ReducedOrderModel {
 };
 
 /// Quasi-static march through a load history in the reduced model: the same segments, physical step
-/// control (QuasiStaticOptions: time_control, time_tol, min/max_dt_s) and reports as QuasiStaticRun,
+/// control (QuasiStaticOptions: time_control, with "drive" run as "error"; time_tol, min/max_dt_s) and reports as QuasiStaticRun,
 /// with Newton in the reduced coordinates.
 class ReducedRun {
  public:

@@ -103,11 +103,7 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
                              bool check) {
   ReducedRunResult res;
   const ReducedOrderModel rom(setup.reference->model, setup.basis, bm.model);
-  // The reduced run has no linear-drive control (engine/rom.cpp compares history scalars only): it
-  // keeps the error control that "drive" refines, as before the choice existed.
-  QuasiStaticOptions qs = bm.solver.quasi_static;
-  if (qs.time_control == TimeControl::Drive) qs.time_control = TimeControl::Error;
-  ReducedRun run(rom, qs);
+  ReducedRun run(rom, bm.solver.quasi_static);
   std::vector<StateRecord> records;
   // Unchecked, each report goes to at_report as it is solved (without fields), so a run that fails
   // part-way has shown the reports before the failure.
