@@ -439,13 +439,10 @@ ReducedRun::ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options)
   // only): "drive" keeps the error control it refines, as before the choice existed.
   if (opt_.time_control == TimeControl::Drive) opt_.time_control = TimeControl::Error;
   z_.q = Eigen::VectorXd::Zero(rom.num_modes());
-  z_prev_ = z_;
   hist_ = rom.initial_history();
   trial_ = hist_;
   rate_dependent_ = !hist_.empty();
 }
-
-ReducedRun::~ReducedRun() = default;
 
 // Newton in the reduced coordinates, with the Jacobian kept from earlier iterations and steps while
 // it contracts (a modified Newton, or chord, method: Dennis & Schnabel 1996, section 5.4; the
@@ -469,7 +466,7 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
   // 100x below the 0.01 deg the reports are written with) and 1e-8 of the path's largest RMS
   // displacement in q.
   constexpr double kTolTheta = 1e-6, kTolQ = 1e-8;
-  // Predictor: along the last step's direction when the pressure keeps moving the same way.
+  // Newton starts from z_ (solve_segment sets it to its predictor).
   ReducedCoordinates z = z_;
   Eigen::VectorXd dz = Eigen::VectorXd::Zero(n);
   const ReducedBasis& B = rom_.basis();
@@ -481,7 +478,7 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
     y.q += s * d.segment(1, n - 2);
     y.lambda += s * d[n - 1];
   };
-  bool converged = false, have_residual = false;
+  bool converged = false;
   // The Jacobian in use: evaluated at the current iterate (fresh) or kept from before (stale).
   bool fresh = false;
   int reused = 0;
@@ -495,27 +492,22 @@ void ReducedRun::equilibrium(double p, double t, double dt) {
     R = rom_.residual(z, p, ts, hist_, trial_, &Jm);
     ++stats_.residuals;
     ++stats_.tangents;
-    have_residual = true;
     fresh = true;
     reused = 0;
     factor();
-    if (!jacobian_) jacobian_ = std::make_unique<Eigen::MatrixXd>();
-    *jacobian_ = Jm;
+    jacobian_ = Jm;
   };
-  if (reuse_jacobian_ && jacobian_ && jacobian_->rows() == n) {
-    Jm = *jacobian_;
+  if (reuse_jacobian_ && jacobian_.rows() == n) {
+    Jm = jacobian_;
     factor();
+    R = rom_.residual(z, p, ts, hist_, trial_, nullptr);
+    ++stats_.residuals;
   } else {
     refresh();
   }
   const double span = B.theta.back() - B.theta.front();
   int it = 0;
   for (; it < 30; ++it) {
-    if (!have_residual) {
-      R = rom_.residual(z, p, ts, hist_, trial_, nullptr);
-      ++stats_.residuals;
-      have_residual = true;
-    }
     dz = -lu.solve(R);
     if (!dz.allFinite()) {
       if (fresh) break;
@@ -606,7 +598,7 @@ void ReducedRun::solve_segment(const Segment& s) {
         try {
           z_.theta = 0.0;
           z_.q.setZero();
-          jacobian_.reset();
+          jacobian_.resize(0, 0);
           z_.lambda = 0.0;
           equilibrium(0.0, t, dt);
           released = true;
@@ -665,9 +657,9 @@ void ReducedRun::solve_segment(const Segment& s) {
     const bool predict = seg_steps_ > 0;
     if (predict) {
       const double ratio = hstep / h_seg_prev_;
-      z_.theta += ratio * (z_saved.theta - z_seg_prev_.theta);
-      z_.q += ratio * (z_saved.q - z_seg_prev_.q);
-      z_.lambda += ratio * (z_saved.lambda - z_seg_prev_.lambda);
+      z_.theta += ratio * (z_saved.theta - z_prev_.theta);
+      z_.q += ratio * (z_saved.q - z_prev_.q);
+      z_.lambda += ratio * (z_saved.lambda - z_prev_.lambda);
     }
     try {
       try {
@@ -705,7 +697,7 @@ void ReducedRun::solve_segment(const Segment& s) {
     }
     hist_cur_ = std::move(hist_new);
     rate_prev_ = rate;
-    z_seg_prev_ = z_saved;
+    z_prev_ = z_saved;
     h_seg_prev_ = hstep;
     ++seg_steps_;
     t += hstep;

@@ -262,7 +262,6 @@ class ReducedRun {
   /// Called at every report with its record, the reduced coordinates and the full displacement.
   using Observer = std::function<void(const StateRecord&, const ReducedCoordinates&, const Eigen::VectorXd& u)>;
   ReducedRun(const ReducedOrderModel& rom, QuasiStaticOptions options);
-  ~ReducedRun();
 
   void run(const LoadHistory& load, const Observer& observer);
   /// Off: a fresh Jacobian at every Newton iteration (plain Newton; for verification of the kept one).
@@ -284,13 +283,12 @@ class ReducedRun {
   QuasiStaticOptions opt_;
   /// The last factorised reduced Jacobian, reused by later iterations and steps while it still
   /// contracts (equilibrium()); reset where the state jumps (a release, a zero-time load).
-  std::unique_ptr<Eigen::MatrixXd> jacobian_;
+  Eigen::MatrixXd jacobian_;  ///< empty: none kept
   bool reuse_jacobian_ = true;
-  ReducedCoordinates z_, z_prev_;
-  ReducedCoordinates z_seg_prev_;   ///< the committed state before the last one in this segment (predictor)
+  ReducedCoordinates z_;
+  ReducedCoordinates z_prev_;       ///< the committed state before the last one in this segment (predictor)
   double h_seg_prev_ = 0.0;         ///< the last committed step's length in this segment
   long seg_steps_ = 0;              ///< steps committed in this segment
-  double p_prev_ = 0.0;
   std::vector<double> hist_, trial_;
   std::vector<ReducedStep> steps_;
   ReducedRunStats stats_;
