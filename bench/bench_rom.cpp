@@ -2,10 +2,11 @@
 // engine/rom.h against the full quasi-static FEM on a scene's protocol.
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
-//             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--dump-points]
+//             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected] [--dump-points]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
-// adjoint and Newton-step indicators beside every report's error; --dump-points runs the FEM beside
+// adjoint and Newton-step indicators beside every report's error; --corrected adds the corrected
+// history's estimate (ReplayOptions: a check at every loaded report); --dump-points runs the FEM beside
 // the reduced model and compares damage and largest stretch at the kept points at every trial's end.
 // Prints the offline cost (elastic trace, basis), the online cost (states, Newton iterations,
 // wall), and with --fem the FEM's record and the differences: every report angle, and the paper's
@@ -103,7 +104,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
-  bool fem = false, check = false, dump = false;
+  bool fem = false, check = false, dump = false, corrected = false;
   int snap_trials = 0;
   int threads = 0;
   RomBasisOptions ro;
@@ -118,6 +119,7 @@ int main(int argc, char** argv) {
     else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
     else if (a == "--check") check = true;
+    else if (a == "--corrected") check = corrected = true;
     else if (a == "--dump-points") dump = true;  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
@@ -261,19 +263,25 @@ int main(int argc, char** argv) {
               since(t_on), st.states, st.rejected_steps, st.newton_iterations, st.tangents, st.reused_tangents, st.residuals, rom.num_points(),
               st.beyond_path ? ", BEYOND THE PATH" : "");
   // The a-posteriori indicators at every report: the adjoint-weighted residual and one full Newton step.
-  std::vector<double> est_adj, est_newton;
+  std::vector<double> est_adj, est_newton, est_corr;
   if (check) {
     const auto t0 = Clock::now();
+    ReplayOptions replay_opt;
+    replay_opt.newton_at = [](const ReducedStep& s) { return s.report >= 0 && s.pressure_Pa > 0.0; };
+    if (corrected) replay_opt.corrected_at = replay_opt.newton_at;
+    replay_opt.newton = bm->solver.quasi_static.newton;
     replay_reduced_run(
         rom, run.trajectory(),
         [&](const ReducedStep& s, const Eigen::VectorXd&, const std::vector<double>&, const ReducedCheck& c) {
           if (s.report < 0) return;
           const std::size_t i = static_cast<std::size_t>(s.report);
-          if (est_adj.size() <= i) est_adj.resize(i + 1, std::nan("")), est_newton.resize(i + 1, std::nan(""));
+          if (est_adj.size() <= i)
+            est_adj.resize(i + 1, std::nan("")), est_newton.resize(i + 1, std::nan("")), est_corr.resize(i + 1, std::nan(""));
           est_adj[i] = c.angle_error_deg;
           est_newton[i] = c.newton_angle_error_deg;
+          est_corr[i] = c.corrected_angle_error_deg;
         },
-        [](const ReducedStep& s) { return s.report >= 0 && s.pressure_Pa > 0.0; });
+        replay_opt);
     std::printf("replay with checks: %.1f s\n", since(t0));
   }
   // Kept points, ROM against FEM, at the last report of every trial: damage and largest stretch.
@@ -366,11 +374,11 @@ int main(int argc, char** argv) {
       else
         std::printf("%5d  %14.3f\n", tr, w);
     }
-    std::printf("reports (trial, t, p kPa, fem, rom, diff%s):\n", check ? ", adjoint estimate, Newton estimate" : "");
+    std::printf("reports (trial, t, p kPa, fem, rom, diff%s):\n", check ? ", adjoint estimate, Newton estimate, corrected-history estimate" : "");
     for (std::size_t i = 0; i < n; ++i) {
       std::printf("  %d %7.2f %6.2f %9.3f %9.3f %+7.3f", full.trial[i], full.t[i], full.p[i] * 1e-3, full.angle[i], red.angle[i],
                   red.angle[i] - full.angle[i]);
-      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f", est_adj[i], est_newton[i]);
+      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f %+8.3f", est_adj[i], est_newton[i], est_corr[i]);
       std::printf("\n");
     }
   } else {
@@ -378,7 +386,7 @@ int main(int argc, char** argv) {
     {
       std::printf("  %d %7.2f %6.2f %9.3f (ideal %9.3f)", red.trial[i], red.t[i], red.p[i] * 1e-3, red.angle[i],
                   i < ideal.angle.size() ? ideal.angle[i] : std::nan(""));
-      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f", est_adj[i], est_newton[i]);
+      if (check && i < est_adj.size()) std::printf(" %+8.3f %+8.3f %+8.3f", est_adj[i], est_newton[i], est_corr[i]);
       std::printf("\n");
     }
   }

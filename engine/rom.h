@@ -315,6 +315,35 @@ struct ReducedCheck {
   /// model's angle error to second order, including what the first estimate cannot see (the
   /// reference's adjoint where the damaged model's would be needed). NaN where not requested.
   double newton_angle_error_deg = std::numeric_limits<double>::quiet_NaN();
+  /// Where requested (ReplayOptions::corrected_at): the reduced angle minus the angle of the
+  /// corrected state (below), which carries the history the full model would have built. The
+  /// first two estimates measure the reduced state against the full equilibrium *for the reduced
+  /// model's own history*; this one also sees how far that history has drifted (a damaged point
+  /// of the full model stretches more, which damages it faster). NaN where not requested.
+  double corrected_angle_error_deg = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The corrected history (the drift check). A second history of every element is integrated along
+/// the reduced trajectory shifted by a correction, u_c = u(z) + (p / p_c) du_c, and at every state
+/// that `corrected_at` picks, the step is solved as the full model solves it (StaticSolver::solve
+/// from u_c, with that history and the step's own tangent); the converged state u* sets
+/// du_c = u* - u(z) and p_c = p. Between checks the correction is held, scaled with the pressure (a
+/// release takes it to zero). This is a defect correction of the reduced trajectory: the reduced
+/// model is the predictor, the full equations the corrector (Kerfriden, Gosselet, Adhikari & Bordas
+/// 2011, CMAME 200, 850-866, pair them the same way to decide when a reduced basis must be
+/// enriched). With a check at every report, the corrected history is the full model's except for
+/// the path between reports, and the reduced angle minus u*'s is the reduced model's error
+/// including the drift of its history (a damaged point of the full model stretches more, which
+/// damages it faster), which the Newton-step check, made with the reduced run's own history, cannot
+/// see. Cost: a second force evaluation per step, and a Newton solve (a few factorisations) per check.
+struct ReplayOptions {
+  /// Reports that get the Newton-step check of the reduced state (ReducedCheck::newton_angle_error_deg).
+  std::function<bool(const ReducedStep&)> newton_at;
+  /// Reports at which the corrected history is corrected (ReducedCheck::corrected_angle_error_deg).
+  /// Empty: no corrected history.
+  std::function<bool(const ReducedStep&)> corrected_at;
+  /// The full model's Newton for the corrected states (the run's solver.quasi_static.newton).
+  StaticOptions newton;
 };
 
 /// Replays every element's history of the run's model (the full mesh) along a reduced trajectory,
@@ -327,5 +356,9 @@ using ReplayObserver =
 /// `newton_at` (optional) picks the reports that also get the Newton-step check (one factorisation each).
 void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
                         const std::function<bool(const ReducedStep&)>& newton_at = nullptr);
+/// The same with the corrected history (ReplayOptions). The observer's `state` is the reduced run's
+/// replayed history either way.
+void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
+                        const ReplayOptions& options);
 
 }  // namespace pneufem

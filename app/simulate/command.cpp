@@ -180,11 +180,11 @@ std::vector<StateRecord> records_of(const Scene& scene) {
 
 /// Per report of a reduced run: its indicator (reduced_check.csv).
 std::string reduced_check_csv(const std::vector<ReducedReport>& reports) {
-  std::string s = "trial,time_s,pressure_kPa,angle_deg,estimated_angle_error_deg,newton_step_angle_error_deg,residual_rel\n";
+  std::string s = "trial,time_s,pressure_kPa,angle_deg,estimated_angle_error_deg,corrected_history_angle_error_deg,residual_rel\n";
   char line[256];
   for (const ReducedReport& r : reports) {
     std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g\n", r.record.trial, r.record.time_s, r.record.pressure_Pa * 1e-3,
-                  r.record.angle_deg, r.check.angle_error_deg, r.check.newton_angle_error_deg, r.check.residual_rel);
+                  r.record.angle_deg, r.check.angle_error_deg, r.check.corrected_angle_error_deg, r.check.residual_rel);
     s += line;
   }
   return s;

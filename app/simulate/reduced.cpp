@@ -35,6 +35,21 @@ ElasticPathTrace unflatten_trace(const std::vector<double>& f, Eigen::Index dofs
   return t;
 }
 
+/// Per trial: the first report at the trial's largest pressure and the report of largest angle.
+std::set<std::size_t> trial_tops(const std::vector<StateRecord>& records) {
+  std::map<int, std::size_t> top_p, top_angle;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    auto [p, new_p] = top_p.emplace(records[k].trial, k);
+    if (!new_p && records[k].pressure_Pa > records[p->second].pressure_Pa) p->second = k;
+    auto [a, new_a] = top_angle.emplace(records[k].trial, k);
+    if (!new_a && records[k].angle_deg > records[a->second].angle_deg) a->second = k;
+  }
+  std::set<std::size_t> tops;
+  for (auto [trial, k] : top_p) tops.insert(k);
+  for (auto [trial, k] : top_angle) tops.insert(k);
+  return tops;
+}
+
 }  // namespace
 
 std::string reduced_check_failure(const ReducedRunResult& run, double tol_deg) {
@@ -118,27 +133,26 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
     return res;
   }
   const auto t0 = Clock::now();
-  // The Newton-step check at each trial's report of largest angle (the top step, where the
-  // actuator is most sensitive and the history effects have acted longest).
-  std::map<int, std::size_t> top;
-  for (std::size_t k = 0; k < records.size(); ++k) {
-    auto [it, added] = top.emplace(records[k].trial, k);
-    if (!added && records[k].angle_deg > records[it->second].angle_deg) it->second = k;
-  }
-  std::set<std::size_t> newton_reports;
-  for (auto [trial, k] : top) newton_reports.insert(k);
-  std::size_t asked = 0, i = 0;
-  auto newton_at = [&](const ReducedStep&) { return newton_reports.count(asked++) > 0; };
+  // The corrected history (engine/rom.h, ReplayOptions) is corrected at each trial's top: its
+  // first report at the trial's largest pressure and its report of largest angle (the top hold's
+  // start and end on a staircase), where the actuator is most sensitive and the history effects
+  // have acted longest. Between them the history follows the reduced trajectory with the held
+  // correction, so the estimate at the tops includes the drift of the history over the trials.
+  const std::set<std::size_t> tops = trial_tops(records);
+  std::size_t i = 0;
+  ReplayOptions replay;
+  replay.corrected_at = [&](const ReducedStep& s) { return tops.count(static_cast<std::size_t>(s.report)) > 0; };
+  replay.newton = bm.solver.quasi_static.newton;
   replay_reduced_run(rom, run.trajectory(), [&](const ReducedStep&, const Eigen::VectorXd& u, const std::vector<double>& state,
                                                 const ReducedCheck& estimate) {
     if (i >= records.size()) throw PhysicsError("reduced model: the replay found more reports than the run made (internal error)");
     res.reports.push_back({records[i], estimate});
     double e = std::isnan(estimate.angle_error_deg) ? 0.0 : std::abs(estimate.angle_error_deg);
-    if (!std::isnan(estimate.newton_angle_error_deg)) e = std::max(e, std::abs(estimate.newton_angle_error_deg));
+    if (!std::isnan(estimate.corrected_angle_error_deg)) e = std::max(e, std::abs(estimate.corrected_angle_error_deg));
     if (e > res.worst_check_deg || res.worst_report < 0) res.worst_check_deg = e, res.worst_report = static_cast<int>(i);
     if (at_report) at_report(records[i], u, state);
     ++i;
-  }, newton_at);
+  }, replay);
   if (i != records.size()) throw PhysicsError("reduced model: the replay found fewer reports than the run made (internal error)");
   res.replay_s = seconds_since(t0);
   return res;

@@ -13,9 +13,11 @@
 //
 // Online part. run_reduced marches the load (ReducedRun), then replays the whole mesh's history
 // along the reduced trajectory (replay_reduced_run): VTU fields at the reports and the indicator,
-// the adjoint-weighted full residual, at every report; and at each trial's report of largest
-// angle the angle after one full Newton step (one factorisation per trial). The caller decides what a report above
-// solver.reduced_check_deg means (simulate falls back to the full FEM).
+// the adjoint-weighted full residual, at every report; and at each trial's top (its first report
+// at its largest pressure and its report of largest angle) the corrected history's estimate
+// (engine/rom.h ReplayOptions: the full model's history built along the corrected states, one
+// Newton solve per top), which also sees the drift of the reduced run's history. The caller
+// decides what a report above solver.reduced_check_deg means (simulate falls back to the full FEM).
 #include <functional>
 #include <memory>
 #include <string>
