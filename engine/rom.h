@@ -321,6 +321,9 @@ struct ReducedCheck {
   /// model's own history*; this one also sees how far that history has drifted (a damaged point
   /// of the full model stretches more, which damages it faster). NaN where not requested.
   double corrected_angle_error_deg = std::numeric_limits<double>::quiet_NaN();
+  /// Requested, but the full model's solve of the corrected state found no equilibrium (near a
+  /// limit point): the reduced state could not be checked there.
+  bool corrected_failed = false;
 };
 
 /// The corrected history (the drift check). A second history of every element is integrated along

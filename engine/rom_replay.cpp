@@ -58,13 +58,13 @@ class CorrectedHistory {
   CorrectedHistory(const Assembler& A, const StaticOptions& newton)
       : A_(A), solver_(A, newton), state_(A.initial_state()), trial_(state_.size()) {
     du_ = Eigen::VectorXd::Zero(A.num_dofs());
-    u_prev_ = du_;
+    u_converged_ = du_;
   }
   /// Advances the history by `step` from u + du_c (u the reduced state), du_c scaled by the
   /// pressure since the last correction (a release takes it to zero with the load). With `correct`,
   /// the step is solved as the full model solves it: Newton from there with the step's own tangent
   /// (StaticSolver::solve), and where that fails (near a limit point) the full model's continuation
-  /// from the previous corrected state (StaticSolver::advance, sub-increments in pressure and time).
+  /// from the last converged corrected state (StaticSolver::advance, sub-increments in pressure).
   /// The converged state sets du_c; `converged` says whether there was one (if not, the prediction
   /// stands). Returns the corrected displacement.
   Eigen::VectorXd advance(const ReducedStep& step, const Eigen::VectorXd& u, bool correct, bool& converged) {
@@ -81,11 +81,14 @@ class CorrectedHistory {
         converged = false;  // an element inverted on the way
       }
       if (!converged) {
+        // Continuation from the last converged corrected state (an equilibrium, at the pressure of
+        // the last correction, of a slightly older history), in pressure sub-increments while the
+        // time runs from the committed history's to the step's.
         std::vector<double> state = state_;
-        solved = u_prev_;
+        solved = u_converged_;
         solver_.set_path({});  // no predictor from an earlier check's path
         try {
-          solver_.advance(p_prev_, step.pressure_Pa, t_prev_, step.time_s, state, solved);
+          solver_.advance(p_check_, step.pressure_Pa, t_prev_, step.time_s, state, solved);
           converged = committed = true;
           state_.swap(state);
         } catch (const PhysicsError&) {
@@ -95,6 +98,7 @@ class CorrectedHistory {
       if (converged) {
         uc = solved;
         du_ = uc - u;
+        u_converged_ = uc;
         p_check_ = step.pressure_Pa;
       }
     }
@@ -103,8 +107,6 @@ class CorrectedHistory {
       state_.swap(trial_);
     }
     A_.update_nonlocal(uc, state_);
-    u_prev_ = uc;
-    p_prev_ = step.pressure_Pa;
     t_prev_ = step.time_s;
     return uc;
   }
@@ -113,8 +115,8 @@ class CorrectedHistory {
   const Assembler& A_;
   StaticSolver solver_;
   std::vector<double> state_, trial_;
-  Eigen::VectorXd du_, u_prev_;
-  double p_check_ = 0.0, p_prev_ = 0.0, t_prev_ = 0.0;
+  Eigen::VectorXd du_, u_converged_;  ///< the correction; the last converged corrected state
+  double p_check_ = 0.0, t_prev_ = 0.0;  ///< its pressure; the committed history's time
 };
 
 }  // namespace
@@ -160,6 +162,7 @@ void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedS
     Eigen::VectorXd du;
     if (newton && newton_step(A, K, R, du))
       check.newton_angle_error_deg = -(unwrap_deg(bending_angle(rom.model(), u - du).angle_deg, a0) - a0);
+    check.corrected_failed = correct && !converged;
     if (correct && converged) check.corrected_angle_error_deg = -(unwrap_deg(bending_angle(rom.model(), uc).angle_deg, a0) - a0);
     at_report(step, u, state, check);
   }

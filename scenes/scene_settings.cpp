@@ -73,6 +73,8 @@ SolverSettings solver_settings(const Scene& s) {
   sv.reduced.softened_levels = s.integer("solver.reduced_softened_levels");
   if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
   sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
+  sv.reduced_check_at = choice<SolverSettings::CheckAt>(s, "solver.reduced_check_at", {{"tops", SolverSettings::CheckAt::Tops},
+                                                                                       {"reports", SolverSettings::CheckAt::Reports}});
   if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)
     s.fail("solver.model", "\"reduced\" needs solver.mode = \"quasi_static\"");
   return sv;

@@ -43,6 +43,8 @@ struct SolverSettings {
   Model model = Model::Full;
   RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels
   double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
+  enum class CheckAt { Tops, Reports };  ///< where the corrected history is corrected (app/simulate/reduced.h)
+  CheckAt reduced_check_at = CheckAt::Tops;
   QuasiStaticOptions quasi_static;
   ExplicitOptions explicit_dynamics;
   double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time

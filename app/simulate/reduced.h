@@ -53,6 +53,7 @@ struct ReducedRunResult {
   double replay_s = 0.0;       ///< wall time of the full-mesh replay
   double worst_check_deg = 0.0;  ///< largest |estimated angle error| over the reports (either estimate)
   int worst_report = -1;       ///< its index in `reports`
+  int unchecked_report = -1;   ///< the first report whose corrected solve found no equilibrium, or -1
 };
 
 /// Runs `bm` (the scene's model, same mesh as the setup's reference) through its load with the
@@ -65,8 +66,9 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
                                  at_report = nullptr,
                              bool check = true);
 
-/// Why a checked reduced run must not stand ("" = it may): its worst estimated angle error
-/// exceeds `tol_deg` (solver.reduced_check_deg), with the report where.
+/// Why a checked reduced run must not stand ("" = it may): the full model found no equilibrium
+/// near a top's reduced state (it could not be checked), or the worst estimated angle error exceeds
+/// `tol_deg` (solver.reduced_check_deg); with the report where.
 std::string reduced_check_failure(const ReducedRunResult& run, double tol_deg);
 
 /// The largest pressure of a load history (Pa).

@@ -107,6 +107,51 @@ TEST(SimulateReduced, ABrokenBasisIsCaughtAndTheRunFallsBackToTheFullFem) {
   EXPECT_NEAR(worst_est, actual_at_worst, 0.3 * std::abs(actual_at_worst));
 }
 
+/// reduced_check.csv's rows: trial, time, pressure (kPa), angle, adjoint estimate, corrected estimate.
+std::vector<std::vector<double>> check_rows(const fs::path& dir) {
+  std::ifstream in(dir / "reduced_check.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_NE(line.find("corrected_history_angle_error_deg"), std::string::npos) << line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    rows.emplace_back();
+    while (std::getline(ss, cell, ',')) rows.back().push_back(std::stod(cell));
+  }
+  return rows;
+}
+
+// solver.reduced_check_at chooses where the full model corrects the history (engine/rom.h
+// ReplayOptions): "tops" at each trial's first report at its largest pressure and its report of
+// largest angle (here the top hold's start and end: 2 of the trial's 20 reports), "reports" at every
+// loaded report. The estimates are the reduced angle minus the corrected state's; this one-trial
+// run follows the FEM within 0.1 deg (ReportsTheReducedRunAndReusesItsCacheBitForBit), so every
+// estimate must be below that and the run stands.
+TEST(SimulateReduced, TheCheckCorrectsAtTheTopsOrAtEveryLoadedReport) {
+  const fs::path tops = temp_dir("check_tops"), every = temp_dir("check_every"), cache = temp_dir("check_cache");
+  run(tops, {"solver.model=\"reduced\""}, cache.string());
+  run(every, {"solver.model=\"reduced\"", "solver.reduced_check_at=\"reports\""}, cache.string());
+  EXPECT_EQ(summary(tops)["reduced_model"]["fallback"], "none");
+  EXPECT_EQ(summary(every)["reduced_model"]["fallback"], "none");
+  int n_tops = 0, n_every = 0, loaded = 0;
+  for (const auto& r : check_rows(tops)) n_tops += std::isnan(r[5]) ? 0 : 1;
+  for (const auto& r : check_rows(every)) {
+    loaded += r[2] > 0.0 ? 1 : 0;
+    if (r[2] > 0.0) {
+      ASSERT_FALSE(std::isnan(r[5])) << "a loaded report at t = " << r[1] << " s";
+      EXPECT_LT(std::abs(r[5]), 0.1) << "t = " << r[1] << " s";
+      ++n_every;
+    }
+  }
+  EXPECT_EQ(n_tops, 2);
+  EXPECT_EQ(n_every, loaded);
+  EXPECT_GE(loaded, 18);
+  EXPECT_NE(error_of([&] { run(tops, {"solver.model=\"reduced\"", "solver.reduced_check_at=\"some\""}); }).find("solver.reduced_check_at"),
+            std::string::npos);
+}
+
 TEST(SimulateReduced, BadReducedKeysAreErrors) {
   const fs::path dir = temp_dir("bad");
   EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"tiny\""}); }).find("solver.model"), std::string::npos);
