@@ -40,16 +40,6 @@ bool has_history(const Model& m) {
 
 }  // namespace
 
-double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa) {
-  constexpr double kProtocolHeadroom = 1.1;  // overshoot and sensor noise above the commanded peak
-  constexpr double kProtocolLowest = 0.8;    // a recording peaking lower follows a protocol of its own
-  if (scene_peak_Pa > 0.0 && recorded_peak_Pa >= kProtocolLowest * scene_peak_Pa &&
-      recorded_peak_Pa <= kProtocolHeadroom * scene_peak_Pa)
-    return kProtocolHeadroom * scene_peak_Pa;
-  const double p = std::max(recorded_peak_Pa, 1e3);
-  const double step = 0.5 * std::pow(10.0, std::floor(std::log10(p)));  // 5 kPa for 10-100 kPa
-  return step * std::ceil(p / step);
-}
 
 PathModelEvaluator::PathModelEvaluator(const Scene& base, const Recording& rec, const std::vector<ComparedFrame>& frames,
                            int rom_points, const Scene* mesh_scene, const std::string& cache_dir)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "analysis/measurements.h"
+#include "app/simulate/drive.h"
 #include "analysis/model_vs_measured.h"
 #include "engine/load_history.h"
 #include "engine/path_model.h"
@@ -20,22 +21,6 @@
 
 namespace pneufem::diagnose_detail {
 
-/// The peak pressure (Pa) diagnose's elastic FEM work is done for, and so the pressure its cache
-/// entries are keyed by: the reduced model's path is traced to 1.8 x it (softened models reach
-/// angles the elastic one reaches only above the peak), the static curves and the calibration
-/// mesh's pressure map span [0, it]. It must cover every recorded pressure AND be the same for
-/// every recording of one protocol, whose measured peaks differ by the controller's overshoot and
-/// the sensor noise (keyed by the exact measured peak, a second recording of the same protocol
-/// never found the first one's entries; issue 28). So:
-///  * a recording whose peak lies within [0.8, 1.1] x the scene's commanded peak follows the
-///    scene's protocol: 1.1 x the commanded peak (10 % headroom: synth's controller overshoots a
-///    10 kPa step by ~7 %, 0.7 kPa, and the sensor noise is ~0.1 kPa), the same for all of them;
-///  * any other recording (its own protocol, not the scene's): its peak rounded UP to a grid of
-///    half its leading power of ten (5 kPa for peaks of 10-100 kPa), so noisy peaks share a key
-///    unless they straddle a grid line. Why not always the grid: a protocol peak on a grid line
-///    (45 kPa -> 50 kPa) would put half of its noisy recordings on either side of it.
-/// `scene_peak_Pa` <= 0 (no protocol in the scene) means the second rule.
-double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa);
 
 /// Reduced-model replay of a recording for any variant of the base scene (same mesh).
 ///

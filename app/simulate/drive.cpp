@@ -291,7 +291,8 @@ using StateObserver = std::function<void(const StateRecord&, const Eigen::Vector
 std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory& load, const DriveOptions& opt,
                           const StateObserver& observe, DriveResult& result) {
   if (opt.progress) std::fprintf(stderr, "  reduced model: elastic path and basis ...\n");
-  const double peak_Pa = std::max(opt.reduced_peak_Pa, peak_pressure(load));
+  // The scene's own protocol (bm.load before the recording replaces it) and the recording's peak.
+  const double peak_Pa = std::max(opt.reduced_peak_Pa, elastic_reference_peak_Pa(peak_pressure(bm.load), peak_pressure(load)));
   const std::unique_ptr<ReducedSetup> setup = reduced_setup(scene, peak_Pa, bm.solver.reduced, opt.cache_dir);
   result.reduced_offline_s = setup->offline_s;
   result.reduced_basis_source = setup->basis_source;
@@ -313,6 +314,17 @@ std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory&
   return "";
 }
 }  // namespace
+
+double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa) {
+  constexpr double kProtocolHeadroom = 1.1;  // overshoot and sensor noise above the commanded peak
+  constexpr double kProtocolLowest = 0.8;    // a recording peaking lower follows a protocol of its own
+  if (scene_peak_Pa > 0.0 && recorded_peak_Pa >= kProtocolLowest * scene_peak_Pa &&
+      recorded_peak_Pa <= kProtocolHeadroom * scene_peak_Pa)
+    return kProtocolHeadroom * scene_peak_Pa;
+  const double p = std::max(recorded_peak_Pa, 1e3);
+  const double step = 0.5 * std::pow(10.0, std::floor(std::log10(p)));  // 5 kPa for 10-100 kPa
+  return step * std::ceil(p / step);
+}
 
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();

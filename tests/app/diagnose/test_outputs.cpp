@@ -96,7 +96,6 @@ class DiagnoseOutputs : public ::testing::Test {
 // for 10-100 kPa). Always at or above the recorded peak. The hidden datasets peak at 30.93 kPa on a
 // 30 kPa protocol (7 % overshoot of a 10 kPa step).
 TEST(ElasticReferencePeak, SameForEveryRecordingOfOneProtocolAndAboveItsPeak) {
-  using diagnose_detail::elastic_reference_peak_Pa;
   EXPECT_DOUBLE_EQ(elastic_reference_peak_Pa(30e3, 30.93e3), 33e3);
   EXPECT_DOUBLE_EQ(elastic_reference_peak_Pa(30e3, 30.10e3), 33e3);
   EXPECT_DOUBLE_EQ(elastic_reference_peak_Pa(30e3, 30e3), 33e3);       // angles only: the scene's pressure
