@@ -142,24 +142,33 @@ const std::string& Scene::default_text() {
 }
 
 Scene Scene::load(const std::string& path, const std::vector<std::string>& overrides) {
+  if (path.empty()) return from_text("", "", overrides);
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open scene file '" + path + "': check the path");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  Scene s = parse(buf.str(), path, std::filesystem::absolute(path).parent_path().string());
+  s.path_ = path;
+  return s.with(overrides);
+}
+
+Scene Scene::from_text(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
+  Scene s = parse(text, source, std::filesystem::current_path().string());
+  return s.with(overrides);
+}
+
+Scene Scene::parse(const std::string& text, const std::string& source, const std::string& dir) {
   auto impl = std::make_shared<Impl>();
   impl->table = parse_text(default_text(), kDefaultOrigin);
-  Scene s;
-  s.path_ = path;
-  if (!path.empty()) {
-    std::ifstream in(path);
-    if (!in) throw InputError("cannot open scene file '" + path + "': check the path");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    const toml::table user = parse_text(buf.str(), path);
+  if (!source.empty()) {
+    const toml::table user = parse_text(text, source);
     check_known(user, impl->table, "");
     merge(impl->table, user, "", impl->origins);
-    impl->dir = std::filesystem::absolute(path).parent_path().string();
-  } else {
-    impl->dir = std::filesystem::current_path().string();
   }
+  impl->dir = dir;
+  Scene s;
   s.impl_ = impl;
-  return s.with(overrides);
+  return s;
 }
 
 Scene Scene::with(const std::vector<std::string>& overrides) const {
