@@ -1,0 +1,37 @@
+// Fuzz target: a scene file (TOML) into the typed scene — the reader (scenes/scene.h, in memory:
+// Scene::from_text), the typed settings (scenes/scene_settings.h), every material with its effects
+// (make_material), the pressure lag and the load history of the staircase (inlet_load,
+// chamber_load: no mesh), and the resolved scene written back (to_toml, to_json). Meshing is not
+// fuzzed here (seconds per input); a deck is the inp target's. A load.csv protocol would read a
+// file the fuzzer names, so it stops after the settings. InputError is the documented answer to
+// bad input; anything else is a finding.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "core/errors.h"
+#include "scenes/build_model.h"
+#include "scenes/pressure_lag.h"
+#include "scenes/scene.h"
+#include "scenes/scene_settings.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const pneufem::Scene scene = pneufem::Scene::from_text(text, "fuzz.toml");
+    (void)scene.to_toml();
+    (void)scene.to_json();
+    (void)pneufem::mesh_settings(scene);
+    (void)pneufem::solver_settings(scene);
+    (void)pneufem::output_settings(scene);
+    for (const std::string& m : scene.table_keys("materials")) (void)pneufem::make_material(scene, m);
+    (void)pneufem::scene_pressure_lag(scene);
+    if (pneufem::load_settings(scene).protocol == pneufem::LoadSettings::Protocol::Staircase) {
+      (void)pneufem::inlet_load(scene);
+      (void)pneufem::chamber_load(scene);
+    }
+    (void)pneufem::elastic_reference_scene(scene).model_toml();
+  } catch (const pneufem::InputError&) {
+  }
+  return 0;
+}
