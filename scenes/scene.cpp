@@ -111,7 +111,8 @@ void merge(toml::table& dst, const toml::table& src, const std::string& prefix, 
       }
       merge(dt, st, key, origins);
     } else {
-      v.visit([&](auto&& node) { dst.insert_or_assign(k.str(), node); });
+      const std::string_view name = k.str();  // a named copy: clang 14 cannot capture a structured binding
+      v.visit([&](auto&& node) { dst.insert_or_assign(name, node); });
       record(origins, key, v);
     }
   }
