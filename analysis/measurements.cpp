@@ -186,6 +186,11 @@ class CanonicalReader {
     if (rows == 0)
       csv::fail(source_, line.number + 1, 1, "no data rows after the header",
                 "add one row per sample: trial,time_s,pressure_kPa,angle_deg");
+    if (trials_.empty())
+      csv::fail(source_, first_skipped, 1,
+                "no samples: none of the " + std::to_string(rows) + " data row(s) has " +
+                    (no_pressure_column_ ? "an angle_deg" : "a pressure_kPa or angle_deg") + " value",
+                "fill the pressure and angle cells (a row may leave one of them empty, not both)");
 
     Recording rec;
     rec.source = source_;

@@ -185,6 +185,21 @@ TEST(MeasurementsCsvErrors, MessagesNameFileLineAndColumn) {
   }
 }
 
+// Found by fuzz/fuzz_measurements: a file whose every data row has neither a pressure nor an angle
+// (each row skipped with a warning) was read as a recording of no trials, without an error; the
+// reader now names the first such row (the fuzzer's input is fuzz/corpus/measurements/no_samples_*).
+TEST(MeasurementsCsvErrors, RowsWithoutAnySampleAreAnErrorNotAnEmptyRecording) {
+  const std::string h = "trial,time_s,pressure_kPa,angle_deg\n";
+  EXPECT_EQ(error_of(h + "1,0,,\n\n1,0.1,,\n").rfind(
+                "data.csv:2:1: no samples: none of the 2 data row(s) has a pressure_kPa or angle_deg value; ", 0),
+            0u);
+  EXPECT_EQ(error_of("Time_s,Trial,Angle_deg,note,PRESSUZE_KPA\n0,2,,0.04,x\n")
+                .rfind("data.csv:2:1: no samples: none of the 1 data row(s) has an angle_deg value; ", 0),
+            0u);
+  // One row with a sample is enough; the others are skipped with the warning, as before.
+  EXPECT_EQ(parse_measurements_csv(h + "1,0,,\n1,0.1,,2\n", "data.csv").trials.size(), 1u);
+}
+
 // Recordings made by other tools name their columns with units in brackets or in other units: the
 // reader converts those it knows exactly (and says so), so nobody has to edit the file.
 TEST(MeasurementsCsv, ColumnsInOtherUnitsAreConvertedAndReported) {
