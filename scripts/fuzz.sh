@@ -29,8 +29,10 @@ run_one() {
   local t=$1 exe="$build/fuzz/fuzz_$1"
   [ -x "$exe" ] || { echo "fuzz: $exe not built (configure with -DPNEUFEM_FUZZ=ON)"; return 2; }
   mkdir -p "$work/$t"
+  local dict=()
+  [ -f "fuzz/$t.dict" ] && dict=(-dict="fuzz/$t.dict")
   # stdin from /dev/null: a deck that *INCLUDEs /dev/stdin must not wait for a terminal.
-  "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "${dict[@]}" \
     -artifact_prefix="$work/artifacts/$t-" "$work/$t" "fuzz/corpus/$t" </dev/null >"$work/$t.log" 2>&1
 }
 
