@@ -10,6 +10,7 @@
 
 #include "analysis/deeplabcut.h"
 #include "core/errors.h"
+#include "fuzz/report.h"
 
 namespace {
 
@@ -46,7 +47,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (i > 0 && !(s.t_s[i] > s.t_s[i - 1])) std::abort();
       }
     }
-  } catch (const pneufem::InputError&) {
+    pneufem::fuzz::report("accepted");
+  } catch (const pneufem::InputError& e) {
+    pneufem::fuzz::report("error", e.what());
   }
   return 0;
 }

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "fuzz/report.h"
 #include "scenes/inp/deck.h"
 
 namespace {
@@ -93,10 +94,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   pneufem::InpDeck deck;
   try {
     deck = pneufem::read_inp(path, 1e-3);
-  } catch (const pneufem::InputError&) {
+  } catch (const pneufem::InputError& e) {
+    pneufem::fuzz::report("error", e.what());
     return 0;
   }
   check(deck);
   check_round_trip(deck, path);
+  pneufem::fuzz::report("accepted");
   return 0;
 }

@@ -10,6 +10,7 @@
 
 #include "analysis/measurements.h"
 #include "core/errors.h"
+#include "fuzz/report.h"
 
 namespace {
 
@@ -28,7 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   pneufem::Recording rec;
   try {
     rec = pneufem::parse_measurements_csv(text, "fuzz.csv");
-  } catch (const pneufem::InputError&) {
+  } catch (const pneufem::InputError& e) {
+    pneufem::fuzz::report("error", e.what());
     return 0;
   }
   for (std::size_t i = 0; i < rec.trials.size(); ++i) {
@@ -47,5 +49,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         a.angle_deg.value != b.angle_deg.value)
       std::abort();
   }
+  pneufem::fuzz::report("accepted");
   return 0;
 }

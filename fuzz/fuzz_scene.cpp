@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "fuzz/report.h"
 #include "scenes/build_model.h"
 #include "scenes/pressure_lag.h"
 #include "scenes/scene.h"
@@ -40,7 +41,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       (void)pneufem::chamber_load(scene);
     }
     (void)pneufem::elastic_reference_scene(scene).model_toml();
-  } catch (const pneufem::InputError&) {
+    pneufem::fuzz::report("accepted");
+  } catch (const pneufem::InputError& e) {
+    pneufem::fuzz::report("error", e.what());
   }
   return 0;
 }
