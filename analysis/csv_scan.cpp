@@ -111,12 +111,25 @@ Number parse_int(std::string_view field, long& value) {
   return Number::ok;
 }
 
-std::string quoted(std::string_view field) {
-  std::string out(1, '\'');
-  out += field.size() > 40 ? std::string(field.substr(0, 37)) + "..." : std::string(field);
-  out += '\'';
-  return out;
+std::string printable(std::string_view text, std::size_t max_chars) {
+  const bool cut = text.size() > max_chars;
+  if (cut) text = text.substr(0, max_chars - 3);
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7F) {
+      static const char* const kHex = "0123456789ABCDEF";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return cut ? out + "..." : out;
 }
+
+std::string quoted(std::string_view field) { return "'" + printable(field, 40) + "'"; }
 
 std::string number_text(double v) {
   char buf[64];
