@@ -97,7 +97,7 @@ class DeckReader {
   std::string at(const Loc& loc) const { return where(loc) + ": " + context_; }
 
   [[noreturn]] void fail(const Loc& loc, const std::string& what, const std::string& todo) const {
-    throw InputError(at(loc) + what + "; " + todo);
+    throw InputError(inp::printable(at(loc) + what + "; " + todo));
   }
 
   /// Adds `message` to the warnings unless a warning with the same key was already given.

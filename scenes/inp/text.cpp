@@ -62,6 +62,23 @@ std::string lower(std::string_view s) {
   return out;
 }
 
+std::string printable(std::string_view message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\n') || u == 0x7F) {
+      static const char* const kHex = "0123456789ABCDEF";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 void split_fields(std::string_view line, std::vector<std::string_view>& fields, bool& trailing_comma) {
   fields.clear();
   line = trim(line);
@@ -157,9 +174,9 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
   std::error_code ec;
   if (!fs::is_directory(path, ec)) in.open(path, std::ios::binary);
   if (!in) {
-    if (!from) throw InputError(path + ": cannot open the deck; check the path and the file permissions");
-    throw InputError(where(*from) + ": cannot open include file '" + path +
-                     "'; check INPUT= (a relative path is taken from the directory of the including file)");
+    if (!from) throw InputError(printable(path + ": cannot open the deck; check the path and the file permissions"));
+    throw InputError(printable(where(*from) + ": cannot open include file '" + path +
+                     "'; check INPUT= (a relative path is taken from the directory of the including file)"));
   }
   in.seekg(0, std::ios::end);
   const std::streamoff size = std::max<std::streamoff>(in.tellg(), 0);
@@ -168,9 +185,9 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
   if (bytes_read_ > kMaxDeckBytes) {
     const std::string what = "the deck's text reaches " + mebibytes(bytes_read_) + " with " + path +
                              ", over the limit of " + mebibytes(kMaxDeckBytes) + " (a file counts each time it is included)";
-    if (!from) throw InputError(path + ": " + what + "; split the model or coarsen the mesh");
-    throw InputError(where(*from) + ": " + what + "; include chain " + include_chain(path) +
-                     "; include each file once");
+    if (!from) throw InputError(printable(path + ": " + what + "; split the model or coarsen the mesh"));
+    throw InputError(printable(where(*from) + ": " + what + "; include chain " + include_chain(path) +
+                     "; include each file once"));
   }
   std::string text;
   if (size > 0) {
@@ -215,7 +232,7 @@ void LineSource::include(std::string_view text, const Loc& loc) {
   const Keyword kw = parse_keyword(text);
   const std::string input = kw.get("INPUT");
   auto fail = [&](const std::string& what, const std::string& todo) {
-    throw InputError(where(loc) + ": " + what + "; " + todo);
+    throw InputError(printable(where(loc) + ": " + what + "; " + todo));
   };
   if (input.empty()) fail("*INCLUDE without INPUT=<file>", "add INPUT=<path of the file to include>");
   fs::path p(input);
