@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem::csv {
 
@@ -109,24 +110,6 @@ Number parse_int(std::string_view field, long& value) {
   if (d != std::floor(d) || std::abs(d) > 1e15) return Number::not_a_number;
   value = static_cast<long>(d);
   return Number::ok;
-}
-
-std::string printable(std::string_view text, std::size_t max_chars) {
-  const bool cut = text.size() > max_chars;
-  if (cut) text = text.substr(0, max_chars - 3);
-  std::string out;
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7F) {
-      static const char* const kHex = "0123456789ABCDEF";
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    } else {
-      out += c;
-    }
-  }
-  return cut ? out + "..." : out;
 }
 
 std::string quoted(std::string_view field) { return "'" + printable(field, 40) + "'"; }

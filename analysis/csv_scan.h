@@ -51,12 +51,8 @@ Number parse_double(std::string_view field, double& value);
 /// accepted, "3.5" is not_a_number.
 Number parse_int(std::string_view field, long& value);
 
-/// `text` for an error message: control bytes (a NUL of a UTF-16 file, a lone CR, escape
-/// sequences) written as \xHH, so the message is one line that a terminal shows as it is and that
-/// no NUL cuts short (InputError::what() is a C string); longer than `max_chars`, cut with "...".
-std::string printable(std::string_view text, std::size_t max_chars);
-
-/// A field shortened to at most 40 characters, printable and quoted, for error messages.
+/// A field shortened to at most 40 characters, printable (core/message_text.h) and quoted, for
+/// error messages.
 std::string quoted(std::string_view field);
 
 /// Shortest text that reads back to exactly `v` (std::to_chars).

@@ -14,6 +14,7 @@
 #include "analysis/csv_scan.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem {
 
@@ -72,7 +73,7 @@ const std::string* header_with_stem(const std::vector<std::string>& names, const
 /// pressure_kPa) was probably meant, with another unit or none.
 std::string missing_column_hint(const std::string& required, const std::vector<std::string>& names) {
   if (const std::string* n = header_with_stem(names, required))
-    return "the header has '" + csv::printable(*n, 40) + "': rename it to " + required +
+    return "the header has '" + printable(*n, 40) + "': rename it to " + required +
            " (the unit is part of the name; convert the values if they are in another unit; units read and "
            "converted: time_s, time_ms, time_min; pressure_kPa, pressure_Pa, pressure_hPa, pressure_mbar, "
            "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
@@ -241,7 +242,7 @@ class CanonicalReader {
       column_[c] = static_cast<int>(i);
       scale_[c] = factor;
       if (factor != 1.0)
-        conversions_.push_back(source_ + ": column '" + csv::printable(header_names_[i], 40) + "' read as " + kColumns[c] +
+        conversions_.push_back(source_ + ": column '" + printable(header_names_[i], 40) + "' read as " + kColumns[c] +
                                " (values times " + csv::number_text(factor) + ")");
     }
     if (column_[kTrial] < 0 && column_[kTime] >= 0) {
@@ -263,7 +264,7 @@ class CanonicalReader {
       std::string have;
       for (const std::string& n : header_names_) have += (have.empty() ? "" : ",") + n;
       csv::fail(source_, line.number, 1,
-                "missing column '" + std::string(kColumns[c]) + "' (the header is '" + csv::printable(have, 120) + "')",
+                "missing column '" + std::string(kColumns[c]) + "' (the header is '" + printable(have, 120) + "')",
                 missing_column_hint(kColumns[c], names));
     }
     width_ = fields_.size();
@@ -271,7 +272,7 @@ class CanonicalReader {
 
   /// The header's spelling of a column, for messages.
   std::string column_name(std::size_t field) const {
-    return field < header_names_.size() && !header_names_[field].empty() ? csv::printable(header_names_[field], 40)
+    return field < header_names_.size() && !header_names_[field].empty() ? printable(header_names_[field], 40)
                                                                          : "field " + std::to_string(field + 1);
   }
 

@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 #include "core/number_text.h"
 #include "scenes/default_scene_text.h"
 #include "scenes/effect_tables.h"
@@ -67,7 +68,7 @@ void check_known(const toml::table& user, const toml::table& defaults, const std
       std::string msg = origin_of(v) + ": key '" + key + "': unknown key";
       if (!best.empty()) msg += "; did you mean '" + (prefix.empty() ? best : prefix + "." + best) + "'?";
       msg += " (`pneufem scene --defaults` lists every key)";
-      throw InputError(msg);
+      throw InputError(printable(msg));
     }
     if (v.is_table() && d->is_table() && !free_form(key)) check_known(*v.as_table(), *d->as_table(), key);
     if (key == "parts" && v.is_array()) {
@@ -75,8 +76,8 @@ void check_known(const toml::table& user, const toml::table& defaults, const std
         if (!item.is_table()) throw InputError(origin_of(item) + ": 'parts' must be an array of tables ([[parts]])");
         for (auto&& [pk, pv] : *item.as_table())
           if (pk.str() != "elset" && pk.str() != "material")
-            throw InputError(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
-                             "': unknown key; a part has 'elset' and 'material'");
+            throw InputError(printable(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
+                                       "': unknown key; a part has 'elset' and 'material'"));
       }
     }
   }
@@ -237,7 +238,7 @@ std::string Scene::origin(const std::string& key) const {
 }
 
 void Scene::fail(const std::string& key, const std::string& what) const {
-  throw SceneKeyError(origin(key) + ": key '" + key + "': " + what);
+  throw SceneKeyError(printable(origin(key) + ": key '" + key + "': " + what));
 }
 
 double Scene::checked(const std::string& key, double v, const std::string& entry) const {

@@ -17,11 +17,6 @@ std::string_view trim(std::string_view s);
 std::string upper(std::string_view s);
 std::string lower(std::string_view s);
 
-/// `message` with its control bytes but the line break (a NUL, a lone CR, a terminal escape:
-/// deck text quoted into a message) written as \xHH: InputError::what() is a C string that a NUL
-/// would cut short, before the advice. Every error and warning of the reader passes through it.
-std::string printable(std::string_view message);
-
 /// Splits a data or keyword line at commas into trimmed fields. A trailing comma (Abaqus:
 /// "continued on the next line") does not produce an empty last field; it is reported instead.
 void split_fields(std::string_view line, std::vector<std::string_view>& fields, bool& trailing_comma);

@@ -39,6 +39,18 @@ TEST(SceneSettings, UnknownMeshSourceNamesTheKeyAndTheSources) {
   EXPECT_EQ(error_of([&] { build_mesh(s); }), msg);
 }
 
+// A scene's text quoted in a message (a key, a string value) may hold a NUL or a terminal escape
+// (TOML strings allow \u0000): InputError::what() is a C string that a NUL cut short, before the
+// rest of the message; control bytes are now written as \xHH (as the deck and CSV readers do).
+TEST(SceneSettings, ControlBytesInKeysAndValuesDoNotCutTheMessageShort) {
+  std::string msg = error_of([] { Scene::from_text("\"a\\u0000b\" = 1\n", "s.toml"); });
+  EXPECT_EQ(msg.rfind("s.toml:1: key 'a\\x00b': unknown key (`pneufem scene --defaults` lists every key)", 0), 0u)
+      << msg;
+  msg = error_of([] { mesh_settings(Scene::from_text("[mesh]\nsource = \"gm\\u0000sh\\u001b[2J\"\n", "s.toml")); });
+  EXPECT_NE(msg.find("s.toml:2:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("got \"gm\\x00sh\\x1B[2J\""), std::string::npos) << msg;
+}
+
 TEST(SceneSettings, LoadProtocolAndRest) {
   const Scene base = Scene::load("");
   const LoadSettings l = load_settings(base.with({"load.rest_s=12.5"}));
