@@ -4,8 +4,9 @@
     fuzz/count_outcomes.py BUILD_DIR/fuzz/fuzz_inp DIR [DIR...]
 
 Replays the corpus with PNEUFEM_FUZZ_REPORT=1 (fuzz/report.h) and counts the inputs read, the
-inputs refused with a clear message (it names where - "<file>:<line>", a scene key or a --set - and
-says what to do after "; "), and the others, a few of which are printed. A crash stops the replay
+inputs refused with a clear message (it names where - "<file>:<line>", an element or node, a scene
+key or a --set - and says what to do: after "; " or as an example, "e.g."), and the others, a few of
+which are printed. A crash stops the replay
 and is reported by libFuzzer as usual."""
 import re
 import subprocess
@@ -16,7 +17,7 @@ exe, dirs = sys.argv[1], sys.argv[2:]
 env = dict(os.environ, PNEUFEM_FUZZ_REPORT="1")
 out = subprocess.run([exe, "-runs=0", *dirs], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                      text=True, errors="replace").stdout
-where = re.compile(r"^(\S+:\d+|--set |[^:]*: key '|default scene: key ')")
+where = re.compile(r"^(\S+:\d+|--set |[^:]*: key '|default scene: key ')|\b(element|node) \S*\d")
 accepted = clear = unclear = 0
 examples = []
 for line in out.split("\n"):
@@ -27,7 +28,7 @@ for line in out.split("\n"):
         accepted += 1
         continue
     msg = rest[len("error "):]
-    if where.search(msg) and "; " in msg:
+    if where.search(msg) and ("; " in msg or "e.g." in msg):
         clear += 1
     else:
         unclear += 1
