@@ -5,7 +5,8 @@
 
 Replays the corpus with PNEUFEM_FUZZ_REPORT=1 (fuzz/report.h) and counts the inputs read, the
 inputs refused with a clear message (it names where - "<file>:<line>", an element or node, a scene
-key or a --set - and says what to do: after "; " or as an example, "e.g."), and the others, a few of
+key or a --set - and says what to do or what is allowed: after "; ", an example ("e.g."), the
+values allowed ("must be", "allowed", "expected") or where to find them), and the others, a few of
 which are printed. A crash stops the replay
 and is reported by libFuzzer as usual."""
 import re
@@ -28,7 +29,7 @@ for line in out.split("\n"):
         accepted += 1
         continue
     msg = rest[len("error "):]
-    if where.search(msg) and ("; " in msg or "e.g." in msg):
+    if where.search(msg) and re.search(r"; |e\.g\.|lists every key|must be|allowed|expected", msg):
         clear += 1
     else:
         unclear += 1

@@ -125,8 +125,9 @@ toml::table parse_text(const std::string& text, const std::string& origin) {
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << origin << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description()
-      << " (TOML syntax error)";
-    throw InputError(s.str());
+      << " (TOML syntax error); fix the text there: one key = value per line, strings in double quotes, "
+         "tables as [name] (https://toml.io)";
+    throw InputError(printable(s.str()));
   }
 }
 
@@ -179,7 +180,7 @@ Scene Scene::with(const std::vector<std::string>& overrides) const {
   for (const std::string& ov : overrides) {
     const auto eq = ov.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw InputError("--set " + ov + ": expected key=value, e.g. --set load.trials=10");
+      throw InputError(printable("--set " + ov + ": expected key=value, e.g. --set load.trials=10"));
     const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
     const std::string origin = "--set " + key;
     toml::table parsed;
@@ -241,6 +242,22 @@ void Scene::fail(const std::string& key, const std::string& what) const {
   throw SceneKeyError(printable(origin(key) + ": key '" + key + "': " + what));
 }
 
+void Scene::fail_missing(const std::string& key) const {
+  // A key the default scene has is never missing: the user's own table lacks it (a material of
+  // their own without `model`), or replaced the table by a value (--set load=3). Name where that
+  // table was set: the key's origin, else where a key beside it in its table (not a top-level
+  // table, whose other keys say nothing about this one) was set.
+  std::string where = origin(key);
+  for (std::string k = key; where == kDefaultOrigin;) {
+    const auto dot = k.find_last_of('.');
+    if (dot == std::string::npos || k.find('.') == dot) break;
+    k = k.substr(0, dot);
+    const auto it = impl_->origins.lower_bound(k + ".");
+    if (it != impl_->origins.end() && it->first.rfind(k + ".", 0) == 0) where = it->second;
+  }
+  throw SceneKeyError(printable(where + ": key '" + key + "': missing; add it (`pneufem scene --defaults` lists every key)"));
+}
+
 double Scene::checked(const std::string& key, double v, const std::string& entry) const {
   if (!std::isfinite(v)) fail(key, "got " + short_num(v) + entry + "; a value must be a finite number");
   const KeyLimit* limit = find_key_limit(key);
@@ -251,7 +268,7 @@ double Scene::checked(const std::string& key, double v, const std::string& entry
 
 double Scene::number(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   const std::optional<double> v = n->value<double>();
   if (!v || !(n->is_floating_point() || n->is_integer())) fail(key, "expected a number");
   return checked(key, *v, "");
@@ -259,7 +276,7 @@ double Scene::number(const std::string& key) const {
 
 int Scene::integer(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_integer()) {
     const std::optional<double> v = n->value<double>();
     fail(key, "expected an integer (no decimal point or exponent)" + (v ? ", got " + short_num(*v) : std::string()));
@@ -278,21 +295,21 @@ int Scene::integer(const std::string& key) const {
 
 bool Scene::boolean(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_boolean()) fail(key, "expected true or false");
   return *n->value<bool>();
 }
 
 std::string Scene::string(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_string()) fail(key, "expected a string (in quotes)");
   return *n->value<std::string>();
 }
 
 std::vector<double> Scene::numbers(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   const toml::array* a = n->as_array();
   if (!a) fail(key, "expected an array of numbers, e.g. [1.0, 2.0]");
   std::vector<double> out;
@@ -322,7 +339,7 @@ std::string Scene::string_entry(const std::string& table, const std::string& nam
   const std::string key = table + "." + name;
   const toml::node* t = impl_->table.at_path(table).node();
   const toml::node* n = t && t->is_table() ? t->as_table()->get(name) : nullptr;
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_string()) fail(key, "expected a string (in quotes)");
   return *n->value<std::string>();
 }

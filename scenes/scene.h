@@ -59,6 +59,8 @@ class Scene {
   std::string origin(const std::string& key) const;
   /// SceneKeyError (an InputError) prefixed with the key's origin.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  /// fail() for a key that is not in the scene, naming the table that lacks it.
+  [[noreturn]] void fail_missing(const std::string& key) const;
 
   /// Resolves a path given in the scene relative to the scene file's directory.
   std::string resolve_path(const std::string& p) const;
