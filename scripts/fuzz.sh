@@ -22,7 +22,9 @@ shift 2
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(inp scene measurements deeplabcut)
 work="$build/fuzz_work"
-mkdir -p "$work/artifacts"
+mkdir -p "$work/artifacts" "$work/tmp"
+# fuzz_inp's deck files go here, not to the shared /tmp.
+case "$work" in /*) export TMPDIR="$work/tmp" ;; *) export TMPDIR="$PWD/$work/tmp" ;; esac
 jobs=$(nproc)
 
 run_one() {
