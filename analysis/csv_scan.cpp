@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem::csv {
 
@@ -111,12 +112,7 @@ Number parse_int(std::string_view field, long& value) {
   return Number::ok;
 }
 
-std::string quoted(std::string_view field) {
-  std::string out(1, '\'');
-  out += field.size() > 40 ? std::string(field.substr(0, 37)) + "..." : std::string(field);
-  out += '\'';
-  return out;
-}
+std::string quoted(std::string_view field) { return "'" + printable(field, 40) + "'"; }
 
 std::string number_text(double v) {
   char buf[64];

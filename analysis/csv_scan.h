@@ -51,7 +51,8 @@ Number parse_double(std::string_view field, double& value);
 /// accepted, "3.5" is not_a_number.
 Number parse_int(std::string_view field, long& value);
 
-/// A field shortened to at most 40 characters and quoted, for error messages.
+/// A field shortened to at most 40 characters, printable (core/message_text.h) and quoted, for
+/// error messages.
 std::string quoted(std::string_view field);
 
 /// Shortest text that reads back to exactly `v` (std::to_chars).

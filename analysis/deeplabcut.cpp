@@ -8,6 +8,7 @@
 
 #include "analysis/csv_scan.h"
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem {
 
@@ -209,7 +210,7 @@ class DlcReader {
     static const std::array<const char*, 3> coord = {"x", "y", "likelihood"};
     for (const auto& [part, cols] : parts_)
       for (std::size_t c = 0; c < 3; ++c)
-        if (cols.xyl[c] == static_cast<int>(f)) return part + " " + coord[c];
+        if (cols.xyl[c] == static_cast<int>(f)) return printable(part, 40) + " " + coord[c];
     return "field " + std::to_string(f + 1);
   }
 
@@ -286,7 +287,8 @@ class DlcReader {
       PartColumns& pc = parts_[parts[f]];
       if (pc.xyl[static_cast<std::size_t>(c)] >= 0)
         csv::fail(source_, coords_line, static_cast<int>(f) + 1,
-                  "body part '" + parts[f] + "' has a second '" + coord + "' column (field " +
+                  "body part '" + printable(parts[f], 40) + "' has a second '" + printable(coord, 40) +
+                      "' column (field " +
                       std::to_string(pc.xyl[static_cast<std::size_t>(c)] + 1) + ")",
                   "a multi-animal file must track one actuator: export one individual, or rename the body parts");
       pc.xyl[static_cast<std::size_t>(c)] = static_cast<int>(f);
@@ -298,8 +300,8 @@ class DlcReader {
           std::string have;
           for (const auto& [part, cols] : parts_) have += (have.empty() ? "" : ", ") + part;
           csv::fail(source_, parts_line, 1,
-                    std::string(list) + " names body part '" + n + "', which is not in the file (it has: " + have +
-                        ")",
+                    std::string(list) + " names body part '" + n + "', which is not in the file (it has: " +
+                        printable(have, 120) + ")",
                     "use the body-part names of the DeepLabCut project (case-sensitive)");
         }
         for (std::size_t c = 0; c < 3; ++c)

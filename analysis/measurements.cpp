@@ -14,6 +14,7 @@
 #include "analysis/csv_scan.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem {
 
@@ -72,7 +73,7 @@ const std::string* header_with_stem(const std::vector<std::string>& names, const
 /// pressure_kPa) was probably meant, with another unit or none.
 std::string missing_column_hint(const std::string& required, const std::vector<std::string>& names) {
   if (const std::string* n = header_with_stem(names, required))
-    return "the header has '" + *n + "': rename it to " + required +
+    return "the header has '" + printable(*n, 40) + "': rename it to " + required +
            " (the unit is part of the name; convert the values if they are in another unit; units read and "
            "converted: time_s, time_ms, time_min; pressure_kPa, pressure_Pa, pressure_hPa, pressure_mbar, "
            "pressure_bar, pressure_MPa, pressure_psi; angle_deg, angle_rad)";
@@ -186,6 +187,11 @@ class CanonicalReader {
     if (rows == 0)
       csv::fail(source_, line.number + 1, 1, "no data rows after the header",
                 "add one row per sample: trial,time_s,pressure_kPa,angle_deg");
+    if (trials_.empty())
+      csv::fail(source_, first_skipped, 1,
+                "no samples: none of the " + std::to_string(rows) + " data row(s) has " +
+                    (no_pressure_column_ ? "an angle_deg" : "a pressure_kPa or angle_deg") + " value",
+                "fill the pressure and angle cells (a row may leave one of them empty, not both)");
 
     Recording rec;
     rec.source = source_;
@@ -236,7 +242,7 @@ class CanonicalReader {
       column_[c] = static_cast<int>(i);
       scale_[c] = factor;
       if (factor != 1.0)
-        conversions_.push_back(source_ + ": column '" + header_names_[i] + "' read as " + kColumns[c] +
+        conversions_.push_back(source_ + ": column '" + printable(header_names_[i], 40) + "' read as " + kColumns[c] +
                                " (values times " + csv::number_text(factor) + ")");
     }
     if (column_[kTrial] < 0 && column_[kTime] >= 0) {
@@ -258,7 +264,7 @@ class CanonicalReader {
       std::string have;
       for (const std::string& n : header_names_) have += (have.empty() ? "" : ",") + n;
       csv::fail(source_, line.number, 1,
-                "missing column '" + std::string(kColumns[c]) + "' (the header is '" + have + "')",
+                "missing column '" + std::string(kColumns[c]) + "' (the header is '" + printable(have, 120) + "')",
                 missing_column_hint(kColumns[c], names));
     }
     width_ = fields_.size();
@@ -266,7 +272,7 @@ class CanonicalReader {
 
   /// The header's spelling of a column, for messages.
   std::string column_name(std::size_t field) const {
-    return field < header_names_.size() && !header_names_[field].empty() ? header_names_[field]
+    return field < header_names_.size() && !header_names_[field].empty() ? printable(header_names_[field], 40)
                                                                          : "field " + std::to_string(field + 1);
   }
 

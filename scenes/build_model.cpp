@@ -419,8 +419,15 @@ LoadHistory inlet_load(const Scene& s) {
                  short_num(size.levels) + " levels x " + short_num(size.reports / (trials * size.levels)) +
                  " per level); the limit is " + short_num(kMaxReports) +
                  "; report less often (load.output_every_s) or run fewer trials");
-    load = staircase(p_max, dp, hold_s, s.number("load.ramp_s"), trials, s.number("load.mark_s"),
-                     settings.rest_s, every_s);
+    // The keys that must agree with each other, with where they were set (staircase() checks them
+    // too, but knows no scene).
+    const double ramp_s = s.number("load.ramp_s"), mark_s = s.number("load.mark_s");
+    if (!(ramp_s < hold_s))
+      s.fail("load.ramp_s", "got " + short_num(ramp_s) + "; it must be shorter than load.hold_s = " + short_num(hold_s));
+    if (!(mark_s >= ramp_s && mark_s <= hold_s))
+      s.fail("load.mark_s", "got " + short_num(mark_s) + "; the mark must lie within the hold, after the ramp: from " +
+                                "load.ramp_s = " + short_num(ramp_s) + " to load.hold_s = " + short_num(hold_s) + " s");
+    load = staircase(p_max, dp, hold_s, ramp_s, trials, mark_s, settings.rest_s, every_s);
   } else {  // LoadSettings::Protocol::Csv
     const std::string csv = s.string("load.csv");
     if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");

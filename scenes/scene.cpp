@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 #include "core/number_text.h"
 #include "scenes/default_scene_text.h"
 #include "scenes/effect_tables.h"
@@ -67,7 +68,7 @@ void check_known(const toml::table& user, const toml::table& defaults, const std
       std::string msg = origin_of(v) + ": key '" + key + "': unknown key";
       if (!best.empty()) msg += "; did you mean '" + (prefix.empty() ? best : prefix + "." + best) + "'?";
       msg += " (`pneufem scene --defaults` lists every key)";
-      throw InputError(msg);
+      throw InputError(printable(msg));
     }
     if (v.is_table() && d->is_table() && !free_form(key)) check_known(*v.as_table(), *d->as_table(), key);
     if (key == "parts" && v.is_array()) {
@@ -75,8 +76,8 @@ void check_known(const toml::table& user, const toml::table& defaults, const std
         if (!item.is_table()) throw InputError(origin_of(item) + ": 'parts' must be an array of tables ([[parts]])");
         for (auto&& [pk, pv] : *item.as_table())
           if (pk.str() != "elset" && pk.str() != "material")
-            throw InputError(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
-                             "': unknown key; a part has 'elset' and 'material'");
+            throw InputError(printable(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
+                                       "': unknown key; a part has 'elset' and 'material'"));
       }
     }
   }
@@ -111,7 +112,8 @@ void merge(toml::table& dst, const toml::table& src, const std::string& prefix, 
       }
       merge(dt, st, key, origins);
     } else {
-      v.visit([&](auto&& node) { dst.insert_or_assign(k.str(), node); });
+      const std::string_view name = k.str();  // a named copy: clang 14 cannot capture a structured binding
+      v.visit([&](auto&& node) { dst.insert_or_assign(name, node); });
       record(origins, key, v);
     }
   }
@@ -123,8 +125,9 @@ toml::table parse_text(const std::string& text, const std::string& origin) {
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << origin << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description()
-      << " (TOML syntax error)";
-    throw InputError(s.str());
+      << " (TOML syntax error); fix the text there: one key = value per line, strings in double quotes, "
+         "tables as [name] (https://toml.io)";
+    throw InputError(printable(s.str()));
   }
 }
 
@@ -142,24 +145,33 @@ const std::string& Scene::default_text() {
 }
 
 Scene Scene::load(const std::string& path, const std::vector<std::string>& overrides) {
+  if (path.empty()) return from_text("", "", overrides);
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open scene file '" + path + "': check the path");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  Scene s = parse(buf.str(), path, std::filesystem::absolute(path).parent_path().string());
+  s.path_ = path;
+  return s.with(overrides);
+}
+
+Scene Scene::from_text(const std::string& text, const std::string& source, const std::vector<std::string>& overrides) {
+  Scene s = parse(text, source, std::filesystem::current_path().string());
+  return s.with(overrides);
+}
+
+Scene Scene::parse(const std::string& text, const std::string& source, const std::string& dir) {
   auto impl = std::make_shared<Impl>();
   impl->table = parse_text(default_text(), kDefaultOrigin);
-  Scene s;
-  s.path_ = path;
-  if (!path.empty()) {
-    std::ifstream in(path);
-    if (!in) throw InputError("cannot open scene file '" + path + "': check the path");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    const toml::table user = parse_text(buf.str(), path);
+  if (!source.empty()) {
+    const toml::table user = parse_text(text, source);
     check_known(user, impl->table, "");
     merge(impl->table, user, "", impl->origins);
-    impl->dir = std::filesystem::absolute(path).parent_path().string();
-  } else {
-    impl->dir = std::filesystem::current_path().string();
   }
+  impl->dir = dir;
+  Scene s;
   s.impl_ = impl;
-  return s.with(overrides);
+  return s;
 }
 
 Scene Scene::with(const std::vector<std::string>& overrides) const {
@@ -168,7 +180,7 @@ Scene Scene::with(const std::vector<std::string>& overrides) const {
   for (const std::string& ov : overrides) {
     const auto eq = ov.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw InputError("--set " + ov + ": expected key=value, e.g. --set load.trials=10");
+      throw InputError(printable("--set " + ov + ": expected key=value, e.g. --set load.trials=10"));
     const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
     const std::string origin = "--set " + key;
     toml::table parsed;
@@ -227,7 +239,23 @@ std::string Scene::origin(const std::string& key) const {
 }
 
 void Scene::fail(const std::string& key, const std::string& what) const {
-  throw SceneKeyError(origin(key) + ": key '" + key + "': " + what);
+  throw SceneKeyError(printable(origin(key) + ": key '" + key + "': " + what));
+}
+
+void Scene::fail_missing(const std::string& key) const {
+  // A key the default scene has is never missing: the user's own table lacks it (a material of
+  // their own without `model`), or replaced the table by a value (--set load=3). Name where that
+  // table was set: the key's origin, else where a key beside it in its table (not a top-level
+  // table, whose other keys say nothing about this one) was set.
+  std::string where = origin(key);
+  for (std::string k = key; where == kDefaultOrigin;) {
+    const auto dot = k.find_last_of('.');
+    if (dot == std::string::npos || k.find('.') == dot) break;
+    k = k.substr(0, dot);
+    const auto it = impl_->origins.lower_bound(k + ".");
+    if (it != impl_->origins.end() && it->first.rfind(k + ".", 0) == 0) where = it->second;
+  }
+  throw SceneKeyError(printable(where + ": key '" + key + "': missing; add it (`pneufem scene --defaults` lists every key)"));
 }
 
 double Scene::checked(const std::string& key, double v, const std::string& entry) const {
@@ -240,7 +268,7 @@ double Scene::checked(const std::string& key, double v, const std::string& entry
 
 double Scene::number(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   const std::optional<double> v = n->value<double>();
   if (!v || !(n->is_floating_point() || n->is_integer())) fail(key, "expected a number");
   return checked(key, *v, "");
@@ -248,7 +276,7 @@ double Scene::number(const std::string& key) const {
 
 int Scene::integer(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_integer()) {
     const std::optional<double> v = n->value<double>();
     fail(key, "expected an integer (no decimal point or exponent)" + (v ? ", got " + short_num(*v) : std::string()));
@@ -267,21 +295,21 @@ int Scene::integer(const std::string& key) const {
 
 bool Scene::boolean(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_boolean()) fail(key, "expected true or false");
   return *n->value<bool>();
 }
 
 std::string Scene::string(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_string()) fail(key, "expected a string (in quotes)");
   return *n->value<std::string>();
 }
 
 std::vector<double> Scene::numbers(const std::string& key) const {
   const toml::node* n = impl_->table.at_path(key).node();
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   const toml::array* a = n->as_array();
   if (!a) fail(key, "expected an array of numbers, e.g. [1.0, 2.0]");
   std::vector<double> out;
@@ -311,7 +339,7 @@ std::string Scene::string_entry(const std::string& table, const std::string& nam
   const std::string key = table + "." + name;
   const toml::node* t = impl_->table.at_path(table).node();
   const toml::node* n = t && t->is_table() ? t->as_table()->get(name) : nullptr;
-  if (!n) fail(key, "missing");
+  if (!n) fail_missing(key);
   if (!n->is_string()) fail(key, "expected a string (in quotes)");
   return *n->value<std::string>();
 }

@@ -28,6 +28,11 @@ class Scene {
   /// Loads `path` ("" = built-in default only) and applies `overrides` ("key=value", value in
   /// TOML syntax; bare words are taken as strings).
   static Scene load(const std::string& path, const std::vector<std::string>& overrides = {});
+  /// The same from scene text in memory (the fuzz target of fuzz/, tests): `source` names it in
+  /// messages, as a file's path would ("" = the built-in default only, `text` unused); relative
+  /// paths in it resolve from the current directory; path() is "".
+  static Scene from_text(const std::string& text, const std::string& source,
+                         const std::vector<std::string>& overrides = {});
   /// The built-in default scene text: scenes/data/default_scene.toml with the effect tables
   /// generated from the registry in place of its marker line (scenes/effect_tables.h).
   static const std::string& default_text();
@@ -54,6 +59,8 @@ class Scene {
   std::string origin(const std::string& key) const;
   /// SceneKeyError (an InputError) prefixed with the key's origin.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  /// fail() for a key that is not in the scene, naming the table that lacks it.
+  [[noreturn]] void fail_missing(const std::string& key) const;
 
   /// Resolves a path given in the scene relative to the scene file's directory.
   std::string resolve_path(const std::string& p) const;
@@ -77,6 +84,8 @@ class Scene {
   /// `v`, read from `key` (`entry` names a list's element in the message), if it is finite and in
   /// the key's declared range; else a failure with the value and the range.
   double checked(const std::string& key, double v, const std::string& entry) const;
+  /// The default scene merged with `text` (named `source`; "" = none), paths resolved from `dir`.
+  static Scene parse(const std::string& text, const std::string& source, const std::string& dir);
 
   struct Impl;
   std::shared_ptr<const Impl> impl_;

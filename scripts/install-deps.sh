@@ -7,6 +7,7 @@ PKGS=(
   libvtk9-dev libopenvdb-dev libboost-iostreams-dev
   libsuitesparse-dev libopenblas-dev libnlopt-cxx-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev
+  clang-14 libclang-rt-14-dev
 )
 missing=()
 for p in "${PKGS[@]}"; do

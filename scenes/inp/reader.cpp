@@ -469,7 +469,9 @@ InpDeck read_inp(const std::string& path, double length_to_m) {
   if (!(length_to_m > 0.0) || !std::isfinite(length_to_m))
     throw InputError(path + ": length_to_m = " + std::to_string(length_to_m) +
                      " is not a positive length; give the deck's length unit in metres (1e-3 for mm)");
-  return inp::DeckReader(path, length_to_m).read();
+  InpDeck deck = inp::DeckReader(path, length_to_m).read();
+  for (std::string& w : deck.warnings) w = printable(w);  // deck text quoted in a note, as in errors
+  return deck;
 }
 
 }  // namespace pneufem

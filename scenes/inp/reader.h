@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 #include "scenes/inp/assembly.h"
 #include "scenes/inp/deck.h"
 #include "scenes/inp/solid_split.h"
@@ -97,7 +98,7 @@ class DeckReader {
   std::string at(const Loc& loc) const { return where(loc) + ": " + context_; }
 
   [[noreturn]] void fail(const Loc& loc, const std::string& what, const std::string& todo) const {
-    throw InputError(at(loc) + what + "; " + todo);
+    throw InputError(printable(at(loc) + what + "; " + todo));
   }
 
   /// Adds `message` to the warnings unless a warning with the same key was already given.

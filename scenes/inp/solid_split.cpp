@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem {
 
@@ -347,10 +348,10 @@ void split_element(const SolidElements& solids, int s, Mesh& mesh, const std::fu
   for (int a = 0; a < ti.nodes; ++a)
     for (int b = a + 1; b < ti.nodes; ++b)
       if (n[a] == n[b])
-        throw InputError(where(s) + ": " + label() + " lists node " +
+        throw InputError(printable(where(s) + ": " + label() + " lists node " +
                          std::to_string(mesh.node_ids[static_cast<std::size_t>(n[a])]) +
                          " twice (a collapsed element); write it as the element it collapses to (C3D6 wedge, C3D5 "
-                         "pyramid or C3D4 tetrahedron) with distinct nodes");
+                         "pyramid or C3D4 tetrahedron) with distinct nodes"));
   out.first_tet[static_cast<std::size_t>(s)] = static_cast<int>(out.ids.size());
   const std::uint16_t r = mesh.region[static_cast<std::size_t>(s)];
   if (&sh == &kTet) {  // the deck's own tetrahedra stay as they are
@@ -377,7 +378,7 @@ void split_element(const SolidElements& solids, int s, Mesh& mesh, const std::fu
           << mesh.node_ids[n[lt[0]]] << ", " << mesh.node_ids[n[lt[1]]] << ", " << mesh.node_ids[n[lt[2]]] << ", "
           << mesh.node_ids[n[lt[3]]] << " has " << (V < 0.0 ? "negative" : "zero") << " volume; check the node order ("
           << ti.name << ": " << node_order_hint(t) << ") or remesh this element (too distorted to split)";
-      throw InputError(msg.str());
+      throw InputError(printable(msg.str()));
     }
     for (int c : lt) out.conn.push_back(n[c]);
     if (quadratic)

@@ -115,9 +115,9 @@ void DeckReader::resolve_surface_elements() {
       if (t.n_corners == 3) {
         tiles[0] = find(c[0], c[1], c[2]);
         if (!tiles[0])
-          throw InputError(surface_element_where(t) + ": surface element " + std::to_string(t.id) + " (ELSET=" + name +
+          throw InputError(printable(surface_element_where(t) + ": surface element " + std::to_string(t.id) + " (ELSET=" + name +
                            ") matches no face of the tetrahedra; its first three nodes must be the corners of a "
-                           "tetrahedron's face (export the surface from the same mesh" + other_instance);
+                           "tetrahedron's face (export the surface from the same mesh" + other_instance));
       } else {
         ++quads;
         for (int d = 0; d < 2 && !tiles[1]; ++d) {  // the diagonal c[d] - c[d + 2]
@@ -125,10 +125,10 @@ void DeckReader::resolve_surface_elements() {
           if (!tiles[0] || !tiles[1]) tiles = {nullptr, nullptr};
         }
         if (!tiles[0])
-          throw InputError(surface_element_where(t) + ": surface element " + std::to_string(t.id) + " (ELSET=" + name +
+          throw InputError(printable(surface_element_where(t) + ": surface element " + std::to_string(t.id) + " (ELSET=" + name +
                            ") matches no quadrilateral face of the solid elements; its first four nodes, in order "
                            "around it (either way), must be the corners of a face of a hexahedron, wedge or pyramid "
-                           "(export the surface from the same mesh" + other_instance);
+                           "(export the surface from the same mesh" + other_instance));
         auto before = [](const Face* x, const Face* y) {
           return std::pair(x->first.element, x->first.local_face) < std::pair(y->first.element, y->first.local_face);
         };

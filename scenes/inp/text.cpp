@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 
 namespace pneufem::inp {
 
@@ -157,9 +158,9 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
   std::error_code ec;
   if (!fs::is_directory(path, ec)) in.open(path, std::ios::binary);
   if (!in) {
-    if (!from) throw InputError(path + ": cannot open the deck; check the path and the file permissions");
-    throw InputError(where(*from) + ": cannot open include file '" + path +
-                     "'; check INPUT= (a relative path is taken from the directory of the including file)");
+    if (!from) throw InputError(printable(path + ": cannot open the deck; check the path and the file permissions"));
+    throw InputError(printable(where(*from) + ": cannot open include file '" + path +
+                     "'; check INPUT= (a relative path is taken from the directory of the including file)"));
   }
   in.seekg(0, std::ios::end);
   const std::streamoff size = std::max<std::streamoff>(in.tellg(), 0);
@@ -168,9 +169,9 @@ void LineSource::push_file(const std::string& path, const std::optional<Loc>& fr
   if (bytes_read_ > kMaxDeckBytes) {
     const std::string what = "the deck's text reaches " + mebibytes(bytes_read_) + " with " + path +
                              ", over the limit of " + mebibytes(kMaxDeckBytes) + " (a file counts each time it is included)";
-    if (!from) throw InputError(path + ": " + what + "; split the model or coarsen the mesh");
-    throw InputError(where(*from) + ": " + what + "; include chain " + include_chain(path) +
-                     "; include each file once");
+    if (!from) throw InputError(printable(path + ": " + what + "; split the model or coarsen the mesh"));
+    throw InputError(printable(where(*from) + ": " + what + "; include chain " + include_chain(path) +
+                     "; include each file once"));
   }
   std::string text;
   if (size > 0) {
@@ -215,7 +216,7 @@ void LineSource::include(std::string_view text, const Loc& loc) {
   const Keyword kw = parse_keyword(text);
   const std::string input = kw.get("INPUT");
   auto fail = [&](const std::string& what, const std::string& todo) {
-    throw InputError(where(loc) + ": " + what + "; " + todo);
+    throw InputError(printable(where(loc) + ": " + what + "; " + todo));
   };
   if (input.empty()) fail("*INCLUDE without INPUT=<file>", "add INPUT=<path of the file to include>");
   fs::path p(input);

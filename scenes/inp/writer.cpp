@@ -8,6 +8,7 @@
 #include <map>
 
 #include "core/errors.h"
+#include "core/message_text.h"
 #include "scenes/inp/text.h"
 
 namespace pneufem {
@@ -45,8 +46,8 @@ std::string deck_name(const std::string& name, const char* what) {
     return c == ',' || c == '=' || c == '*' || c == '"' || c == '\n' || is_blank(c);
   });
   if (!letter_first || u.size() > kMaxNameChars || bad_char)
-    throw InputError(std::string(what) + " name '" + name + "' cannot be written to an .inp deck; rename it (1-80 " +
-                     "characters starting with a letter, no blanks, commas, '=', '*' or quotes)");
+    throw InputError(printable(std::string(what) + " name '" + name + "' cannot be written to an .inp deck; rename it (1-80 " +
+                     "characters starting with a letter, no blanks, commas, '=', '*' or quotes)"));
   return u;
 }
 
@@ -60,8 +61,8 @@ void write_id_lines(std::ostream& os, const std::vector<long>& ids) {
 
 void write_inp_mesh(std::ostream& os, const Mesh& mesh, double length_to_m) {
   if (!(length_to_m > 0.0) || !std::isfinite(length_to_m))
-    throw InputError("write_inp_mesh: length_to_m = " + std::to_string(length_to_m) +
-                     " is not a positive length; give the deck's length unit in metres (1e-3 for mm)");
+    throw InputError(printable("write_inp_mesh: length_to_m = " + std::to_string(length_to_m) +
+                     " is not a positive length; give the deck's length unit in metres (1e-3 for mm)"));
   const auto nn = static_cast<std::size_t>(mesh.num_nodes());
   const auto ne = static_cast<std::size_t>(mesh.num_elements());
   auto node_id = [&](int i) {
@@ -85,8 +86,8 @@ void write_inp_mesh(std::ostream& os, const Mesh& mesh, double length_to_m) {
   for (std::size_t i = 0; i < nn; ++i) {
     const Eigen::Vector3d& x = mesh.X[i];
     if (!x.allFinite())
-      throw InputError("write_inp_mesh: node " + std::to_string(node_id(static_cast<int>(i))) +
-                       " has a non-finite coordinate; fix the mesh before writing it");
+      throw InputError(printable("write_inp_mesh: node " + std::to_string(node_id(static_cast<int>(i))) +
+                       " has a non-finite coordinate; fix the mesh before writing it"));
     os << node_id(static_cast<int>(i)) << ", " << format_real(x[0] / length_to_m) << ", "
        << format_real(x[1] / length_to_m) << ", " << format_real(x[2] / length_to_m) << '\n';
   }

@@ -245,6 +245,17 @@ TEST(DeepLabCutErrors, MessagesNameFileLineAndColumn) {
   }
 }
 
+// Found by fuzz/count_outcomes.py on the fuzz corpus: a first cell with a NUL byte (a UTF-16 file)
+// cut the message short at the NUL, before the advice; control bytes are now written as \xHH.
+TEST(DeepLabCutErrors, AUtf16FileGivesTheWholeMessageOnOneLine) {
+  std::string utf16 = "\xFF\xFE";
+  for (const char c : std::string("scorer,DLC\nbodyparts,base1\n")) utf16 += std::string{c, '\0'};
+  const std::string msg = error_of(utf16);
+  EXPECT_EQ(msg.rfind("tracks.csv:1:1: expected the header row 'scorer', found '\xFF\xFEs\\x00c\\x00o\\x00", 0), 0u) << msg;
+  EXPECT_NE(msg.find("r\\x00'; give DeepLabCut's CSV as written by analyze_videos"), std::string::npos) << msg;
+  for (const char c : msg) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20) << msg;
+}
+
 TEST(DeepLabCutErrors, InvalidMappingNamesTheField) {
   const std::string text = header() + "0" + kRow;
   DlcMapping m = mapping();

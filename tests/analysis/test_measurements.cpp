@@ -185,6 +185,40 @@ TEST(MeasurementsCsvErrors, MessagesNameFileLineAndColumn) {
   }
 }
 
+// Found by fuzz/fuzz_measurements: a file whose every data row has neither a pressure nor an angle
+// (each row skipped with a warning) was read as a recording of no trials, without an error; the
+// reader now names the first such row (the fuzzer's input is fuzz/corpus/measurements/no_samples_*).
+TEST(MeasurementsCsvErrors, RowsWithoutAnySampleAreAnErrorNotAnEmptyRecording) {
+  const std::string h = "trial,time_s,pressure_kPa,angle_deg\n";
+  EXPECT_EQ(error_of(h + "1,0,,\n\n1,0.1,,\n").rfind(
+                "data.csv:2:1: no samples: none of the 2 data row(s) has a pressure_kPa or angle_deg value; ", 0),
+            0u);
+  EXPECT_EQ(error_of("Time_s,Trial,Angle_deg,note,PRESSUZE_KPA\n0,2,,0.04,x\n")
+                .rfind("data.csv:2:1: no samples: none of the 1 data row(s) has an angle_deg value; ", 0),
+            0u);
+  // One row with a sample is enough; the others are skipped with the warning, as before.
+  EXPECT_EQ(parse_measurements_csv(h + "1,0,,\n1,0.1,,2\n", "data.csv").trials.size(), 1u);
+}
+
+// Found by fuzz/count_outcomes.py on the fuzz corpus: a header with a NUL byte (every ASCII character
+// of a UTF-16 file, as spreadsheets save "Unicode text") was quoted raw into the message, and
+// InputError::what() - a C string - ended at the NUL: "missing column 'trial' (the header is '",
+// with no advice. Control bytes are now written as \xHH and the quoted header is bounded.
+TEST(MeasurementsCsvErrors, AUtf16OrBinaryHeaderGivesTheWholeMessageOnOneLine) {
+  std::string utf16 = "\xFF\xFE";  // UTF-16LE byte-order mark, then each character and a NUL
+  for (const char c : std::string("trial,time_s,pressure_kPa,angle_deg\n1,0,1,2\n")) utf16 += std::string{c, '\0'};
+  const std::string msg = error_of(utf16);
+  EXPECT_EQ(msg.rfind("data.csv:1:1: missing column 'trial' (the header is '\xFF\xFEt\\x00r\\x00i\\x00", 0), 0u) << msg;
+  EXPECT_NE(msg.find("'); add the column; the header must name trial,time_s,pressure_kPa,angle_deg"), std::string::npos)
+      << msg;
+  EXPECT_LT(msg.size(), 600u) << msg;
+  for (const char c : msg) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20) << msg;
+  // A column name with a control byte, named in a cell's message, is printable too.
+  EXPECT_EQ(error_of("trial,time_s,pressure_kPa,angle_deg,note\x1B[2J\n1,0,1,2\n")
+                .rfind("data.csv:2:5: note\\x1B[2J is missing: the row has 4 fields, the header 5; ", 0),
+            0u);
+}
+
 // Recordings made by other tools name their columns with units in brackets or in other units: the
 // reader converts those it knows exactly (and says so), so nobody has to edit the file.
 TEST(MeasurementsCsv, ColumnsInOtherUnitsAreConvertedAndReported) {

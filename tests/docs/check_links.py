@@ -11,7 +11,7 @@ UPWARD = re.compile(r"(?<![\w/.])((?:\.\./)+[\w.-][\w./-]*)")
 
 
 def documents(root):
-    for top in ("README.md", "BENCHMARKS.md"):
+    for top in ("README.md", "BENCHMARKS.md", "RELIABILITY.md"):
         yield os.path.join(root, top)
     for folder in ("docs", os.path.join("bench", "notes")):
         for dirpath, _, files in os.walk(os.path.join(root, folder)):

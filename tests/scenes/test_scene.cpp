@@ -121,6 +121,8 @@ TEST(SceneErrors, TomlSyntaxErrorNamesLine) {
   const std::string p = write_temp("syntax.toml", "[load]\ntrials = = 3\n");
   const std::string msg = error_of([&] { Scene::load(p); });
   EXPECT_NE(msg.find(p + ":2"), std::string::npos) << msg;
+  // What to do, too (the fuzz corpus's syntax errors named the place but gave no advice).
+  EXPECT_NE(msg.find(" (TOML syntax error); fix the text there: one key = value per line"), std::string::npos) << msg;
 }
 
 TEST(SceneErrors, WrongTypeNamesKeyAndOrigin) {

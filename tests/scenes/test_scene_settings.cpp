@@ -39,6 +39,40 @@ TEST(SceneSettings, UnknownMeshSourceNamesTheKeyAndTheSources) {
   EXPECT_EQ(error_of([&] { build_mesh(s); }), msg);
 }
 
+// A scene's text quoted in a message (a key, a string value) may hold a NUL or a terminal escape
+// (TOML strings allow \u0000): InputError::what() is a C string that a NUL cut short, before the
+// rest of the message; control bytes are now written as \xHH (as the deck and CSV readers do).
+TEST(SceneSettings, ControlBytesInKeysAndValuesDoNotCutTheMessageShort) {
+  std::string msg = error_of([] { Scene::from_text("\"a\\u0000b\" = 1\n", "s.toml"); });
+  EXPECT_EQ(msg.rfind("s.toml:1: key 'a\\x00b': unknown key (`pneufem scene --defaults` lists every key)", 0), 0u)
+      << msg;
+  msg = error_of([] { mesh_settings(Scene::from_text("[mesh]\nsource = \"gm\\u0000sh\\u001b[2J\"\n", "s.toml")); });
+  EXPECT_NE(msg.find("s.toml:2:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("got \"gm\\x00sh\\x1B[2J\""), std::string::npos) << msg;
+}
+
+// Found by counting the scene fuzz corpus: a material of the user's own whose table lacks a key
+// was reported as "default scene: key 'materials.gel.model': missing" - the wrong place, and no
+// advice. The message now names the line of the user's table and what to do.
+TEST(SceneSettings, AMissingKeyOfTheUsersOwnTableNamesThatTable) {
+  const Scene s = Scene::from_text("[load]\ntrials = 2\n[materials.gel.mullins]\nenabled = true\n", "s.toml");
+  const std::string msg = error_of([&] { make_material(s, "gel"); });
+  EXPECT_EQ(msg, "s.toml:4: key 'materials.gel.model': missing; add it (`pneufem scene --defaults` lists every key)");
+  // A table replaced by a value names the --set that did it.
+  EXPECT_EQ(error_of([] { load_settings(Scene::from_text("", "s.toml", {"load=3"})); }).rfind("--set load: key 'load.protocol': missing; add it", 0), 0u);
+}
+
+// Found by counting the scene fuzz corpus: load.mark_s outside the hold was refused by the engine
+// as "load.mark_s: must lie within the hold, after the ramp" - no file, no line, no values.
+TEST(SceneSettings, AMarkOutsideTheHoldNamesWhereAndTheRange) {
+  const Scene s = Scene::from_text("[load]\nhold_s = 4.0\nmark_s = 5.0\n", "s.toml");
+  EXPECT_EQ(error_of([&] { inlet_load(s); }),
+            "s.toml:3: key 'load.mark_s': got 5; the mark must lie within the hold, after the ramp: from load.ramp_s "
+            "= 0.5 to load.hold_s = 4 s");
+  EXPECT_EQ(error_of([] { inlet_load(Scene::from_text("[load]\nhold_s = 4.0\nramp_s = 4.0\n", "s.toml")); }),
+            "s.toml:3: key 'load.ramp_s': got 4; it must be shorter than load.hold_s = 4");
+}
+
 TEST(SceneSettings, LoadProtocolAndRest) {
   const Scene base = Scene::load("");
   const LoadSettings l = load_settings(base.with({"load.rest_s=12.5"}));

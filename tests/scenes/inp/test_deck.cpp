@@ -921,6 +921,29 @@ TEST(InpErrors, MissingDeck) {
   }
 }
 
+/// Found by fuzz/count_outcomes.py on the fuzz corpus: deck text with a NUL byte (a UTF-16 deck, a
+/// binary file) quoted into a message cut InputError::what() - a C string - short at the NUL, before
+/// the advice ("node 1: coordinate z '"). Control bytes in messages and notes are now \xHH.
+TEST_F(InpFiles, ControlBytesInTheDeckDoNotCutTheMessageShort) {
+  const std::string nodes = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n";
+  std::string msg = error_of(std::string("*NODE\n1, 0, 0, z\0z\n", 19));
+  EXPECT_NE(msg.find("bad.inp:2: "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'z\\x00z'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("; "), std::string::npos) << "no advice in: " << msg;
+  msg = error_of(nodes + "*ELEMENT, TYPE=C3D\x1B[2J\n1, 1, 2, 3, 4\n");
+  EXPECT_NE(msg.find("bad.inp:6: "), std::string::npos) << msg;
+  EXPECT_NE(msg.find("C3D\\x1B[2J"), std::string::npos) << msg;
+  for (const char c : msg) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 && c != '\n') << msg;
+  // A note quoting deck text (a skipped keyword) is printable too.
+  const InpDeck deck = read_inp(write("note.inp", nodes + "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*FOO\r\x07\n"), 1e-3);
+  bool found = false;
+  for (const std::string& w : deck.warnings) {
+    for (const char c : w) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 && c != '\n') << w;
+    found = found || w.find("\\x07") != std::string::npos;
+  }
+  EXPECT_TRUE(found) << "the note on *FOO\\r\\x07 is missing";
+}
+
 /// Every mutilation of a valid deck either reads or throws InputError: no crash, no other error.
 TEST_F(InpFiles, GarbageNeverCrashes) {
   std::ifstream in(data_path("tet4_two.inp"));
