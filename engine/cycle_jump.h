@@ -1,0 +1,65 @@
+#pragma once
+// Cycle jumping: skipping load cycles (trials) whose history can be extrapolated.
+//
+// Many repetitions of one load cycle change a structure's history slowly and smoothly from cycle to
+// cycle, so that the history after cycle k + N follows from the last computed cycles; "cycle
+// jumping" (Lemaitre & Doghri 1994; Van Paepegem, Degrieck & De Baets 2001, "Finite element
+// approach for modelling fatigue damage in fibre-reinforced composite materials", Compos. B 32;
+// Cojocaru & Karlsson 2006, "A simple numerical method of cycle jumps for cyclically loaded
+// structures", Int. J. Fatigue 28; the damage extrapolation of Abaqus's direct cyclic low-cycle
+// fatigue analysis) computes some cycles, extrapolates every integration point's history over the
+// next N and carries on computing from there.
+//
+// Here a cycle is a trial of the load history, and its end (the state before the release to the
+// next trial's rest) is where the history is compared and extrapolated. With H_k the committed
+// history at the end of cycle k, each law extrapolates its variables linearly in a measure z that
+// grows about linearly per cycle (Material::jump_cycles: the fatigue integrity's s^(1-n), the
+// Mullins peak energy; the Prony branches are not extrapolated: the rest after the jump sets them):
+//   z_(k+N) = z_k + N (z_k - z_(k-1))                                              (1)
+// The displacement is the last computed cycle's end; the release and rest that follow it, and the
+// cycle after the jump, are computed as usual from the extrapolated history.
+//
+// Error control (the cycle-space analogue of Milne's device in engine/quasi_static.h). (1) is exact
+// when z is linear in the cycle count; when its increment changes by delta per cycle, the jump's
+// error after N cycles is delta (1 + 2 + ... + N) = delta N (N + 1) / 2. delta is measured by the one-
+// cycle jump from the two cycles before the last and compared with the last, computed one:
+//   e_1 = max over points of jump_error(jump(H_(k-2), H_(k-1), 1), H_k)            (2)
+// in units of the isochoric stiffness fraction (Material::jump_error: fatigue |ds|; Mullins the
+// largest change of eta its W_max difference can cause). A jump by N from (H_(k-1), H_k) is taken
+// with the largest N such that
+//   e_1 N (N + 1) / 2 <= tol,       c_1 N <= change,       N <= cycles left - 1,    (3)
+// where c_1 = max over points of jump_error(H_(k-1), H_k) is the last cycle's change: (2) is an
+// estimate from three cycles and the history's effect on the stress is nonlinear, so the total
+// change a jump may add is bounded as well (the "maximum damage increment" of Abaqus's and Van
+// Paepegem's jump rules). The last cycle is always computed. A jump needs three consecutive computed
+// cycle ends, so at least two cycles are computed after each jump (the one-cycle estimate (2) then
+// checks the extrapolated start, as Cojocaru and Karlsson's control cycles do).
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/assembly.h"
+
+namespace pneufem {
+
+struct CycleJumpOptions {
+  bool on = false;      ///< off: every cycle is computed
+  double tol = 0.002;   ///< bound of the estimated extrapolation error (3), stiffness fraction
+  double change = 0.05; ///< bound of the history change one jump adds (3), stiffness fraction
+};
+
+/// True when every material of the model says how its history extrapolates (Material::jumps_cycles);
+/// otherwise `law` gets the first one that does not.
+bool model_jumps_cycles(const Assembler& asmb, std::string& law);
+
+/// (1) for every point: the history `cycles` cycles after `after`, from the cycle ends before and after.
+std::vector<double> jump_history(const Assembler& asmb, std::span<const double> before, std::span<const double> after,
+                                 double cycles);
+
+/// max over points of Material::jump_error(predicted, computed).
+double history_jump_error(const Assembler& asmb, std::span<const double> predicted, std::span<const double> computed);
+
+/// The largest N of (3) for a one-cycle error estimate e1 and last change c1, at most max_cycles (>= 0).
+int cycles_to_jump(double e1, double c1, const CycleJumpOptions& opt, int max_cycles);
+
+}  // namespace pneufem
