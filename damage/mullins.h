@@ -78,9 +78,11 @@ class Mullins final : public Material {
   /// Cycle jumping (Material::jump_cycles): W_max is a running maximum; when the structure softens
   /// from cycle to cycle (fatigue) the peak energy of the repeated load grows slowly, and it is
   /// extrapolated linearly, W_max,(k+N) = W_max,k + N max(0, W_max,k - W_max,(k-1)); eta_last is the
-  /// last cycle's. jump_error bounds the change of eta a W_max difference dW can cause at any W_dev
-  /// <= W_max: |d eta / d W_max| = (2 / (r sqrt(pi))) exp(-z^2) (m + beta W_dev) / (m + beta W_max)^2
-  /// <= 2 / (r sqrt(pi) (m + beta W_max)), so the error is 2 |dW| / (r sqrt(pi) (m + beta min W_max)).
+  /// last cycle's. jump_error bounds the change of eta that W_max1 < W_max2 (dW = W_max2 - W_max1) can
+  /// cause at any W_dev: at W_dev >= W_max1 the first is on its primary curve, and below it
+  /// |d eta / d W_max| = (2 / (r sqrt(pi))) exp(-z^2) (m + beta W_dev) / (m + beta W_max)^2 with
+  /// z >= (W_max - W_max1) / D2; integrated over W_max in [W_max1, W_max2], with Di = m + beta W_maxi,
+  ///   |d eta| <= (D2 / D1) erf(dW / D2) / r     (<= 2 dW / (r sqrt(pi) D1) for small dW; at most 1/r).
   bool jumps_cycles() const override { return base_->jumps_cycles(); }
   void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                    std::span<double> out) const override;

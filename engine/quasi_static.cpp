@@ -490,8 +490,9 @@ std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::
   if (cycle_ends_.size() < 3 || last_trial - trial < 2) return i;
   // (2) and (3) of cycle_jump.h: the one-cycle prediction of this trial's end against the computed one.
   const std::vector<double> predicted = jump_history(asm_, cycle_ends_[0], cycle_ends_[1], 1.0);
-  const double e1 = history_jump_error(asm_, predicted, cycle_ends_[2]);
-  const double c1 = history_jump_error(asm_, cycle_ends_[1], cycle_ends_[2]);
+  const std::vector<double> share = energy_shares(asm_, u_, state_);  // at the trial's end, loaded
+  const double e1 = history_jump_error(asm_, share, predicted, cycle_ends_[2]);
+  const double c1 = history_jump_error(asm_, share, cycle_ends_[1], cycle_ends_[2]);
   const int n = cycles_to_jump(e1, c1, opt_.cycle_jump, last_trial - trial - 1);
   if (opt_.newton.verbose)
     std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g, change %.3g -> skip %d trials\n", trial + 1, e1,
