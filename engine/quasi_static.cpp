@@ -150,7 +150,7 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
     if (n > 3) throw InputError("checkpoint: corrupt cycle-jump memory");
     for (std::uint64_t k = 0; k < n; ++k) c.cycle_ends.push_back(get_vec(is));
     get(is, n);
-    if (n > 2) throw InputError("checkpoint: corrupt cycle-jump memory");
+    if (n > 3) throw InputError("checkpoint: corrupt cycle-jump memory");
     for (std::uint64_t k = 0; k < n; ++k) c.cycle_reports.push_back(get_records(is));
     c.trial_reports = get_records(is);
   }
@@ -469,6 +469,20 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
 }
 
 namespace {
+/// (2') of engine/cycle_jump.h: the largest second difference of the last three trials' reported
+/// angles over the last trial's largest |angle|, at least 1 deg (a structure that hardly bends, such
+/// as a test block, is not judged relative to the round-off of its angle); 0 without three trials.
+double report_second_difference(const std::vector<std::vector<StateRecord>>& trials) {
+  if (trials.size() < 3) return 0.0;
+  const std::vector<StateRecord>&a = trials[0], &b = trials[1], &c = trials[2];
+  double d2 = 0.0, scale = 1.0;
+  for (std::size_t r = 0; r < c.size() && r < a.size() && r < b.size(); ++r) {
+    d2 = std::max(d2, std::abs(c[r].angle_deg - 2.0 * b[r].angle_deg + a[r].angle_deg));
+    scale = std::max(scale, std::abs(c[r].angle_deg));
+  }
+  return d2 / scale;
+}
+
 /// True when every trial of `load` repeats the first one's load and reports.
 bool trials_repeat(const LoadHistory& load) {
   for (const TrialLoad& t : load.trials) {
@@ -484,7 +498,7 @@ std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::
   if (cycle_ends_.size() > 3) cycle_ends_.erase(cycle_ends_.begin());
   cycle_reports_.push_back(std::move(trial_reports_));
   trial_reports_.clear();
-  if (cycle_reports_.size() > 2) cycle_reports_.erase(cycle_reports_.begin());
+  if (cycle_reports_.size() > 3) cycle_reports_.erase(cycle_reports_.begin());
   const int trial = segs[i].trial;  // 0-based, just ended
   const int last_trial = segs.back().trial;
   if (cycle_ends_.size() < 3 || last_trial - trial < 2) return i;
@@ -493,15 +507,16 @@ std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::
   const std::vector<double> share = energy_shares(asm_, u_, state_);  // at the trial's end, loaded
   const double e1 = history_jump_error(asm_, share, predicted, cycle_ends_[2]);
   const double c1 = history_jump_error(asm_, share, cycle_ends_[1], cycle_ends_[2]);
-  const int n = cycles_to_jump(e1, c1, opt_.cycle_jump, last_trial - trial - 1);
+  const double ea = report_second_difference(cycle_reports_);
+  const int n = cycles_to_jump(std::max(e1, ea), c1, opt_.cycle_jump, last_trial - trial - 1);
   if (opt_.newton.verbose)
-    std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g, change %.3g -> skip %d trials\n", trial + 1, e1,
-                 c1, n);
+    std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g (reported angles %.3g), change %.3g -> skip %d trials\n",
+                 trial + 1, e1, ea, c1, n);
   if (n < 1) return i;
   state_ = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
   // The skipped trials' reports, extrapolated linearly in the trial count from the last two trials.
-  const std::vector<StateRecord>& a = cycle_reports_[0];
-  const std::vector<StateRecord>& b = cycle_reports_[1];
+  const std::vector<StateRecord>& a = cycle_reports_[cycle_reports_.size() - 2];
+  const std::vector<StateRecord>& b = cycle_reports_.back();
   std::vector<StateRecord> last;
   std::size_t j = i + 1;
   for (int m = 1; m <= n; ++m) {

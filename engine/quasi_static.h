@@ -141,7 +141,7 @@ struct QuasiStaticCheckpoint {
   /// pressure increment the control suggested after it (Pa; 0 = none): the next ramp's first guess.
   double ramp_start_dp_Pa[2] = {0.0, 0.0};
   /// Cycle jumping only: the histories at the last (up to 3) consecutive trial ends, the reports of
-  /// the last (up to 2) trials and those of the current trial so far.
+  /// those trials and those of the current trial so far.
   std::vector<std::vector<double>> cycle_ends;
   std::vector<std::vector<StateRecord>> cycle_reports;
   std::vector<StateRecord> trial_reports;
