@@ -54,7 +54,7 @@ std::string metrics_json(const std::vector<TrialMetrics>& trials, const std::vec
     const TrialMetrics& t = trials[i];
     s << "    {\"trial\": " << t.trial << ", \"nrmse\": " << num(t.nrmse) << ", \"abs_error_deg\": " << arr(t.abs_error_deg)
       << ", \"spread_deg\": " << arr(t.spread_deg) << ", \"angle_at_mark_deg\": " << arr(t.mark_deg)
-      << ", \"reference_at_mark_deg\": " << arr(t.reference_deg) << "}" << (i + 1 < trials.size() ? "," : "") << "\n";
+      << ", \"reference_at_mark_deg\": " << arr(t.reference_deg) << (t.extrapolated ? ", \"extrapolated\": true" : "") << "}" << (i + 1 < trials.size() ? "," : "") << "\n";
   }
   s << "  ],\n  \"levels_kPa\": " << arr(levels) << "\n}\n";
   return s.str();

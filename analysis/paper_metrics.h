@@ -25,13 +25,16 @@ struct TrialMetrics {
   std::vector<double> spread_deg;
   std::vector<double> mark_deg;      ///< the compared record at the marks
   std::vector<double> reference_deg; ///< the reference at the marks
+  /// The trial was skipped by cycle jumping: its angles are extrapolated (engine/cycle_jump.h).
+  bool extrapolated = false;
 };
 
 /// Metrics of `a` against `reference` (same number of steps). Throws InputError when the step
 /// counts differ or the reference range is zero.
 TrialMetrics paper_metrics(const StepAngles& a, const StepAngles& reference);
 
-/// JSON document {"trials": [...], "levels_kPa": [...]} (the format metrics.json uses).
+/// JSON document {"trials": [...], "levels_kPa": [...]} (the format metrics.json uses); an
+/// extrapolated trial carries "extrapolated": true (the field is absent for solved trials).
 std::string metrics_json(const std::vector<TrialMetrics>& trials, const std::vector<double>& levels_kPa);
 
 }  // namespace pneufem

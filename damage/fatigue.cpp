@@ -165,6 +165,25 @@ void FatigueDamage::init_state(std::span<double> state) const {
   base_->init_state(state.subspan(static_cast<std::size_t>(own_state_size())));
 }
 
+void FatigueDamage::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                                std::span<double> out) const {
+  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  std::copy(after.begin(), after.begin() + static_cast<std::ptrdiff_t>(own), out.begin());  // rho: the last cycle's
+  // z = s^(1-n) (n > 1) or -ln s (n = 1), linear in time at a constant driver (fatigue.h).
+  const auto z_of = [&](double s) { return p_.n > 1.0 ? std::pow(s, 1.0 - p_.n) : -std::log(s); };
+  const auto s_of = [&](double z) { return p_.n > 1.0 ? std::pow(z, -1.0 / (p_.n - 1.0)) : std::exp(-z); };
+  const double s_after = after[0];
+  const double dz = std::max(0.0, z_of(s_after) - z_of(before[0]));
+  const double s_jump = s_of(z_of(s_after) + cycles * dz);
+  out[0] = std::min(s_after, std::max(s_jump, 1.0 - p_.d_fail));  // never heals, stops at d_fail
+  base_->jump_cycles(before.subspan(own), after.subspan(own), cycles, out.subspan(own));
+}
+
+double FatigueDamage::jump_error(std::span<const double> predicted, std::span<const double> computed) const {
+  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  return std::max(std::abs(predicted[0] - computed[0]), base_->jump_error(predicted.subspan(own), computed.subspan(own)));
+}
+
 Material::NonlocalSpec FatigueDamage::nonlocal() const {
   if (!(p_.nonlocal_radius_m > 0.0)) return base_->nonlocal();
   return {p_.nonlocal_radius_m, p_.driver == FatigueDriver::energy ? "fatigue:energy" : "fatigue:stretch"};

@@ -119,6 +119,17 @@ class FatigueDamage final : public Material {
   void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
     base_->linear_drive_value(state.subspan(static_cast<std::size_t>(own_state_size())), out);
   }
+  /// Cycle jumping (Material::jump_cycles). At a constant driver the exact integrity is
+  /// s(t)^(1-n) = s(0)^(1-n) + (n - 1) g t / tau (n > 1) and -ln s(t) = -ln s(0) + g t / tau (n = 1):
+  /// z = s^(1-n) resp. -ln s grows linearly in time, so over cycles that repeat the driver's history
+  /// it grows linearly per cycle, z_(k+N) = z_k + N (z_k - z_(k-1)) (the cycle-jump variable of
+  /// Van Paepegem et al. 2001 for a damage rate of this form). The result is clipped to damage
+  /// never decreasing and never passing d_fail; rho (non-local) is the last cycle's. jump_error:
+  /// |s_predicted - s_computed| (the stiffness fraction is s times the base's), or the base's if larger.
+  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                   std::span<double> out) const override;
+  double jump_error(std::span<const double> predicted, std::span<const double> computed) const override;
   /// With nonlocal_radius_m > 0: kind "fatigue:energy" or "fatigue:stretch"; the driver X at the
   /// committed state; rho = average / X stored for the next increments.
   NonlocalSpec nonlocal() const override;

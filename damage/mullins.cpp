@@ -41,6 +41,23 @@ void Mullins::init_state(std::span<double> state) const {
   base_->init_state(state.subspan(kOwnState));
 }
 
+void Mullins::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                          std::span<double> out) const {
+  out[0] = after[0] + cycles * std::max(0.0, after[0] - before[0]);  // W_max: linear per cycle (mullins.h)
+  out[1] = after[1];                                                 // eta_last: output only
+  base_->jump_cycles(before.subspan(kOwnState), after.subspan(kOwnState), cycles, out.subspan(kOwnState));
+}
+
+double Mullins::jump_error(std::span<const double> predicted, std::span<const double> computed) const {
+  const double base = base_->jump_error(predicted.subspan(kOwnState), computed.subspan(kOwnState));
+  const double dW = std::abs(predicted[0] - computed[0]);
+  if (dW == 0.0) return base;
+  const double D = p_.m_Pa + p_.beta * std::min(predicted[0], computed[0]);
+  // The bound of mullins.h; with m = 0 and a virgin point (D = 0) the softening can change by up to 1/r.
+  const double e = D > 0.0 ? std::min(1.0 / p_.r, 2.0 * dW / (p_.r * std::sqrt(std::numbers::pi) * D)) : 1.0 / p_.r;
+  return std::max(base, e);
+}
+
 namespace {
 /// One point's Ogden-Roxburgh update from the base's isochoric energy W_dev, shared by evaluate() and
 /// stress(): writes the trial state [W_max, eta] and returns the softening, or nothing on the primary

@@ -71,11 +71,22 @@ class Mullins final : public Material {
   double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
   /// Forwarded to the base (its slice of the state).
-  /// Forwarded to the base (its slice of the state).
   LinearDrive linear_drive() const override { return base_->linear_drive(); }
   void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
     base_->linear_drive_value(state.subspan(kOwnState), out);
   }
+  /// Cycle jumping (Material::jump_cycles): W_max is a running maximum; when the structure softens
+  /// from cycle to cycle (fatigue) the peak energy of the repeated load grows slowly, and it is
+  /// extrapolated linearly, W_max,(k+N) = W_max,k + N max(0, W_max,k - W_max,(k-1)); eta_last is the
+  /// last cycle's. jump_error bounds the change of eta that W_max1 < W_max2 (dW = W_max2 - W_max1) can
+  /// cause at any W_dev: at W_dev >= W_max1 the first is on its primary curve, and below it
+  /// |d eta / d W_max| = (2 / (r sqrt(pi))) exp(-z^2) (m + beta W_dev) / (m + beta W_max)^2 with
+  /// z >= (W_max - W_max1) / D2; integrated over W_max in [W_max1, W_max2], with Di = m + beta W_maxi,
+  ///   |d eta| <= (D2 / D1) erf(dW / D2) / r     (<= 2 dW / (r sqrt(pi) D1) for small dW; at most 1/r).
+  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                   std::span<double> out) const override;
+  double jump_error(std::span<const double> predicted, std::span<const double> computed) const override;
   NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
     return base_->nonlocal_driver(F, state.subspan(kOwnState));

@@ -1,5 +1,6 @@
 #include "damage/viscoelastic.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -140,6 +141,13 @@ void Viscoelastic::init_state(std::span<double> state) const {
   const std::size_t own = static_cast<std::size_t>(own_state_size());
   for (std::size_t i = 0; i < own; ++i) state[i] = 0.0;  // S0 = 0 and Q_i = 0 in the virgin state
   base_->init_state(state.subspan(own));
+}
+
+void Viscoelastic::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                               std::span<double> out) const {
+  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  std::copy(after.begin(), after.begin() + static_cast<std::ptrdiff_t>(own), out.begin());  // set by the last rest
+  base_->jump_cycles(before.subspan(own), after.subspan(own), cycles, out.subspan(own));
 }
 
 struct Viscoelastic::Increment {

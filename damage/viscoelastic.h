@@ -117,6 +117,17 @@ class Viscoelastic final : public Material {
     return moduli_ == ViscoModuli::instantaneous ? mu_base_ : (1.0 + gamma_sum_) * mu_base_;
   }
   double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// Cycle jumping (Material::jump_cycles): the branches Q_i and S0 are NOT extrapolated. They
+  /// follow the load within a cycle and relax during the rest that ends it, so after a jump they are
+  /// the last computed cycle's (the first computed cycle after the jump starts from them). The
+  /// base's history is extrapolated by the base; jump_error is the base's.
+  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                   std::span<double> out) const override;
+  double jump_error(std::span<const double> predicted, std::span<const double> computed) const override {
+    const std::size_t own = static_cast<std::size_t>(own_state_size());
+    return base_->jump_error(predicted.subspan(own), computed.subspan(own));
+  }
   /// Forwarded to the base (its slice of the state): a fatigue law inside keeps its non-local driver.
   NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {

@@ -21,6 +21,7 @@ constexpr std::uint64_t kMagic = 0x31504b4346454e50ULL;   // "PNEFCKP1"
 constexpr std::uint64_t kMagic2 = 0x32504b4346454e50ULL;  // "PNEFCKP2": + error-control memory
 constexpr std::uint64_t kMagic3 = 0x33504b4346454e50ULL;  // "PNEFCKP3": + ramp-start memory
 constexpr std::uint64_t kMagic4 = 0x34504b4346454e50ULL;  // "PNEFCKP4": + drive-control memory
+constexpr std::uint64_t kMagic5 = 0x35504b4346454e50ULL;  // "PNEFCKP5": + cycle-jump memory and counts
 
 template <class T>
 void put(std::ostream& os, const T& v) {
@@ -45,10 +46,35 @@ std::vector<double> get_vec(std::istream& is) {
   return v;
 }
 
+void put_records(std::ostream& os, const std::vector<StateRecord>& recs) {
+  put(os, static_cast<std::uint64_t>(recs.size()));
+  for (const StateRecord& r : recs) {
+    put(os, static_cast<std::int64_t>(r.trial));
+    put(os, static_cast<std::uint64_t>(r.extrapolated ? 1 : 0));
+    for (double v : {r.time_s, r.global_time_s, r.pressure_Pa, r.angle_deg, r.cavity_volume_m3, r.plane_rms_m}) put(os, v);
+  }
+}
+std::vector<StateRecord> get_records(std::istream& is) {
+  std::uint64_t n = 0;
+  get(is, n);
+  if (n > (1ULL << 32)) throw InputError("checkpoint: corrupt report count");
+  std::vector<StateRecord> recs(n);
+  for (StateRecord& r : recs) {
+    std::int64_t trial = 0;
+    std::uint64_t extrapolated = 0;
+    get(is, trial);
+    get(is, extrapolated);
+    r.trial = static_cast<int>(trial);
+    r.extrapolated = extrapolated != 0;
+    for (double* v : {&r.time_s, &r.global_time_s, &r.pressure_Pa, &r.angle_deg, &r.cavity_volume_m3, &r.plane_rms_m}) get(is, *v);
+  }
+  return recs;
+}
+
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
-  put(os, kMagic4);
+  put(os, kMagic5);
   put(os, static_cast<std::uint64_t>(next_segment));
   put(os, dt_suggest_s);
   put(os, last_angle_deg);
@@ -69,13 +95,20 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put_vec(os, drive_prev.data(), drive_prev.size());
   put_vec(os, drive_cur.data(), drive_cur.size());
   put(os, static_cast<std::uint64_t>(damage_grew ? 1 : 0));
+  put(os, stats.cycle_jumps);
+  put(os, stats.trials_extrapolated);
+  put(os, static_cast<std::uint64_t>(cycle_ends.size()));
+  for (const std::vector<double>& h : cycle_ends) put_vec(os, h.data(), h.size());
+  put(os, static_cast<std::uint64_t>(cycle_reports.size()));
+  for (const std::vector<StateRecord>& r : cycle_reports) put_records(os, r);
+  put_records(os, trial_reports);
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
   QuasiStaticCheckpoint c;
   std::uint64_t magic = 0, seg = 0;
   get(is, magic);
-  if (magic != kMagic && magic != kMagic2 && magic != kMagic3 && magic != kMagic4) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  if (magic != kMagic && magic != kMagic2 && magic != kMagic3 && magic != kMagic4 && magic != kMagic5) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
   get(is, seg);
   c.next_segment = static_cast<std::size_t>(seg);
   get(is, c.dt_suggest_s);
@@ -92,25 +125,38 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   get(is, c.stats.rejected_steps);
   get(is, c.stats.relaxation_iterations);
   get(is, c.stats.wall_s);
-  if (magic == kMagic2 || magic == kMagic3 || magic == kMagic4) {
+  if (magic == kMagic2 || magic == kMagic3 || magic == kMagic4 || magic == kMagic5) {
     c.hist_prev = get_vec(is);
     c.hist_cur = get_vec(is);
     get(is, c.h_prev_s);
     get(is, c.rate_prev_Pa_s);
   }
-  if (magic == kMagic3 || magic == kMagic4) {
+  if (magic == kMagic3 || magic == kMagic4 || magic == kMagic5) {
     get(is, c.ramp_start_dp_Pa[0]);
     get(is, c.ramp_start_dp_Pa[1]);
   }
-  if (magic == kMagic4) {
+  if (magic == kMagic4 || magic == kMagic5) {
     c.drive_prev = get_vec(is);
     c.drive_cur = get_vec(is);
     std::uint64_t grew = 0;
     get(is, grew);
     c.damage_grew = grew != 0;
   }
+  if (magic == kMagic5) {
+    get(is, c.stats.cycle_jumps);
+    get(is, c.stats.trials_extrapolated);
+    std::uint64_t n = 0;
+    get(is, n);
+    if (n > 3) throw InputError("checkpoint: corrupt cycle-jump memory");
+    for (std::uint64_t k = 0; k < n; ++k) c.cycle_ends.push_back(get_vec(is));
+    get(is, n);
+    if (n > 3) throw InputError("checkpoint: corrupt cycle-jump memory");
+    for (std::uint64_t k = 0; k < n; ++k) c.cycle_reports.push_back(get_records(is));
+    c.trial_reports = get_records(is);
+  }
   if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size ||
-      (!c.drive_cur.empty() && c.drive_cur.size() != c.hist_cur.size() * 3))
+      (!c.drive_cur.empty() && c.drive_cur.size() != c.hist_cur.size() * 3) ||
+      std::any_of(c.cycle_ends.begin(), c.cycle_ends.end(), [&](const std::vector<double>& h) { return h.size() != state_size; }))
     throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
                      "resume with the run's own scene.toml");
   return c;
@@ -126,6 +172,14 @@ QuasiStaticRun::QuasiStaticRun(const Assembler& assembler, QuasiStaticOptions op
     throw InputError("quasi-static run: time_tol must be a finite number > 0");
   if (!(opt_.min_dt_s > 0.0) || !(opt_.max_dt_s >= opt_.min_dt_s) || !std::isfinite(opt_.max_dt_s))
     throw InputError("quasi-static run: need 0 < min_dt_s <= max_dt_s (finite)");
+  if (opt_.cycle_jump.on) {
+    if (!(opt_.cycle_jump.tol > 0.0) || !(opt_.cycle_jump.change > 0.0))
+      throw InputError("quasi-static run: cycle jumping needs tol > 0 and change > 0");
+    std::string law;
+    if (!model_jumps_cycles(asm_, law))
+      throw InputError("cycle jumping: the material '" + law + "' does not say how its history extrapolates over "
+                       "trials (Material::jumps_cycles); switch cycle jumping off for this model");
+  }
   if (opt_.time_control == TimeControl::Drive && rate_dependent_) {
     // Each point's law's linear drive, as an index into the distinct kinds (a few per model).
     drive_kind_.assign(static_cast<std::size_t>(asm_.num_points()), -1);
@@ -414,6 +468,85 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   }
 }
 
+namespace {
+/// (2') of engine/cycle_jump.h: the largest second difference of the last three trials' reported
+/// angles over the last trial's largest |angle|, at least 1 deg (a structure that hardly bends, such
+/// as a test block, is not judged relative to the round-off of its angle); 0 without three trials.
+double report_second_difference(const std::vector<std::vector<StateRecord>>& trials) {
+  if (trials.size() < 3) return 0.0;
+  const std::vector<StateRecord>&a = trials[0], &b = trials[1], &c = trials[2];
+  double d2 = 0.0, scale = 1.0;
+  for (std::size_t r = 0; r < c.size() && r < a.size() && r < b.size(); ++r) {
+    d2 = std::max(d2, std::abs(c[r].angle_deg - 2.0 * b[r].angle_deg + a[r].angle_deg));
+    scale = std::max(scale, std::abs(c[r].angle_deg));
+  }
+  return d2 / scale;
+}
+
+/// True when every trial of `load` repeats the first one's load and reports.
+bool trials_repeat(const LoadHistory& load) {
+  for (const TrialLoad& t : load.trials) {
+    const TrialLoad& t0 = load.trials.front();
+    if (t.time_s != t0.time_s || t.pressure_Pa != t0.pressure_Pa || t.output_s != t0.output_s) return false;
+  }
+  return true;
+}
+}  // namespace
+
+std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::size_t i, const Observer& observer) {
+  cycle_ends_.push_back(state_);
+  if (cycle_ends_.size() > 3) cycle_ends_.erase(cycle_ends_.begin());
+  cycle_reports_.push_back(std::move(trial_reports_));
+  trial_reports_.clear();
+  if (cycle_reports_.size() > 3) cycle_reports_.erase(cycle_reports_.begin());
+  const int trial = segs[i].trial;  // 0-based, just ended
+  const int last_trial = segs.back().trial;
+  if (cycle_ends_.size() < 3 || last_trial - trial < 2) return i;
+  // (2) and (3) of cycle_jump.h: the one-cycle prediction of this trial's end against the computed one.
+  const std::vector<double> predicted = jump_history(asm_, cycle_ends_[0], cycle_ends_[1], 1.0);
+  const std::vector<double> share = energy_shares(asm_, u_, state_);  // at the trial's end, loaded
+  const double e1 = history_jump_error(asm_, share, predicted, cycle_ends_[2]);
+  const double c1 = history_jump_error(asm_, share, cycle_ends_[1], cycle_ends_[2]);
+  const double ea = report_second_difference(cycle_reports_);
+  const int n = cycles_to_jump(std::max(e1, ea), c1, opt_.cycle_jump, last_trial - trial - 1);
+  if (opt_.newton.verbose)
+    std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g (reported angles %.3g), change %.3g -> skip %d trials\n",
+                 trial + 1, e1, ea, c1, n);
+  if (n < 1) return i;
+  state_ = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
+  // The skipped trials' reports, extrapolated linearly in the trial count from the last two trials.
+  const std::vector<StateRecord>& a = cycle_reports_[cycle_reports_.size() - 2];
+  const std::vector<StateRecord>& b = cycle_reports_.back();
+  std::vector<StateRecord> last;
+  std::size_t j = i + 1;
+  for (int m = 1; m <= n; ++m) {
+    last.clear();
+    for (; j < segs.size() && segs[j].trial == trial + m; ++j) {
+      const Segment& s = segs[j];
+      if (!s.report) continue;
+      const std::size_t r = last.size();
+      StateRecord rec;
+      rec.trial = s.trial + 1;
+      rec.extrapolated = true;
+      rec.time_s = s.t1;
+      rec.global_time_s = s.g1;
+      rec.pressure_Pa = s.p1;
+      rec.angle_deg = b[r].angle_deg + m * (b[r].angle_deg - a[r].angle_deg);
+      rec.cavity_volume_m3 = b[r].cavity_volume_m3 + m * (b[r].cavity_volume_m3 - a[r].cavity_volume_m3);
+      rec.plane_rms_m = b[r].plane_rms_m;
+      last.push_back(rec);
+      last_angle_ = rec.angle_deg;
+      if (observer) observer(rec, Eigen::VectorXd(), std::vector<double>());
+    }
+  }
+  ++stats_.cycle_jumps;
+  stats_.trials_extrapolated += n;
+  // The extrapolated end of the last skipped trial starts the next run of consecutive trial ends.
+  cycle_ends_.assign(1, state_);
+  cycle_reports_.assign(1, std::move(last));
+  return j - 1;
+}
+
 std::string QuasiStaticRun::failure_note() const {
   // Points a damage law has declared failed explain most stalls of damaged runs: say where.
   if (state_.empty()) return "";
@@ -441,6 +574,11 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
                          const QuasiStaticCheckpoint* resume) {
   const auto wall0 = std::chrono::steady_clock::now();
   const std::vector<Segment> segs = segments(load);
+  // Cycle jumping needs a history to extrapolate and a repeated cycle to extrapolate over.
+  const bool jumping = opt_.cycle_jump.on && rate_dependent_ && load.trials.size() > 3;
+  if (jumping && !trials_repeat(load))
+    throw InputError("cycle jumping: the trials of the load history differ (pressures, times or reports); it "
+                     "extrapolates over repetitions of one cycle only. Switch cycle jumping off for this load");
   std::size_t first = 0;
   double wall_before = 0.0;
   if (resume) {
@@ -460,6 +598,9 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     drive_prev_ = resume->drive_prev;
     drive_cur_ = resume->drive_cur;
     damage_grew_ = resume->damage_grew;
+    cycle_ends_ = resume->cycle_ends;
+    cycle_reports_ = resume->cycle_reports;
+    trial_reports_ = resume->trial_reports;
     wall_before = stats_.wall_s;
   }
   // The run starts from u = 0, which is an equilibrium only without load. When the load history
@@ -498,7 +639,9 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       rec.plane_rms_m = a.plane_rms_m;
       rec.cavity_volume_m3 = asm_.cavity_volume(u_);
       if (observer) observer(rec, u_, state_);
+      if (jumping) trial_reports_.push_back(rec);
     }
+    if (jumping && (i + 1 == segs.size() || segs[i + 1].trial != s.trial)) i = end_of_trial(segs, i, observer);
     stats_.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     if (sink) {
       QuasiStaticCheckpoint c;
@@ -520,6 +663,9 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.drive_prev = drive_prev_;
       c.drive_cur = drive_cur_;
       c.damage_grew = damage_grew_;
+      c.cycle_ends = cycle_ends_;
+      c.cycle_reports = cycle_reports_;
+      c.trial_reports = trial_reports_;
       sink(c);
     }
   }

@@ -54,6 +54,12 @@
 // it equals the rest's) keeps the control's memory. Without a Prony term (no linear drive) the
 // control is Error's at damaging points and needs nothing elsewhere.
 //
+// Cycle jumping (options.cycle_jump, engine/cycle_jump.h): at the end of a trial, when the last three
+// trial ends allow it, the history is extrapolated over the next N trials, which are reported as
+// extrapolated (StateRecord::extrapolated) and not solved; the run continues with the release into
+// trial N + 1 after the last computed one. It needs trials that repeat one cycle (identical loads)
+// and laws that say how their history extrapolates (Material::jumps_cycles): InputError otherwise.
+//
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
 // resuming from a checkpoint continues bit-for-bit as the uninterrupted run would.
@@ -64,6 +70,7 @@
 #include <Eigen/Core>
 
 #include "engine/assembly.h"
+#include "engine/cycle_jump.h"
 #include "engine/load_history.h"
 #include "engine/relaxation.h"
 #include "engine/static_solver.h"
@@ -85,11 +92,16 @@ struct QuasiStaticOptions {
   /// before the run stops with the element whose history changes fastest: a history that keeps
   /// the step near min_dt_s would otherwise look like a hang (tens of thousands of Newton solves).
   long max_segment_steps = 5000;
+  /// Skipping trials whose history is extrapolated (engine/cycle_jump.h); off by default.
+  CycleJumpOptions cycle_jump;
 };
 
 /// One reported state.
 struct StateRecord {
   int trial = 0;             ///< 1-based
+  /// The trial was skipped by a cycle jump: the values are extrapolated linearly in the trial count
+  /// from the last two trials before the jump (at the same report of the trial), not solved.
+  bool extrapolated = false;
   double time_s = 0.0;       ///< time within the trial
   double global_time_s = 0.0;
   double pressure_Pa = 0.0;
@@ -103,6 +115,8 @@ struct QuasiStaticStats {
   long rejected_steps = 0;   ///< physical steps redone shorter
   long relaxation_iterations = 0;
   double wall_s = 0.0;
+  long cycle_jumps = 0;          ///< cycle jumps taken
+  long trials_extrapolated = 0;  ///< trials skipped by them (reported as extrapolated)
 };
 
 /// Everything needed to continue a run exactly where it stopped.
@@ -126,6 +140,11 @@ struct QuasiStaticCheckpoint {
   /// The first step of the last falling [0] and rising [1] ramp since the last release, as the
   /// pressure increment the control suggested after it (Pa; 0 = none): the next ramp's first guess.
   double ramp_start_dp_Pa[2] = {0.0, 0.0};
+  /// Cycle jumping only: the histories at the last (up to 3) consecutive trial ends, the reports of
+  /// those trials and those of the current trial so far.
+  std::vector<std::vector<double>> cycle_ends;
+  std::vector<std::vector<StateRecord>> cycle_reports;
+  std::vector<StateRecord> trial_reports;
 
   void write(std::ostream& os) const;
   /// Throws InputError when the stream is not a checkpoint of a model with `dofs` and `state_size`.
@@ -161,6 +180,10 @@ class QuasiStaticRun {
   static std::vector<Segment> segments(const LoadHistory& load);
 
  private:
+  /// Cycle jumping at the end of the trial whose last segment is segs[i] (engine/cycle_jump.h):
+  /// records the trial's end, and when (3) allows a jump by N, extrapolates the history, reports
+  /// the N skipped trials as extrapolated and returns the index of the last skipped segment (else i).
+  std::size_t end_of_trial(const std::vector<Segment>& segs, std::size_t i, const Observer& observer);
   std::string failure_note() const;  ///< where damage laws report failed points ("" = none)
   void solve_segment(const Segment& s);
   void equilibrium(double p0, double p1, double t0, double t1);
@@ -189,6 +212,10 @@ class QuasiStaticRun {
   std::vector<Material::LinearDrive> drive_kinds_;
   std::vector<double> drive_prev_, drive_cur_;
   bool damage_grew_ = false;
+  // Cycle jumping, as the checkpoint's cycle_ends, cycle_reports, trial_reports.
+  std::vector<std::vector<double>> cycle_ends_;
+  std::vector<std::vector<StateRecord>> cycle_reports_;
+  std::vector<StateRecord> trial_reports_;
 };
 
 }  // namespace pneufem

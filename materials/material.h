@@ -13,6 +13,7 @@
 // everything in "iso" and report is_split() == false.
 //
 // Units: SI (Pa for stresses and energy densities J/m^3, s for time).
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <span>
@@ -165,6 +166,31 @@ class Material {
   virtual void linear_drive_value(std::span<const double> state, std::span<double> out) const {
     (void)state;
     (void)out;
+  }
+
+  /// Cycle jumping (engine/cycle_jump.h; Cojocaru & Karlsson 2006, Abaqus "Low-cycle fatigue
+  /// analysis using the direct cyclic approach"). `before` and `after` are one point's committed
+  /// states at the ends of two consecutive load cycles; jump_cycles writes into `out` the state N
+  /// cycles after `after`, each history variable extrapolated linearly in a measure that grows
+  /// about linearly per cycle (fatigue: the integrity's s^(1-n); Mullins: the peak energy), and
+  /// variables set by the last part of a cycle (the Prony branches, fixed by the rest) copied from
+  /// `after`. jump_error says by how much two states of a point differ in what the extrapolated
+  /// variables do to the stress, as the largest change of the isochoric stiffness fraction they
+  /// can cause (dimensionless); the engine compares a one-cycle prediction with a computed cycle.
+  /// A law says it can do this with jumps_cycles(); the default can for laws without history and
+  /// refuses for others, so a law that does not know how its history extrapolates never jumps.
+  /// Decorators extrapolate their own part and forward the rest (their base's slice) to the base.
+  virtual bool jumps_cycles() const { return state_size() == 0; }
+  virtual void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                           std::span<double> out) const {
+    (void)before;
+    (void)cycles;
+    std::copy(after.begin(), after.end(), out.begin());
+  }
+  virtual double jump_error(std::span<const double> predicted, std::span<const double> computed) const {
+    (void)predicted;
+    (void)computed;
+    return 0.0;
   }
 
   struct NonlocalSpec {

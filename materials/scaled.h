@@ -36,6 +36,14 @@ class ScaledMaterial final : public Material {
   void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
     base_->linear_drive_value(state, out);
   }
+  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
+                   std::span<double> out) const override {
+    base_->jump_cycles(before, after, cycles, out);
+  }
+  double jump_error(std::span<const double> predicted, std::span<const double> computed) const override {
+    return base_->jump_error(predicted, computed);
+  }
   NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
     return base_->nonlocal_driver(F, state);

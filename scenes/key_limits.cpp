@@ -105,6 +105,10 @@ std::vector<KeyLimit> make_limits() {
   l.push_back(positive("solver.min_dt_s", kMaxTime_s, kTimeWhy));
   l.push_back(positive("solver.max_dt_s", kMaxTime_s, kTimeWhy));
   l.push_back(closed("solver.max_segment_steps", 1, 100000000, "1e8 steps of one segment is a stall"));
+  l.push_back(KeyLimit{"solver.cycle_jump_tol", 0.0, 0.1, true, false,
+                       "a relative error of the compliance; 0.1 would let a jump be 10 % wrong"});
+  l.push_back(KeyLimit{"solver.cycle_jump_change", 0.0, 0.5, true, false,
+                       "a relative compliance change; half of it in one jump is no extrapolation"});
   l.push_back(closed("solver.krylov_max_iterations", 0, 10000, "0 = off; tens of CG steps are enough"));
   l.push_back(KeyLimit{"solver.dt_safety", 0.0, 1.0, true, false, "a fraction of the stable time step"});
   l.push_back(closed("solver.target_dt_s", 0.0, 1.0, "0 = no mass scaling; explicit steps are microseconds"));

@@ -56,6 +56,9 @@ SolverSettings solver_settings(const Scene& s) {
   if (sv.quasi_static.max_dt_s < sv.quasi_static.min_dt_s) s.fail("solver.max_dt_s", "must be >= solver.min_dt_s");
   sv.quasi_static.max_segment_steps = s.integer("solver.max_segment_steps");
   if (sv.quasi_static.max_segment_steps < 1) s.fail("solver.max_segment_steps", "must be >= 1");
+  sv.quasi_static.cycle_jump.on = s.boolean("solver.cycle_jump");
+  sv.quasi_static.cycle_jump.tol = positive(s, "solver.cycle_jump_tol");
+  sv.quasi_static.cycle_jump.change = positive(s, "solver.cycle_jump_change");
   sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
   if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
   sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");

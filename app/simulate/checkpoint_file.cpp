@@ -11,7 +11,7 @@ namespace pneufem {
 
 namespace {
 
-const std::string kMagicLine = "pneufem checkpoint 1";  // the format's version: a new layout counts up
+const std::string kMagicLine = "pneufem checkpoint 2";  // the format's version: a new layout counts up (2: StateRecord::extrapolated)
 const std::string kMagic = kMagicLine + "\n";
 constexpr std::size_t kHexDigits = 16;  // one 64-bit FNV-1a hash
 const std::string kChecksumTag = "checksum ";

@@ -1,5 +1,6 @@
 #include "app/simulate/command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -52,13 +53,17 @@ std::string mesh_stats_json(const MeshStats& s) {
   return o.str(2);
 }
 
+/// With trials skipped by cycle jumping, a last column `extrapolated` (1: not solved, see angles_csv).
 std::string states_csv(const std::vector<StateRecord>& recs) {
-  std::string s = "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm\n";
+  const bool jumped = std::any_of(recs.begin(), recs.end(), [](const StateRecord& r) { return r.extrapolated; });
+  std::string s = "trial,time_s,global_time_s,pressure_kPa,angle_deg,cavity_volume_mm3,tip_plane_rms_mm";
+  s += jumped ? ",extrapolated\n" : "\n";
   char line[256];
   for (const StateRecord& r : recs) {
-    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n", r.trial, r.time_s, r.global_time_s,
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g", r.trial, r.time_s, r.global_time_s,
                   r.pressure_Pa * 1e-3, r.angle_deg, r.cavity_volume_m3 * 1e9, r.plane_rms_m * 1e3);
     s += line;
+    s += jumped ? (r.extrapolated ? ",1\n" : ",0\n") : "\n";
   }
   return s;
 }
@@ -332,7 +337,8 @@ class RunRecorder {
 
   void observe(const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
     app_.records.push_back(r);
-    if (want_vtu_ && (bm_.output.vtu == "all" || is_step_end(r))) {
+    // A trial skipped by a cycle jump has no fields, only its extrapolated angles.
+    if (want_vtu_ && !r.extrapolated && (bm_.output.vtu == "all" || is_step_end(r))) {
       char name[64];
       std::snprintf(name, sizeof name, "vtu/state_%04zu.vtu", app_.vtu.size());
       write_vtu((dir_ / name).string(), bm_.model, compute_fields(asmb_, u, state), r.global_time_s, r.trial,
@@ -431,6 +437,9 @@ void run_full_fem(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec,
       .add("assembly_s", st.assembly_s)
       .add("factor_solve_s", st.factor_s)
       .add("resumed", opt.resume ? 1.0 : 0.0);
+  if (bm.solver.quasi_static.cycle_jump.on)
+    solver_stats.add("cycle_jumps", static_cast<double>(run.stats().cycle_jumps))
+        .add("trials_extrapolated", static_cast<double>(run.stats().trials_extrapolated));
 }
 
 /// Explicit dynamics through the concatenated trials; time_scale > 1 compresses the protocol
@@ -485,7 +494,11 @@ std::string write_metrics(const fs::path& dir, const BuiltModel& bm, const std::
   const int ntrials = static_cast<int>(bm.load.trials.size());
   const StepAngles ref = step_angles(bm.load.trials[0], 1, ideal);
   std::vector<TrialMetrics> per_trial;
-  for (int k = 0; k < ntrials; ++k) per_trial.push_back(paper_metrics(step_angles(bm.load.trials[k], k + 1, records), ref));
+  for (int k = 0; k < ntrials; ++k) {
+    per_trial.push_back(paper_metrics(step_angles(bm.load.trials[k], k + 1, records), ref));
+    per_trial.back().extrapolated = std::any_of(records.begin(), records.end(),
+                                                [&](const StateRecord& r) { return r.trial == k + 1 && r.extrapolated; });
+  }
   write_file_atomic((dir / "metrics.json").string(), metrics_json(per_trial, ref.level_kPa));
   return json::quote("metrics.json");
 }

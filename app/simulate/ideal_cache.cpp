@@ -1,5 +1,6 @@
 #include "app/simulate/ideal_cache.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -35,14 +36,17 @@ std::string ideal_cache_key(const Scene& ideal_scene, const Model& model, const 
 }
 
 std::string angles_csv(const std::vector<StateRecord>& recs, bool exact) {
-  std::string s = "trial,time_s,pressure_kPa,angle_deg\n";
+  // Trials skipped by cycle jumping (StateRecord::extrapolated) add a column: 1 = extrapolated, 0 = solved.
+  const bool jumped = std::any_of(recs.begin(), recs.end(), [](const StateRecord& r) { return r.extrapolated; });
+  std::string s = jumped ? "trial,time_s,pressure_kPa,angle_deg,extrapolated\n" : "trial,time_s,pressure_kPa,angle_deg\n";
   char line[160];
   for (const StateRecord& r : recs) {
     if (exact)
-      std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+      std::snprintf(line, sizeof line, "%d,%.17g,%.17g,%.17g", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     else
-      std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
+      std::snprintf(line, sizeof line, "%d,%.6f,%.6f,%.6f", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
     s += line;
+    s += jumped ? (r.extrapolated ? ",1\n" : ",0\n") : "\n";
   }
   return s;
 }

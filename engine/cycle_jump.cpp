@@ -1,0 +1,102 @@
+#include "engine/cycle_jump.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace pneufem {
+
+namespace {
+/// Calls f(material, offset, size) for every material point with history.
+template <class F>
+void for_each_point(const Assembler& asmb, F&& f) {
+  const int ne = asmb.model().mesh.num_elements();
+  const int nqp = asmb.geometry().nqp;
+  std::size_t o = 0;
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = asmb.model().material_of(e);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    for (int q = 0; q < nqp; ++q, o += ss)
+      if (ss > 0) f(mat, o, ss);
+  }
+}
+}  // namespace
+
+bool model_jumps_cycles(const Assembler& asmb, std::string& law) {
+  const int ne = asmb.model().mesh.num_elements();
+  for (int e = 0; e < ne; ++e) {
+    const Material& mat = asmb.model().material_of(e);
+    if (!mat.jumps_cycles()) {
+      law = mat.name();
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<double> jump_history(const Assembler& asmb, std::span<const double> before, std::span<const double> after,
+                                 double cycles) {
+  std::vector<double> out(after.begin(), after.end());
+  for_each_point(asmb, [&](const Material& mat, std::size_t o, std::size_t ss) {
+    mat.jump_cycles(before.subspan(o, ss), after.subspan(o, ss), cycles, std::span<double>(out).subspan(o, ss));
+  });
+  return out;
+}
+
+std::vector<double> energy_shares(const Assembler& asmb, const Eigen::VectorXd& u, std::span<const double> state) {
+  const int ne = asmb.model().mesh.num_elements();
+  const int nqp = asmb.geometry().nqp;
+  std::vector<double> share(static_cast<std::size_t>(ne) * nqp, 0.0);
+  std::vector<Mat3> F(static_cast<std::size_t>(nqp));
+  std::vector<PointResponse> r(static_cast<std::size_t>(nqp));
+  double total = 0.0;
+  for (int e = 0; e < ne; ++e) {
+    asmb.point_responses(u, e, asmb.element_state(state, e), F, r);
+    const bool history = asmb.model().material_of(e).state_size() > 0;
+    for (int q = 0; q < nqp; ++q) {
+      const double w = asmb.geometry().weight[static_cast<std::size_t>(e) * nqp + q];
+      total += w * r[q].psi();
+      if (history) share[static_cast<std::size_t>(e) * nqp + q] = w * std::max(0.0, r[q].psi_iso);
+    }
+  }
+  if (total > 0.0)
+    for (double& s : share) s /= total;
+  else  // an unloaded structure: volume shares of the points with history
+    return {};
+  return share;
+}
+
+double history_jump_error(const Assembler& asmb, const std::vector<double>& share, std::span<const double> predicted,
+                          std::span<const double> computed) {
+  double e = 0.0, volume = 0.0, sum = 0.0;
+  std::size_t p = 0;
+  const int nqp = asmb.geometry().nqp;
+  for (int el = 0; el < asmb.model().mesh.num_elements(); ++el) {
+    const Material& mat = asmb.model().material_of(el);
+    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
+    const std::size_t o = asmb.element_state(computed, el).data() - computed.data();
+    for (int q = 0; q < nqp; ++q, ++p) {
+      if (ss == 0) continue;
+      const double err = mat.jump_error(predicted.subspan(o + q * ss, ss), computed.subspan(o + q * ss, ss));
+      if (share.empty()) {
+        const double w = asmb.geometry().weight[p];
+        sum += w * err;
+        volume += w;
+      } else {
+        e += share[p] * err;
+      }
+    }
+  }
+  return share.empty() ? (volume > 0.0 ? sum / volume : 0.0) : e;
+}
+
+int cycles_to_jump(double e1, double c1, const CycleJumpOptions& opt, int max_cycles) {
+  if (max_cycles < 1) return 0;
+  double n = static_cast<double>(max_cycles);
+  // e1 N (N + 1) / 2 <= tol: N <= (sqrt(1 + 8 tol / e1) - 1) / 2.
+  if (e1 > 0.0) n = std::min(n, std::floor(0.5 * (std::sqrt(1.0 + 8.0 * opt.tol / e1) - 1.0)));
+  if (c1 > 0.0) n = std::min(n, std::floor(opt.change / c1));
+  return std::max(0, static_cast<int>(n));
+}
+
+}  // namespace pneufem
