@@ -11,12 +11,12 @@
 #     in suites of seconds (but the three tests that bend an actuator); the solver suites run for
 #     minutes and read no user input;
 #  3. runs each fuzzer over its seed corpus (fuzz/corpus/) and on new inputs for
-#     PNEUFEM_FUZZ_SECONDS (default 40) each (scripts/fuzz.sh).
+#     PNEUFEM_FUZZ_SECONDS (default 20) each (scripts/fuzz.sh).
 # Any sanitizer report, failed test or fuzzer finding fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${PNEUFEM_SANITIZE_BUILD:-build-sanitize}
-seconds=${PNEUFEM_FUZZ_SECONDS:-40}
+seconds=${PNEUFEM_FUZZ_SECONDS:-20}
 tests=(test_inp test_inp_assembly test_scene test_scene_settings test_key_limits test_measurements)
 # The three tests that bend an actuator (a solver run, minutes under ASan) read no input their
 # siblings do not: left to the normal suite.
