@@ -7,17 +7,18 @@
 namespace pneufem {
 
 namespace {
-/// Calls f(material, offset, size) for every material point with history.
+/// Calls f(material, p, offset, size) for every material point with history: p its index among all
+/// points (element-major, as the quadrature weights), offset and size its slice of the state.
 template <class F>
 void for_each_point(const Assembler& asmb, F&& f) {
   const int ne = asmb.model().mesh.num_elements();
   const int nqp = asmb.geometry().nqp;
-  std::size_t o = 0;
+  std::size_t o = 0, p = 0;
   for (int e = 0; e < ne; ++e) {
     const Material& mat = asmb.model().material_of(e);
     const std::size_t ss = static_cast<std::size_t>(mat.state_size());
-    for (int q = 0; q < nqp; ++q, o += ss)
-      if (ss > 0) f(mat, o, ss);
+    for (int q = 0; q < nqp; ++q, o += ss, ++p)
+      if (ss > 0) f(mat, p, o, ss);
   }
 }
 }  // namespace
@@ -37,7 +38,7 @@ bool model_jumps_cycles(const Assembler& asmb, std::string& law) {
 std::vector<double> jump_history(const Assembler& asmb, std::span<const double> before, std::span<const double> after,
                                  double cycles) {
   std::vector<double> out(after.begin(), after.end());
-  for_each_point(asmb, [&](const Material& mat, std::size_t o, std::size_t ss) {
+  for_each_point(asmb, [&](const Material& mat, std::size_t, std::size_t o, std::size_t ss) {
     mat.jump_cycles(before.subspan(o, ss), after.subspan(o, ss), cycles, std::span<double>(out).subspan(o, ss));
   });
   return out;
@@ -59,35 +60,22 @@ std::vector<double> energy_shares(const Assembler& asmb, const Eigen::VectorXd& 
       if (history) share[static_cast<std::size_t>(e) * nqp + q] = w * std::max(0.0, r[q].psi_iso);
     }
   }
-  if (total > 0.0)
-    for (double& s : share) s /= total;
-  else  // an unloaded structure: volume shares of the points with history
-    return {};
+  if (!(total > 0.0)) return {};  // an unloaded structure: the caller weighs points by volume
+  for (double& s : share) s /= total;
   return share;
 }
 
 double history_jump_error(const Assembler& asmb, const std::vector<double>& share, std::span<const double> predicted,
                           std::span<const double> computed) {
-  double e = 0.0, volume = 0.0, sum = 0.0;
-  std::size_t p = 0;
-  const int nqp = asmb.geometry().nqp;
-  for (int el = 0; el < asmb.model().mesh.num_elements(); ++el) {
-    const Material& mat = asmb.model().material_of(el);
-    const std::size_t ss = static_cast<std::size_t>(mat.state_size());
-    const std::size_t o = asmb.element_state(computed, el).data() - computed.data();
-    for (int q = 0; q < nqp; ++q, ++p) {
-      if (ss == 0) continue;
-      const double err = mat.jump_error(predicted.subspan(o + q * ss, ss), computed.subspan(o + q * ss, ss));
-      if (share.empty()) {
-        const double w = asmb.geometry().weight[p];
-        sum += w * err;
-        volume += w;
-      } else {
-        e += share[p] * err;
-      }
-    }
-  }
-  return share.empty() ? (volume > 0.0 ? sum / volume : 0.0) : e;
+  double weighted = 0.0, volume = 0.0;
+  for_each_point(asmb, [&](const Material& mat, std::size_t p, std::size_t o, std::size_t ss) {
+    const double err = mat.jump_error(predicted.subspan(o, ss), computed.subspan(o, ss));
+    const double w = share.empty() ? asmb.geometry().weight[p] : share[p];
+    weighted += w * err;
+    volume += w;
+  });
+  if (!share.empty()) return weighted;
+  return volume > 0.0 ? weighted / volume : 0.0;
 }
 
 int cycles_to_jump(double e1, double c1, const CycleJumpOptions& opt, int max_cycles) {

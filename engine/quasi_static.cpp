@@ -485,8 +485,8 @@ double report_second_difference(const std::vector<std::vector<StateRecord>>& tri
 
 /// True when every trial of `load` repeats the first one's load and reports.
 bool trials_repeat(const LoadHistory& load) {
+  const TrialLoad& t0 = load.trials.front();
   for (const TrialLoad& t : load.trials) {
-    const TrialLoad& t0 = load.trials.front();
     if (t.time_s != t0.time_s || t.pressure_Pa != t0.pressure_Pa || t.output_s != t0.output_s) return false;
   }
   return true;

@@ -62,7 +62,10 @@
 //
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
-// resuming from a checkpoint continues bit-for-bit as the uninterrupted run would.
+// resuming from a checkpoint continues as the uninterrupted run would: bit for bit from a checkpoint
+// before a ramp; from one before a hold or rest the results differ in the last bits (measured
+// 2026-11-27), most likely because the last factorisation, which preconditions the Krylov steps at
+// constant pressure, is not part of the checkpoint.
 #include <functional>
 #include <string>
 #include <vector>

@@ -356,12 +356,9 @@ struct ReplayOptions {
 /// per step of the trajectory. Throws PhysicsError when an element inverts in the reconstruction.
 using ReplayObserver =
     std::function<void(const ReducedStep&, const Eigen::VectorXd& u, const std::vector<double>& state, const ReducedCheck&)>;
-/// `newton_at` (optional) picks the reports that also get the Newton-step check (one factorisation each).
+/// `options` add the Newton-step check and the corrected history at the reports they pick; the
+/// observer's `state` is the reduced run's replayed history either way.
 void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
-                        const std::function<bool(const ReducedStep&)>& newton_at = nullptr);
-/// The same with the corrected history (ReplayOptions). The observer's `state` is the reduced run's
-/// replayed history either way.
-void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
-                        const ReplayOptions& options);
+                        const ReplayOptions& options = {});
 
 }  // namespace pneufem

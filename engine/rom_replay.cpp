@@ -72,7 +72,9 @@ class CorrectedHistory {
     Eigen::VectorXd uc = u + scale * du_;
     const TimeStep ts{step.time_s, step.dt_s};
     converged = false;
-    bool committed = false;
+    // Where the step's history stands: committed (by a continuation), in trial_ (at the solve's
+    // converged state), or still to be evaluated at the prediction.
+    enum class History { ToEvaluate, InTrial, Committed } history = History::ToEvaluate;
     if (correct) {
       Eigen::VectorXd solved = uc;
       try {
@@ -80,7 +82,9 @@ class CorrectedHistory {
       } catch (const PhysicsError&) {
         converged = false;  // an element inverted on the way
       }
-      if (!converged) {
+      if (converged) {
+        history = History::InTrial;
+      } else {
         // Continuation from the last converged corrected state (an equilibrium, at the pressure of
         // the last correction, of a slightly older history), in pressure sub-increments while the
         // time runs from the committed history's to the step's.
@@ -89,7 +93,8 @@ class CorrectedHistory {
         solver_.set_path({});  // no predictor from an earlier check's path
         try {
           solver_.advance(p_check_, step.pressure_Pa, t_prev_, step.time_s, state, solved);
-          converged = committed = true;
+          converged = true;
+          history = History::Committed;
           state_.swap(state);
         } catch (const PhysicsError&) {
           converged = false;  // no equilibrium reached: keep the prediction
@@ -102,10 +107,8 @@ class CorrectedHistory {
         p_check_ = step.pressure_Pa;
       }
     }
-    if (!committed) {
-      solver_.residual(step.pressure_Pa, ts, state_, trial_, uc);  // the step's history at uc
-      state_.swap(trial_);
-    }
+    if (history == History::ToEvaluate) solver_.residual(step.pressure_Pa, ts, state_, trial_, uc);  // the step's history at uc
+    if (history != History::Committed) state_.swap(trial_);
     A_.update_nonlocal(uc, state_);
     t_prev_ = step.time_s;
     return uc;
@@ -120,13 +123,6 @@ class CorrectedHistory {
 };
 
 }  // namespace
-
-void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
-                        const std::function<bool(const ReducedStep&)>& newton_at) {
-  ReplayOptions options;
-  options.newton_at = newton_at;
-  replay_reduced_run(rom, trajectory, at_report, options);
-}
 
 void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
                         const ReplayOptions& options) {
