@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
   bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false;
-  int snap_trials = 0;
+  int snap_trials = 0, enrich = 0;
+  std::string save_corrected, extra_snapshots;
   int threads = 0;
   RomBasisOptions ro;
   ro.verbose = true;
@@ -119,6 +120,9 @@ int main(int argc, char** argv) {
     else if (a == "--snap-trials") snap_trials = std::stoi(next());  // FEM snapshots of the first N trials enrich the basis
     else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
+    else if (a == "--save-corrected") save_corrected = next();   // the enrichment's corrected states, to a file
+    else if (a == "--extra-snapshots") extra_snapshots = next(); // snapshots from such a file join the basis
+    else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
     else if (a == "--dump-points") dump = true;  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
@@ -184,10 +188,35 @@ int main(int argc, char** argv) {
     const Scene snap_scene = scene.with(snap_sets).with({"load.trials=" + std::to_string(snap_trials)});
     auto sm = build_model(snap_scene);
     const auto t0 = Clock::now();
-    Assembler A(sm->model);
-    QuasiStaticRun q(A, sm->solver.quasi_static);
-    q.run(sm->load, [&](const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>&) { snapshots.push_back(u); });
-    std::printf("snapshots: %zu FEM reports of %d trial(s) in %.1f s\n", snapshots.size(), snap_trials, since(t0));
+    // Cached in the work directory (keyed by the snapshot run's scene): an A/B of basis options
+    // does not pay the FEM run again.
+    const fs::path f = fs::path(work) / ("snapshots_" + std::to_string(fnv(snap_scene.model_toml())) + ".bin");
+    std::vector<double> d;
+    const long nd = sm->model.num_dofs();
+    if (read_doubles(f, d) && d.size() % static_cast<std::size_t>(nd) == 0) {
+      for (std::size_t k = 0; k < d.size() / static_cast<std::size_t>(nd); ++k)
+        snapshots.push_back(Eigen::Map<const Eigen::VectorXd>(d.data() + k * nd, nd));
+      std::printf("snapshots: %zu FEM reports from %s\n", snapshots.size(), f.c_str());
+    } else {
+      Assembler A(sm->model);
+      QuasiStaticRun q(A, sm->solver.quasi_static);
+      q.run(sm->load, [&](const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>&) { snapshots.push_back(u); });
+      d.clear();
+      for (const auto& u : snapshots) d.insert(d.end(), u.data(), u.data() + u.size());
+      write_doubles(f, d);
+      std::printf("snapshots: %zu FEM reports of %d trial(s) in %.1f s\n", snapshots.size(), snap_trials, since(t0));
+    }
+  }
+  if (!extra_snapshots.empty()) {
+    std::vector<double> d;
+    const long nd = ref->model.num_dofs();
+    if (!read_doubles(extra_snapshots, d) || d.size() % static_cast<std::size_t>(nd) != 0) {
+      std::printf("cannot read snapshots from %s\n", extra_snapshots.c_str());
+      return 1;
+    }
+    for (std::size_t k = 0; k < d.size() / static_cast<std::size_t>(nd); ++k)
+      snapshots.push_back(Eigen::Map<const Eigen::VectorXd>(d.data() + k * nd, nd));
+    std::printf("snapshots: %zu from %s\n", d.size() / static_cast<std::size_t>(nd), extra_snapshots.c_str());
   }
   const auto tb = Clock::now();
   // The basis is cached too (keyed by the reference, the options and the snapshot run), so that an
@@ -199,11 +228,17 @@ int main(int argc, char** argv) {
                   snap_sets.size());
     std::string snap_key;
     for (const std::string& s : snap_sets) snap_key += s + ";";
+    if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
     const fs::path f = fs::path(work) / ("basis_" + std::to_string(fnv(ref_scene.model_toml() + opts + snap_key)) + ".bin");
     std::vector<double> d;
     if (read_doubles(f, d)) {
-      std::printf("basis: from %s\n", f.c_str());
-      return ReducedBasis::from_doubles(d);
+      try {
+        ReducedBasis b = ReducedBasis::from_doubles(d);
+        std::printf("basis: from %s\n", f.c_str());
+        return b;
+      } catch (const InputError& e) {
+        std::printf("basis: %s: %s; rebuilt\n", f.c_str(), e.what());
+      }
     }
     ReducedBasis b = build_reduced_basis(ref->model, trace, ro, snapshots);
     write_doubles(f, b.to_doubles());
@@ -265,7 +300,7 @@ int main(int argc, char** argv) {
               st.beyond_path ? ", BEYOND THE PATH" : "");
   // The a-posteriori indicators at every report: the adjoint-weighted residual and one full Newton step.
   std::vector<double> est_adj, est_newton, est_corr;
-  if (check) {
+  if (check && enrich == 0) {
     const auto t0 = Clock::now();
     ReplayOptions replay_opt;
     replay_opt.newton_at = [](const ReducedStep& s) { return s.report >= 0 && s.pressure_Pa > 0.0; };
@@ -285,6 +320,65 @@ int main(int argc, char** argv) {
         },
         replay_opt);
     std::printf("replay with checks: %.1f s\n", since(t0));
+  }
+  // Enrichment rounds: the corrected states (full-model equilibria near the reduced ones, with the
+  // history the full model would have built) join the snapshots; the basis is rebuilt and the run
+  // repeated.
+  std::vector<std::unique_ptr<ReducedBasis>> bases;
+  std::vector<std::unique_ptr<ReducedOrderModel>> roms;
+  std::vector<std::unique_ptr<ReducedRun>> runs;
+  std::vector<Eigen::VectorXd> corrected_states;
+  const ReducedOrderModel* rom_now = &rom;
+  const ReducedRun* run_now = &run;
+  for (int round = 0; round <= enrich && corrected; ++round) {
+    if (round > 0) {
+      std::vector<Eigen::VectorXd> snaps = snapshots;
+      snaps.insert(snaps.end(), corrected_states.begin(), corrected_states.end());
+      const auto t0 = Clock::now();
+      bases.push_back(std::make_unique<ReducedBasis>(build_reduced_basis(ref->model, trace, ro, snaps)));
+      std::printf("enrich %d: %zu snapshots, %d modes, %zu sampled elements, basis %.1f s\n", round, snaps.size(),
+                  bases.back()->num_modes(), bases.back()->elements.size(), since(t0));
+      roms.push_back(std::make_unique<ReducedOrderModel>(ref->model, *bases.back(), bm->model));
+      runs.push_back(std::make_unique<ReducedRun>(*roms.back(), bm->solver.quasi_static));
+      rom_now = roms.back().get();
+      run_now = runs.back().get();
+      red = Record{};
+      const auto t1 = Clock::now();
+      try {
+        runs.back()->run(bm->load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) {
+          red.trial.push_back(r.trial), red.t.push_back(r.time_s), red.p.push_back(r.pressure_Pa), red.angle.push_back(r.angle_deg);
+        });
+      } catch (const std::exception& e) {
+        std::printf("enrich %d: reduced run failed: %s\n", round, e.what());
+      }
+      std::printf("enrich %d: reduced run %.1f s, %ld states\n", round, since(t1), runs.back()->stats().states);
+    }
+    if (round == enrich) break;
+    ReplayOptions replay_opt;
+    replay_opt.corrected_at = [p_max, corrected_tops](const ReducedStep& s) {
+      return s.report >= 0 && s.pressure_Pa > (corrected_tops ? 0.99 * p_max : 0.0);
+    };
+    replay_opt.newton = bm->solver.quasi_static.newton;
+    const auto t2 = Clock::now();
+    double worst = 0.0;
+    int added = 0;
+    replay_reduced_run(
+        *rom_now, run_now->trajectory(),
+        [&](const ReducedStep& s, const Eigen::VectorXd&, const std::vector<double>&, const ReducedCheck& c) {
+          if (s.report < 0) return;
+          if (std::isfinite(c.corrected_angle_error_deg)) worst = std::max(worst, std::abs(c.corrected_angle_error_deg));
+          if (c.corrected_u.size() > 0) corrected_states.push_back(c.corrected_u), ++added;
+          const std::size_t i = static_cast<std::size_t>(s.report);
+          if (i < est_corr.size()) est_corr[i] = c.corrected_angle_error_deg;
+        },
+        replay_opt);
+    std::printf("enrich %d: replay %.1f s, worst corrected estimate %.3f deg, %d corrected states\n", round, since(t2), worst, added);
+  }
+  if (!save_corrected.empty()) {
+    std::vector<double> d;
+    for (const auto& u : corrected_states) d.insert(d.end(), u.data(), u.data() + u.size());
+    write_doubles(save_corrected, d);
+    std::printf("corrected states: %zu to %s\n", corrected_states.size(), save_corrected.c_str());
   }
   // Kept points, ROM against FEM, at the last report of every trial: damage and largest stretch.
   if (dump) {

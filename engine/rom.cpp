@@ -258,6 +258,7 @@ struct ReducedOrderModel::Impl {
   std::vector<double> dp;                   ///< monotone slopes of p_el
   std::vector<double> dwg;                  ///< slopes of w^T g (spline)
   Eigen::MatrixXd db, dc, dh, dgt, dgauge;  ///< slopes of b (exact), c, h, gt, gauge
+  Eigen::MatrixXd dpw;                      ///< slopes of pw
   std::vector<Eigen::MatrixXd> dK, dH, dKref;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<int> tip_nodes;               ///< nodes whose displacement the angle needs
@@ -307,6 +308,7 @@ ReducedOrderModel::ReducedOrderModel(const Model& reference, const ReducedBasis&
   impl_->dK = slopes_of(th, basis.K);
   impl_->dH = slopes_of(th, basis.H);
   impl_->dKref = slopes_of(th, basis.Kref);
+  impl_->dpw = slopes_of(th, basis.pw);
   impl_->gravity = model.gravity_m_s2;
 }
 
@@ -339,7 +341,12 @@ double ReducedOrderModel::cavity_volume(const ReducedCoordinates& z) const {
   const int k = path_segment_index(th, z.theta);
   const Hermite h((z.theta - th[k]) / (th[k + 1] - th[k]), th[k + 1] - th[k]);
   double V = h.value(basis_.V[k], basis_.V[k + 1], basis_.dV[k], basis_.dV[k + 1]);
-  if (z.q.size() > 0) V += spline_at(basis_.b, impl_->db, k, h).v.dot(z.q);
+  if (z.q.size() > 0) {
+    // V(u_el + d) = V + g.d + d^T H_V d / 2 + g2[d, d, d] / 6: to second order in q (the third is
+    // ~|d|/L of the second).
+    const Eigen::MatrixXd Hq = h.value(basis_.H[k], basis_.H[k + 1], impl_->dH[k], impl_->dH[k + 1]);
+    V += spline_at(basis_.b, impl_->db, k, h).v.dot(z.q) + 0.5 * z.q.dot(Hq * z.q);
+  }
   return V;
 }
 
@@ -389,6 +396,17 @@ Eigen::VectorXd ReducedOrderModel::residual(const ReducedCoordinates& z, double 
                                            : Eigen::VectorXd::Zero(n1);
   const Eigen::MatrixXd Kref = h.value(B.Kref[k], B.Kref[k + 1], impl_->dKref[k], impl_->dKref[k + 1]);
   R.head(n1) += G - Gref - Kref.rightCols(r) * q;
+  // The follower load's second order in q (ReducedBasis::pq, pw): -p/2 T^T g2[Phi q, Phi q].
+  const Eigen::Index rr = static_cast<Eigen::Index>(r) * r;
+  Splined pw2;
+  Eigen::VectorXd qq;
+  if (r > 0) {
+    qq.resize(rr);
+    for (int l = 0; l < r; ++l) qq.segment(static_cast<Eigen::Index>(r) * l, r) = q[l] * q;
+    pw2 = spline_at(B.pw, impl_->dpw, k, h);
+    R[0] -= 0.5 * p_Pa * pw2.v.dot(qq);
+    R.segment(1, r).noalias() -= (0.5 * p_Pa) * (B.pq * qq);
+  }
 
   // Gauge: q is mass-orthogonal to u_el'(theta); multiplier lambda.
   R[0] += z.lambda * gauge.d.dot(q);
@@ -407,6 +425,14 @@ Eigen::VectorXd ReducedOrderModel::residual(const ReducedCoordinates& z, double 
     Jm.block(1, 1, r, r) = Kq + dp * Hq;
     if (!gvec.isZero()) {
       Jm(0, 0) -= gt.d.dot(gvec);
+    }
+    // The load's second order: d/dq of -p/2 q^T A q is -p A q (A = w^T g2 symmetric), of
+    // -p/2 pq (q x q) is -p sum_l q_l pq(:, r l .. r l + r).
+    if (r > 0) {
+      const Eigen::Map<const Eigen::MatrixXd> A2(pw2.v.data(), r, r);
+      Jm(0, 0) -= 0.5 * p_Pa * pw2.d.dot(qq);
+      Jm.block(0, 1, 1, r) -= p_Pa * (A2 * q).transpose();
+      for (int l = 0; l < r; ++l) Jm.block(1, 1, r, r) -= (p_Pa * q[l]) * B.pq.middleCols(static_cast<Eigen::Index>(r) * l, r);
     }
     // Hyper-reduced part.
     const Eigen::MatrixXd dKref = h.slope(B.Kref[k], B.Kref[k + 1], impl_->dKref[k], impl_->dKref[k + 1]);

@@ -46,7 +46,7 @@
 // model does. The residual is written in a difference ("control variate") form that keeps the elastic
 // reference exact and the stiff fabric unlocked:
 //
-//     r(theta, q) = E(theta, q; p) + [G_hat(theta, q) - G_hat_ref(theta) - K_hat_ref(theta) q] - T^T f_g
+//     r(theta, q) = E(theta, q; p) + P(theta, q; p) + [G_hat(theta, q) - G_hat_ref(theta) - K_hat_ref(theta) q] - T^T f_g
 //
 //   E:  the exact FEM reference residual linearised in q about the path,
 //         E_theta = (p_el(theta) - p) w^T g + [c(theta) + (p_el - p) h(theta)] . q
@@ -58,6 +58,12 @@
 //       model is reproduced exactly whatever the rest; the fabric (10^5 times stiffer than the silicone)
 //       enters only here, linearly in q: a linearised rotation of a correction mode does not stretch it
 //       to second order, which locked every linear reduced basis tried before (BENCHMARKS.md §7).
+//   P:  the follower load's second order in q, -p/2 T^T g2[Phi q, Phi q] (pq, pw below). The load per
+//       unit pressure g(u) = dV/du is quadratic in the nodal positions, so E plus this term is its
+//       exact projection, not a linearisation. It matters where q is large (a damaged wall
+//       ballooning into the gap): with the FEM's own states in the basis, the story's 15-chamber
+//       actuator (h = 6) was 0.45 deg off by trial 3 without it, 0.17 deg with it
+//       (bench/results/rom_h6_pressure_order).
 //   G_hat: the hyper-reduced projected internal force of the soft parts with the RUN'S materials and
 //       history, sum over sampled elements e of xi_e T_e^T f_e(u_e(theta, q)) (T = [w, Phi], the test vectors); G_hat_ref, K_hat_ref the
 //       same quadrature with the reference materials at q = 0 and its q-derivative (precomputed). The
@@ -138,6 +144,11 @@ struct ReducedBasis {
   static constexpr int kRefSub = 64;
   Eigen::MatrixXd Gref;           ///< (r + 1) x (segments * (kRefSub + 1))
   std::vector<Eigen::MatrixXd> Kref;  ///< (r + 1) x (r + 1) per sample: d G_hat_ref / d(theta, q) at q = 0
+  // The follower load's second order in q (constant: the load is quadratic in the positions):
+  // pq(i, j + r l) = Phi_i^T g2[Phi_j, Phi_l] and pw(j + r l, k) = w_k^T g2[Phi_j, Phi_l], g2 the
+  // second derivative of g = dV/du (see the header comment).
+  Eigen::MatrixXd pq;             ///< r x r^2
+  Eigen::MatrixXd pw;             ///< r^2 x ns
   std::vector<char> stiff_part;   ///< per part of the reference: 1 = stiff (linear reference only)
   double mesh_fingerprint = 0.0;  ///< mesh_fingerprint() of the reference's mesh
   // What the construction saw (reported in summaries).
@@ -231,7 +242,7 @@ class ReducedOrderModel {
   Eigen::VectorXd displacement(const ReducedCoordinates& z) const;
   /// Bending angle (deg, unwrapped near `previous_deg`) and tip-plane residual of z.
   double angle_deg(const ReducedCoordinates& z, double previous_deg, double* plane_rms_m = nullptr) const;
-  /// Cavity volume (m^3), linearised in q about the path (as the equations are).
+  /// Cavity volume (m^3), to second order in q about the path.
   double cavity_volume(const ReducedCoordinates& z) const;
 
   /// Reduced residual (r + 2: theta row, q rows, gauge row) at z, pressure p, physical step ts; reads
@@ -324,6 +335,9 @@ struct ReducedCheck {
   /// Requested, but the full model's solve of the corrected state found no equilibrium (near a
   /// limit point): the reduced state could not be checked there.
   bool corrected_failed = false;
+  /// The corrected state where it converged (empty elsewhere): a full-model equilibrium near the
+  /// reduced state, with the history the full model would have built (a snapshot for enrichment).
+  Eigen::VectorXd corrected_u;
 };
 
 /// The corrected history (the drift check). A second history of every element is integrated along

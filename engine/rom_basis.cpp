@@ -347,6 +347,47 @@ double mesh_fingerprint(const Mesh& mesh) {
   return static_cast<double>(h >> 12);
 }
 
+namespace {
+
+/// The follower load's second order in q (ReducedBasis::pq, pw). The load per unit pressure,
+/// g(u) = dV/du, is a polynomial of degree two in the nodal positions (each face's area vector
+/// x_xi x x_eta is bilinear in them, for any fixed quadrature), so
+///     g(u + d) = g(u) + H_V(u) d + 1/2 g2[d, d]
+/// exactly, with g2 constant, and by polarisation g2[a, b] = g(a + b) - g(a) - g(b) + g(0).
+/// The linearised reference carries g(u_el) + H_V(u_el) Phi q; this adds the rest, projected:
+/// pq(i, j + r l) = Phi_i^T g2[Phi_j, Phi_l], pw(j + r l, k) = w_k^T g2[Phi_j, Phi_l].
+/// Why: a damaged interior wall balloons into the gap (a large local q), and on the story's
+/// 15-chamber actuator with the FEM's own states in the basis the reduced model was 0.45 deg off
+/// by trial 3 without this term and 0.17 deg with it (bench/results/rom_h6_pressure_order).
+/// Cost: r (r + 3) / 2 + 1 assemblies of the pressure load, once.
+void pressure_second_order(const Assembler& A, ReducedBasis& B) {
+  const int r = B.num_modes();
+  const Eigen::Index nd = B.dofs(), ns = B.num_samples();
+  auto load = [&](const Eigen::VectorXd& u) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(nd);
+    A.add_pressure(u, 1.0, f, nullptr);
+    A.zero_fixed(f);
+    return f;
+  };
+  const Eigen::VectorXd g0 = load(Eigen::VectorXd::Zero(nd));
+  std::vector<Eigen::VectorXd> g1(static_cast<std::size_t>(r));
+  for (int j = 0; j < r; ++j) g1[static_cast<std::size_t>(j)] = load(B.Phi.col(j));
+  B.pq = Eigen::MatrixXd::Zero(r, static_cast<Eigen::Index>(r) * r);
+  B.pw = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(r) * r, ns);
+  for (int j = 0; j < r; ++j)
+    for (int l = j; l < r; ++l) {
+      const Eigen::VectorXd v = load(B.Phi.col(j) + B.Phi.col(l)) - g1[static_cast<std::size_t>(j)] - g1[static_cast<std::size_t>(l)] + g0;
+      const Eigen::VectorXd pv = B.Phi.transpose() * v;
+      const Eigen::RowVectorXd wv = v.transpose() * B.W;
+      B.pq.col(j + static_cast<Eigen::Index>(r) * l) = pv;
+      B.pq.col(l + static_cast<Eigen::Index>(r) * j) = pv;
+      B.pw.row(j + static_cast<Eigen::Index>(r) * l) = wv;
+      B.pw.row(l + static_cast<Eigen::Index>(r) * j) = wv;
+    }
+}
+
+}  // namespace
+
 ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& opt,
                                  const std::vector<Eigen::VectorXd>& snapshots) {
   const auto t_start = Clock::now();
@@ -571,6 +612,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     for (int d = 0; d < 3; ++d) B.gt(d, kk) = w.dot(f_axis[d]);
     B.gauge.col(kk) = MPhi.transpose() * tk;
   }
+  pressure_second_order(A, B);
   if (opt.verbose) std::fprintf(stderr, "reduced basis: operators at %zu samples, %.1f s\n", ns, seconds_since(t_start));
 
   // 3. ECSW: per cluster, non-negative element weights reproducing the cluster's reduced force on
@@ -720,7 +762,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
 // ------------------------------------------------------------------ serialisation
 namespace {
 constexpr double kMagic = 7.261126e6;  // format tag of ReducedBasis::to_doubles
-constexpr double kVersion = 4.0;
+constexpr double kVersion = 5.0;
 
 struct Writer {
   std::vector<double> d;
@@ -795,6 +837,8 @@ std::vector<double> ReducedBasis::to_doubles() const {
   w.vec(std::vector<double>(elements.begin(), elements.end()));
   w.vec(weights);
   w.mat(Gref);
+  w.mat(pq);
+  w.mat(pw);
   w.vec(std::vector<double>(stiff_part.begin(), stiff_part.end()));
   w.num(mesh_fingerprint);
   w.num(info.clusters);
@@ -837,6 +881,8 @@ ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
   for (double e : rd.vec()) B.elements.push_back(static_cast<int>(e));
   B.weights = rd.vec();
   B.Gref = rd.mat();
+  B.pq = rd.mat();
+  B.pw = rd.mat();
   for (double s : rd.vec()) B.stiff_part.push_back(static_cast<char>(s));
   B.mesh_fingerprint = rd.num();
   B.info.clusters = static_cast<int>(rd.num());
@@ -851,7 +897,8 @@ ReducedBasis ReducedBasis::from_doubles(const std::vector<double>& d) {
                   B.b.rows() == r && B.b.cols() == n && B.c.cols() == n && B.h.cols() == n && ns == B.theta.size() &&
                   B.gt.rows() == 3 && B.gt.cols() == n && B.gq.rows() == r && B.gauge.cols() == n &&
                   B.elements.size() == B.weights.size() && B.Gref.rows() == r + 1 &&
-                  B.Gref.cols() == (n - 1) * (kRefSub + 1);
+                  B.Gref.cols() == (n - 1) * (kRefSub + 1) && B.pq.rows() == r && B.pq.cols() == r * r &&
+                  B.pw.rows() == r * r && B.pw.cols() == n;
   if (!ok) throw InputError("reduced model: stored basis is damaged (inconsistent sizes)");
   for (std::size_t k = 0; k < ns; ++k)
     if (B.K[k].rows() != r || B.H[k].rows() != r || B.Kref[k].rows() != r + 1)

@@ -159,7 +159,10 @@ void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedS
     if (newton && newton_step(A, K, R, du))
       check.newton_angle_error_deg = -(unwrap_deg(bending_angle(rom.model(), u - du).angle_deg, a0) - a0);
     check.corrected_failed = correct && !converged;
-    if (correct && converged) check.corrected_angle_error_deg = -(unwrap_deg(bending_angle(rom.model(), uc).angle_deg, a0) - a0);
+    if (correct && converged) {
+      check.corrected_angle_error_deg = -(unwrap_deg(bending_angle(rom.model(), uc).angle_deg, a0) - a0);
+      check.corrected_u = uc;
+    }
     at_report(step, u, state, check);
   }
 }

@@ -78,6 +78,7 @@ SolverSettings solver_settings(const Scene& s) {
   sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
   sv.reduced_check_at = choice<SolverSettings::CheckAt>(s, "solver.reduced_check_at", {{"tops", SolverSettings::CheckAt::Tops},
                                                                                        {"reports", SolverSettings::CheckAt::Reports}});
+  sv.reduced_enrich_rounds = s.integer("solver.reduced_enrich_rounds");
   if (sv.model == SolverSettings::Model::Reduced && sv.mode != SolverSettings::Mode::QuasiStatic)
     s.fail("solver.model", "\"reduced\" needs solver.mode = \"quasi_static\"");
   return sv;

@@ -45,6 +45,7 @@ struct SolverSettings {
   double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
   enum class CheckAt { Tops, Reports };  ///< where the corrected history is corrected (app/simulate/reduced.h)
   CheckAt reduced_check_at = CheckAt::Tops;
+  int reduced_enrich_rounds = 2;       ///< basis enrichments from the corrected states before a fallback
   QuasiStaticOptions quasi_static;
   ExplicitOptions explicit_dynamics;
   double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time

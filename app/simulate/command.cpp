@@ -210,7 +210,8 @@ std::string reduced_summary(const ReducedSetup& setup, const ReducedRunResult& r
       .add("pod_energy_left", B.info.pod_energy_left)
       .add("ecsw_worst_residual", B.info.ecsw_worst_residual);
   json::Object online;
-  online.add("states", static_cast<double>(res.stats.states))
+  online.add("modes", static_cast<double>(res.modes))
+      .add("states", static_cast<double>(res.stats.states))
       .add("rejected_time_steps", static_cast<double>(res.stats.rejected_steps))
       .add("newton_iterations", static_cast<double>(res.stats.newton_iterations))
       .add("solve_s", res.stats.wall_s)
@@ -223,8 +224,21 @@ std::string reduced_summary(const ReducedSetup& setup, const ReducedRunResult& r
     check.add("worst_trial", static_cast<double>(w.trial)).add("worst_time_s", w.time_s).add("worst_pressure_kPa", w.pressure_Pa * 1e-3);
   }
   check.add_str("per_report", "reduced_check.csv");
+  std::string enrichments = "[";
+  for (std::size_t k = 0; k < res.enrichments.size(); ++k) {
+    const ReducedRunResult::Enrichment& e = res.enrichments[k];
+    json::Object j;
+    j.add_str("why", e.why).add("corrected_states", static_cast<double>(e.snapshots)).add("modes", static_cast<double>(e.modes)).add("basis_s", e.basis_s);
+    if (!e.failed.empty()) j.add_str("run_failed", e.failed);
+    enrichments += (k ? ", " : "") + j.str(6);
+  }
+  enrichments += "]";
   json::Object o;
-  o.add("offline", offline.str(4)).add("online", online.str(4)).add("check", check.str(4)).add_str("fallback", fallback);
+  o.add("offline", offline.str(4))
+      .add("enrichments", enrichments)
+      .add("online", online.str(4))
+      .add("check", check.str(4))
+      .add_str("fallback", fallback);
   return o.str(2);
 }
 
@@ -381,7 +395,13 @@ class RunRecorder {
 /// the solver statistics go to `solver_stats`. `reduced_json` gets summary.json's reduced_model part.
 bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& rec, ProgressLine& progress,
                        const RunOptions& opt, const fs::path& dir, json::Object& solver_stats, std::string& reduced_json) {
-  const ReducedRunResult rr = run_reduced(setup, bm, rec.observer());
+  const ReducedRunResult rr = run_reduced(setup, bm, rec.observer(), true, [&](const ReducedRunResult::Enrichment& e) {
+    progress.done();
+    if (opt.progress)
+      std::fprintf(stderr, "  reduced model: %s; the basis takes the %d corrected states (%d modes) and runs again\n",
+                   e.why.c_str(), e.snapshots, e.modes);
+    rec.restart();  // the next run's reports and VTU files replace these
+  });
   const double tol = bm.solver.reduced_check_deg;
   std::string fallback = "none";
   bool full = true;

@@ -30,6 +30,8 @@ namespace pneufem {
 
 struct ReducedSetup {
   std::unique_ptr<BuiltModel> reference;  ///< the elastic reference model
+  ElasticPathTrace path;                  ///< its traced elastic path (an enrichment rebuilds the basis on it)
+  RomBasisOptions options;                ///< the basis options
   ReducedBasis basis;
   std::string path_source, basis_source;  ///< "computed", "cache <file>", "recomputed (...)"
   double offline_s = 0.0;                 ///< wall time of this setup (trace + basis, or reading them)
@@ -54,6 +56,16 @@ struct ReducedRunResult {
   double worst_check_deg = 0.0;  ///< largest |estimated angle error| over the reports (either estimate)
   int worst_report = -1;       ///< its index in `reports`
   int unchecked_report = -1;   ///< the first report whose corrected solve found no equilibrium, or -1
+  /// The basis enrichments made (solver.reduced_enrich_rounds): why each was made (the check of the
+  /// run before it), what it added and what the run with it cost. The reports above are the last run's.
+  struct Enrichment {
+    std::string why;             ///< reduced_check_failure of the run before
+    int snapshots = 0, modes = 0;  ///< corrected states in the basis so far; modes of the new basis
+    double basis_s = 0.0;        ///< wall time of the basis build
+    std::string failed;          ///< why the run with this basis failed ("" = it ran; then the run before stands)
+  };
+  std::vector<Enrichment> enrichments;
+  int modes = 0;               ///< modes of the basis of the last run
 };
 
 /// Runs `bm` (the scene's model, same mesh as the setup's reference) through its load with the
@@ -61,10 +73,19 @@ struct ReducedRunResult {
 /// report's record, full displacement and whole-mesh history, in order, after the replay.
 /// `check` = false: no replay and no indicator: the reports of the run alone, each passed to
 /// `at_report` as it is solved, with empty displacement and history.
+/// Enrichment (with `restart` and bm.solver.reduced_enrich_rounds > 0): when the check fails
+/// (reduced_check_failure with bm.solver.reduced_check_deg), the converged corrected states of the
+/// replay (full-model equilibria near the reduced ones, with the history the full model would have
+/// built) join the basis as snapshots (build_reduced_basis on the setup's path and options), the
+/// run and its check are repeated, and `restart` is called first (with what the enrichment did) so
+/// the caller can drop the reports it has seen. At most reduced_enrich_rounds times; the result is the last run's.
+/// Why: the snapshots carry the damaged shapes the softening responses hold only to first order
+/// (measured on the 15-chamber story at h = 6: max error over three trials 0.90 -> 0.24 deg after
+/// two rounds; bench/results/rom_h6_pressure_order).
 ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
                              const std::function<void(const StateRecord&, const Eigen::VectorXd&, const std::vector<double>&)>&
                                  at_report = nullptr,
-                             bool check = true);
+                             bool check = true, const std::function<void(const ReducedRunResult::Enrichment&)>& restart = nullptr);
 
 /// Why a checked reduced run must not stand ("" = it may): the full model found no equilibrium
 /// near a top's reduced state (it could not be checked), or the worst estimated angle error exceeds

@@ -563,7 +563,46 @@ TEST(ReducedModel, FollowsTheFemForAnEffectKnownOnlyToTheRegistry) {
 /// The analytic Jacobian (q columns) and the theta column's difference against central differences
 /// of the residual, at a state off the path with damaged history. Step: 1e-6 of the coordinate's
 /// scale; truncation ~1e-12 relative, round-off ~1e-10 / 1e-6: tolerance 1e-4 of the Jacobian's norm.
-TEST(ReducedModel, JacobianMatchesFiniteDifferences) {
+// The follower load's second order in q (ReducedBasis::pq, pw) against the full mesh's load: the
+// load is quadratic in the positions, so [g(u + d) + g(u - d)] / 2 - g(u) = g2[d, d] / 2 exactly at
+// any u (the symmetric difference has no truncation error for a quadratic). Tolerance 1e-9 of the
+// term: round-off of assemblies whose entries are ~1e3 times the term (d is a fraction of u).
+TEST(ReducedModel, FollowerLoadSecondOrderMatchesTheFullMesh) {
+  const Offline& o = offline();
+  const ReducedBasis& B = o.basis;
+  const Assembler A(o.ref->model);
+  const int r = B.num_modes();
+  ASSERT_GT(r, 0);
+  const Eigen::Index nd = B.dofs();
+  auto load = [&](const Eigen::VectorXd& u) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(nd);
+    A.add_pressure(u, 1.0, f, nullptr);
+    A.zero_fixed(f);
+    return f;
+  };
+  for (int k : {B.num_samples() / 3, B.num_samples() - 2}) {
+    Eigen::VectorXd q(r);
+    for (int j = 0; j < r; ++j) q[j] = 3e-4 * std::cos(0.7 * j + 0.2 * k);
+    const Eigen::VectorXd u = B.U.col(k), d = B.Phi * q;
+    const Eigen::VectorXd half_g2 = 0.5 * (load(u + d) + load(u - d)) - load(u);
+    Eigen::VectorXd qq(static_cast<Eigen::Index>(r) * r);
+    for (int l = 0; l < r; ++l) qq.segment(static_cast<Eigen::Index>(r) * l, r) = q[l] * q;
+    const Eigen::VectorXd want_q = B.Phi.transpose() * half_g2;
+    const Eigen::VectorXd got_q = 0.5 * B.pq * qq;
+    ASSERT_GT(want_q.norm(), 0.0);
+    EXPECT_LE((got_q - want_q).norm(), 1e-9 * want_q.norm()) << "sample " << k;
+    const double want_w = B.W.col(k).dot(half_g2), got_w = 0.5 * B.pw.col(k).dot(qq);
+    EXPECT_NEAR(got_w, want_w, 1e-9 * std::abs(want_w) + 1e-12 * want_q.norm()) << "sample " << k;
+  }
+}
+
+// Amplitudes: 2e-5 (near the path) and 5e-5 (a large correction of this small actuator: 1e-4
+// inverts an element). The follower load's second-order block is ~1e-6 of the Jacobian here, below
+// what finite differences resolve; FollowerLoadSecondOrderMatchesTheFullMesh checks its operator.
+class ReducedJacobian : public ::testing::TestWithParam<double> {};
+INSTANTIATE_TEST_SUITE_P(ReducedModel, ReducedJacobian, ::testing::Values(2e-5, 5e-5));
+
+TEST_P(ReducedJacobian, MatchesFiniteDifferences) {
   const Offline& o = offline();
   const auto bm = build_model(small_scene({"load.trials=1"}));
   const ReducedOrderModel rom(o.ref->model, o.basis, bm->model);
@@ -571,7 +610,7 @@ TEST(ReducedModel, JacobianMatchesFiniteDifferences) {
   const int k = o.basis.num_samples() / 2;
   z.theta = 0.5 * (o.basis.theta[k] + o.basis.theta[k + 1]);
   z.q = Eigen::VectorXd::Zero(rom.num_modes());
-  for (int j = 0; j < z.q.size(); ++j) z.q[j] = 2e-5 * std::cos(1.3 * j + 0.4);
+  for (int j = 0; j < z.q.size(); ++j) z.q[j] = GetParam() * std::cos(1.3 * j + 0.4);
   z.lambda = 0.1;
   const std::vector<double> h0 = rom.initial_history();
   std::vector<double> h1(h0.size());
