@@ -181,6 +181,26 @@ TEST(Cli, ExplicitMassScalingIsReportedAndRefusedWhereItChangesTheAnswer) {
   EXPECT_NE(r.out.find("added 4.413 kg to the model's 0.004246 kg"), std::string::npos) << r.out;
 }
 
+// Issue 30 item 6: a failed run's summary.json keeps the full solver statistics of what ran.
+// Before, it kept only "states": a run that stalls in its third load segment (a creeping silicone,
+// a time_tol that needs more than 5 steps per hold) said nothing of the Newton iterations,
+// factorisations and rejected steps it had spent.
+TEST(Cli, AFailedRunKeepsItsSolverStatistics) {
+  const fs::path d = fresh_dir("failed_stats");
+  const Result r = run("simulate --out " + d.string() + " " + kTiny +
+                       " --set load.max_kPa=10.0 --set materials.silicone.viscoelastic.enabled=true"
+                       " --set solver.time_tol=0.001 --set solver.max_segment_steps=5");
+  EXPECT_EQ(r.code, 3) << r.out;
+  const std::string summary = slurp(d / "summary.json");
+  EXPECT_NE(summary.find("\"status\": \"physical time stepping stalled"), std::string::npos) << summary;
+  for (const char* key : {"\"states\": ", "\"rejected_time_steps\": ", "\"newton_iterations\": ", "\"factorizations\": ",
+                          "\"increments\": "}) {
+    const std::size_t at = summary.find(key);
+    ASSERT_NE(at, std::string::npos) << key << summary;
+    EXPECT_NE(summary[at + std::string(key).size()], '0') << key << " of what ran is not zero: " << summary;
+  }
+}
+
 // Issue 30 item 1: a resume never mixes two runs. Before, a changed scene killed before its first
 // checkpoint resumed from the old run's checkpoint and exited 0 with a mixed result; a flipped bit
 // resumed silently; a directory without a checkpoint said only "no checkpoint.bin there".
