@@ -768,6 +768,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   try {
     rom_made = std::make_unique<const PathModelEvaluator>(cal_scene, rec, frames, opt.rom_points,
                                                           opt.calibration_h_mm > 0.0 ? &scene : nullptr, opt.cache_dir);
+  } catch (const InputError&) {
+    throw;  // bad input (an unusable --cache, a scene the FEM refuses): nothing is written
   } catch (const std::exception& e) {
     // Minutes of elastic FEM and no round yet: diagnosis.json says that it failed, where and why.
     json::Object root;
