@@ -809,11 +809,12 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
            "# Data: " + opt.data_path + "\n" + fitted.to_toml();
   };
   std::vector<Series> fitted_fem;  // the FEM traces of the refined constants, when a refinement ran them
-  bool rounds_closed = false;
+  bool rounds_closed = false, have_baseline = false;
   try {
     const Comparison base = s.metrics(cal_scene);
     ++s.rom_runs;
     record_baseline(base, opt, out);
+    have_baseline = true;
     s.sig = signature_of(base);
     s.current = base;
     s.current_rss = base.rss_deg2;
@@ -842,11 +843,11 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.rom_runs = s.rom_runs;
     try {
-      if (!rounds_closed) close_rounds();
+      if (!rounds_closed && have_baseline) close_rounds();
       const Scene fitted = scene.with(s.selected_sets);
       out.fitted_toml = fitted_toml(fitted);
       write_diagnosis(scene, fitted, rec, rom, s.chosen, opt, out);
-      std::fprintf(stderr, "diagnose: failed after %d round(s); what was done is in %s (diagnosis.json: \"status\": \"failed\")\n",
+      std::fprintf(stderr, "diagnose: failed with %d effect(s) selected; what was done is in %s (diagnosis.json: \"status\": \"failed\")\n",
                    static_cast<int>(out.after_round.size()), opt.out_dir.c_str());
     } catch (const std::exception& w) {
       std::fprintf(stderr, "diagnose: failed, and writing what was done failed too: %s\n", w.what());
