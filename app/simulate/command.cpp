@@ -308,7 +308,8 @@ class RunRecorder {
       resumed_exactly_ = resumes_exactly(resume_from_->next_segment);
       if (!resumed_exactly_) {
         const std::string note =
-            "--resume: this checkpoint was taken before a hold or rest (the run was killed during a long one), "
+            "--resume: this checkpoint was taken before a hold or rest (written during a long one, or with "
+            "--checkpoint-every 0), "
             "so the fields after it differ from an uninterrupted run's in the last bits (~1e-9 relative; the "
             "angles as printed agree): the solver's last factorisation, which preconditions the steps at "
             "constant pressure, is not in the checkpoint (engine/quasi_static.h)";
