@@ -310,8 +310,9 @@ class RunRecorder {
         const std::string note =
             "--resume: this checkpoint was taken before a hold or rest (written during a long one, or with "
             "--checkpoint-every 0), "
-            "so the fields after it differ from an uninterrupted run's in the last bits (~1e-9 relative; the "
-            "angles as printed agree): the solver's last factorisation, which preconditions the steps at "
+            "so the fields after it differ from an uninterrupted run's in the last bits (~1e-9 relative at most: "
+            "angles.csv and metrics.json agree, states.csv can differ in its last digit): the solver's last "
+            "factorisation, which preconditions the steps at "
             "constant pressure, is not in the checkpoint (engine/quasi_static.h)";
         std::fprintf(stderr, "note: %s\n", note.c_str());
         notes_.push_back(note);
