@@ -52,6 +52,23 @@ double ExplicitIntegrator::estimate_stable_dt() {
   return w2max > 0.0 ? opt_.dt_safety * 2.0 / std::sqrt(w2max) : 1.0;
 }
 
+double ExplicitIntegrator::added_mass_force_share() const {
+  if (f_int_.size() == 0 || stats_.added_mass_kg <= 0.0) return 0.0;
+  const auto& fixed = asm_.model().fixed;
+  const Eigen::VectorXd& m_phys = asm_.lumped_mass();
+  double fake2 = 0.0, ext2 = 0.0, int2 = 0.0;
+  for (int i = 0; i < f_int_.size(); ++i) {
+    if (fixed[i]) continue;
+    const double share = (m_[i / 3] - m_phys[i / 3]) / m_[i / 3];
+    const double r = share * (f_ext_[i] - f_int_[i]);
+    fake2 += r * r;
+    ext2 += f_ext_[i] * f_ext_[i];
+    int2 += f_int_[i] * f_int_[i];
+  }
+  const double scale2 = std::max(ext2, int2);
+  return scale2 > 0.0 ? std::sqrt(fake2 / scale2) : 0.0;
+}
+
 void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int observe_every,
                              const std::function<void(double, const Eigen::VectorXd&, const Eigen::VectorXd&)>& observer) {
   const int n = asm_.num_dofs();
@@ -142,6 +159,8 @@ void ExplicitIntegrator::run(double t_end, const PressureFn& pressure, int obser
     }
     if (observer && (local_steps % std::max(1, observe_every) == 0 || t_ >= t_end - 1e-15)) observer(t_, u_, v_);
   }
+  f_int_ = f_int;
+  f_ext_ = f_ext;
 }
 
 }  // namespace pneufem

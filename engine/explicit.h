@@ -63,6 +63,18 @@ class ExplicitIntegrator {
   /// Estimates the stable step at the current state and applies mass scaling when configured.
   double estimate_stable_dt();
 
+  /// How much the mass added by selective mass scaling changes the answer now: the force the
+  /// added mass takes, relative to the loads, ||(dm_i / m_i) (f_ext - f_int)_i|| / max(||f_ext||,
+  /// ||f_int||) over the free dofs, after the last run() (0 before any step or without scaling).
+  /// Why this measure: with M a + C v = f_ext - f_int and mass-proportional damping C = a M, the
+  /// added mass dm takes the share dm/m of every node's out-of-balance force, inertia and damping
+  /// alike; the run with the physical masses would have applied that force to the structure, so
+  /// the displacement it withholds is K^-1 of it, and its size relative to the loads is (for a
+  /// response near linear) the relative error of the deformed shape. A quasi-static run (slow,
+  /// damped: f_ext ~ f_int) gives ~0 however much mass was added; a dynamic one whose moving nodes
+  /// were scaled gives the fraction of its inertia that is fictitious.
+  double added_mass_force_share() const;
+
   double time() const { return t_; }
   Eigen::VectorXd& u() { return u_; }
   Eigen::VectorXd& v() { return v_; }
@@ -78,6 +90,7 @@ class ExplicitIntegrator {
   ExplicitOptions opt_;
   Eigen::VectorXd m_;  ///< nodal (possibly scaled) masses, one per node
   Eigen::VectorXd u_, v_;
+  Eigen::VectorXd f_int_, f_ext_;  ///< the forces at the end of the last run() (empty before)
   std::vector<double> state_, trial_;
   double t_ = 0.0;
   double dt_ = 0.0;

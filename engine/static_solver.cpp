@@ -491,9 +491,15 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
         std::ostringstream s;
         s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure;
         if (r.regularised > 0)
+          // Only what works: past a limit point under a pressure load there is no nearby
+          // equilibrium (the wall balloons or the softened part gives way), so explicit dynamics,
+          // which this hint once suggested, runs away into an inverted element (issue 30 item 6).
           s << ". Hint: the tangent stiffness is not positive definite there, so the actuator is at a limit "
-               "point (ballooning, or a softened part giving way), where a load-controlled static solve cannot "
-               "continue; use solver.mode = \"explicit\" (dynamic) beyond it, or a stiffer/thicker design.";
+               "point (ballooning, or a softened part giving way): above about "
+            << pa * 1e-3
+            << " kPa it has no equilibrium near this one, and no solver follows it (explicit dynamics "
+               "runs away into an inverted element). Keep the pressure below it (load.max_kPa, or the recording's "
+               "peak), or make the actuator stiffer: thicker walls (geometry.*) or a stiffer silicone.";
         else
           s << ". Hint: the tangent stayed positive definite (no limit point detected) and Newton did not converge "
                "within solver.max_iterations = "

@@ -132,9 +132,12 @@ class StaticSolver {
     std::vector<Eigen::VectorXd> u;
   };
   Path path() const { return {path_p_, path_u_}; }
+  /// A non-empty path also means an equilibrium was reached (as after advance()): a run resumed
+  /// from a checkpoint then releases and carries its weight as the uninterrupted run does.
   void set_path(Path path) {
     path_p_ = std::move(path.p);
     path_u_ = std::move(path.u);
+    if (!path_p_.empty()) has_equilibrium_ = true;
   }
 
  private:

@@ -68,6 +68,7 @@ SolverSettings solver_settings(const Scene& s) {
   if (sv.explicit_dynamics.damping_alpha_1_s < 0) s.fail("solver.damping_1_s", "must be >= 0");
   sv.explicit_dynamics.adaptive_damping = s.boolean("solver.adaptive_damping");
   sv.time_scale = positive(s, "solver.time_scale");
+  sv.force_mass_scaling = s.boolean("solver.force_mass_scaling");
   sv.model = choice<SolverSettings::Model>(s, "solver.model", {{"full", SolverSettings::Model::Full},
                                                              {"reduced", SolverSettings::Model::Reduced}});
   sv.reduced.max_modes = s.integer("solver.reduced_modes");

@@ -49,6 +49,9 @@ struct SolverSettings {
   QuasiStaticOptions quasi_static;
   ExplicitOptions explicit_dynamics;
   double time_scale = 1.0;  ///< explicit mode: protocol time / simulated time
+  /// explicit mode: run even where the mass added by selective mass scaling changes the answer
+  /// (app/simulate/command.cpp, run_explicit, refuses it otherwise).
+  bool force_mass_scaling = false;
 };
 
 /// The [solver] settings above.

@@ -8,9 +8,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,11 @@
 #include "app/diagnose/elastic_curve.h"
 #include "app/diagnose/evaluator.h"
 #include "app/simulate/drive.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/json_writer.h"
 #include "core/output_dir.h"
+#include "core/version.h"
 #include "scenes/build_model.h"
 #include "scenes/scene_settings.h"
 
@@ -759,46 +764,102 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   if (opt.progress)
     std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
                  opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");
-  const PathModelEvaluator rom(cal_scene, rec, frames, opt.rom_points, opt.calibration_h_mm > 0.0 ? &scene : nullptr,
-                         opt.cache_dir);
+  std::unique_ptr<const PathModelEvaluator> rom_made;
+  try {
+    rom_made = std::make_unique<const PathModelEvaluator>(cal_scene, rec, frames, opt.rom_points,
+                                                          opt.calibration_h_mm > 0.0 ? &scene : nullptr, opt.cache_dir);
+  } catch (const InputError&) {
+    throw;  // bad input (an unusable --cache, a scene the FEM refuses): nothing is written
+  } catch (const std::exception& e) {
+    // Minutes of elastic FEM and no round yet: diagnosis.json says that it failed, where and why.
+    json::Object root;
+    root.add_str("version", version_string()).add_str("command", opt.command_line).add_str("data", opt.data_path);
+    root.add_str("status", std::string("failed: ") + e.what());
+    root.add_str("failed_in", "tracing the elastic path, before the baseline and any round");
+    root.add("candidates", "[]").add("selected", "[]");
+    try {
+      write_file_atomic((std::filesystem::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
+    } catch (const std::exception&) {
+      // the original error matters more than this one
+    }
+    throw;
+  }
+  const PathModelEvaluator& rom = *rom_made;
   if (opt.progress) print_elastic_path(rom, t0);
 
   DiagnosisResult out;
   out.elastic_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Selection s(cal_scene, rec, frames, segment, rom, opt, std::move(cands), out);
-  const Comparison base = s.metrics(cal_scene);
-  ++s.rom_runs;
-  record_baseline(base, opt, out);
-  s.sig = signature_of(base);
-  s.current = base;
-  s.current_rss = base.rss_deg2;
-  s.current_static = fit_static_discrepancy(base.frames);
-  for (int round = 1; round <= opt.max_effects; ++round)
-    if (!selection_round(s, round, t0)) break;
-  out.final_nrmse = s.current.nrmse;
-  for (const TrialComparison& t : s.current.trials) {
-    out.final_nrmse_per_trial.push_back(t.nrmse);
-    out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
-  }
-  describe_static_remainder(s.current, s.current_static, opt, out);
-
+  // The final model of the rounds done so far, and the scene with their effects.
+  auto close_rounds = [&] {
+    out.final_nrmse = s.current.nrmse;
+    out.final_nrmse_per_trial.clear();
+    out.final_rmse_deg_per_trial.clear();
+    for (const TrialComparison& t : s.current.trials) {
+      out.final_nrmse_per_trial.push_back(t.nrmse);
+      out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
+    }
+    describe_static_remainder(s.current, s.current_static, opt, out);
+  };
+  auto fitted_toml = [&](const Scene& fitted) {
+    const std::string head = out.failure.empty() ? "# pneufem diagnose: the input scene plus the selected effects ("
+                                                 : "# pneufem diagnose FAILED (" + out.failure +
+                                                       "); the input scene plus the effects selected before it failed (";
+    return head + (out.selected.empty() ? std::string("none") : join(out.selected, " + ")) + ") with calibrated constants.\n" +
+           "# Data: " + opt.data_path + "\n" + fitted.to_toml();
+  };
   std::vector<Series> fitted_fem;  // the FEM traces of the refined constants, when a refinement ran them
-  refine_with_fem(scene, cal_scene, rec, frames, rom, opt, s.chosen, s.selected_sets, s.rom_runs, out, &fitted_fem);
-  out.rom_runs = s.rom_runs;
+  bool rounds_closed = false, have_baseline = false;
+  try {
+    const Comparison base = s.metrics(cal_scene);
+    ++s.rom_runs;
+    record_baseline(base, opt, out);
+    have_baseline = true;
+    s.sig = signature_of(base);
+    s.current = base;
+    s.current_rss = base.rss_deg2;
+    s.current_static = fit_static_discrepancy(base.frames);
+    for (int round = 1; round <= opt.max_effects; ++round) {
+      const bool more = selection_round(s, round, t0);
+      if (round == opt.fail_after_round)
+        throw std::runtime_error("diagnose: injected failure after round " + std::to_string(round) + " (fail_after_round)");
+      if (!more) break;
+    }
+    close_rounds();
+    rounds_closed = true;
 
-  const Scene fitted = scene.with(s.selected_sets);
-  out.fitted_toml = "# pneufem diagnose: the input scene plus the selected effects (" +
-                    (out.selected.empty() ? std::string("none") : join(out.selected, " + ")) + ") with calibrated constants.\n" +
-                    "# Data: " + opt.data_path + "\n" + fitted.to_toml();
+    refine_with_fem(scene, cal_scene, rec, frames, rom, opt, s.chosen, s.selected_sets, s.rom_runs, out, &fitted_fem);
+    out.rom_runs = s.rom_runs;
 
-  const bool fem_refined = opt.refine > 0 && opt.refine_model == DiagnoseOptions::RefineModel::Full;
-  if (opt.verify || fem_refined || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
+    const Scene fitted = scene.with(s.selected_sets);
+    out.fitted_toml = fitted_toml(fitted);
+
+    const bool fem_refined = opt.refine > 0 && opt.refine_model == DiagnoseOptions::RefineModel::Full;
+    if (opt.verify || fem_refined || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
+  } catch (const std::exception& e) {
+    // A late failure (hours into the fitting) keeps what was done: the rounds so far, the history
+    // and a diagnosis.json whose status says it failed and why; then the error goes on as before.
+    out.failure = e.what();
+    out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.rom_runs = s.rom_runs;
+    try {
+      if (!rounds_closed && have_baseline) close_rounds();
+      const Scene fitted = scene.with(s.selected_sets);
+      out.fitted_toml = fitted_toml(fitted);
+      write_diagnosis(scene, fitted, rec, rom, s.chosen, opt, out);
+      std::fprintf(stderr, "diagnose: failed with %d effect(s) selected; what was done is in %s (diagnosis.json: \"status\": \"failed\")\n",
+                   static_cast<int>(out.after_round.size()), opt.out_dir.c_str());
+    } catch (const std::exception& w) {
+      std::fprintf(stderr, "diagnose: failed, and writing what was done failed too: %s\n", w.what());
+    }
+    throw;
+  }
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   if (opt.progress && !opt.cache_dir.empty())
     std::fprintf(stderr, "diagnose: cache %s: elastic path %s; static FEM curves: %d from the cache, %d computed\n",
                  opt.cache_dir.c_str(), rom.path_source().c_str(), rom.curves_from_cache(), rom.curves_computed());
-  write_diagnosis(scene, fitted, rec, rom, s.chosen, opt, out);
+  write_diagnosis(scene, scene.with(s.selected_sets), rec, rom, s.chosen, opt, out);
   return out;
 }
 

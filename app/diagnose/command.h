@@ -110,6 +110,9 @@ struct DiagnoseOptions {
   double calibration_h_mm = -1.0;
   int threads = 0;
   bool progress = false;
+  /// Tests only: fail (throw) right after this round, as a late failure would (0 = never). The
+  /// failure path then writes what was done (run_diagnosis).
+  int fail_after_round = 0;
   /// Cache directory for the actuator's elastic FEM results (app/simulate/result_cache.h); "" = none.
   std::string cache_dir;
   std::string command_line;
@@ -213,6 +216,10 @@ struct DiagnosisResult {
   double refined_nrmse = -1.0;
   std::vector<double> refined_nrmse_per_trial;
   std::string fitted_toml;
+  /// Why the diagnosis failed ("" = it did not). A failed diagnosis writes what it had done (the
+  /// rounds so far, the history, fitted.toml of the effects selected so far) with
+  /// diagnosis.json's "status" saying that it failed and why, and then throws again.
+  std::string failure;
   double wall_s = 0.0;
   /// Wall time of the elastic FEM work before the calibrations (path trace, scene-mesh sweep;
   /// near 0 when read from --cache).

@@ -26,6 +26,8 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
   root.add_str("version", version_string());
   root.add_str("command", opt.command_line);
   root.add_str("data", opt.data_path);
+  // A failed diagnosis (run_diagnosis's failure path) writes what it had done, saying so here.
+  root.add_str("status", out.failure.empty() ? std::string("ok") : "failed: " + out.failure);
   json::Object b;
   b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
   b.add("rmse_deg_per_trial", json::array(out.baseline_rmse_deg_per_trial));
@@ -149,7 +151,13 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
             (std::isfinite(c.trace[i].rss_deg2) ? json::num(c.trace[i].rss_deg2) : std::string("inf")) + ",\"" + e + "\"\n";
     }
   write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
-  write_file_atomic((fs::path(opt.out_dir) / "report.md").string(), diagnosis_report(scene, rec, rom, opt, out));
+  const std::string failed =
+      out.failure.empty() ? std::string()
+                          : "> **This diagnosis failed** after " + std::to_string(out.after_round.size()) +
+                                " selected effect(s): " + out.failure +
+                                ". What follows is what it had done before; the missing effect and fitted.toml are those "
+                                "of the rounds that finished, not a result.\n\n";
+  write_file_atomic((fs::path(opt.out_dir) / "report.md").string(), failed + diagnosis_report(scene, rec, rom, opt, out));
   // History: the baseline, then the model after each round (the path model's errors; the last
   // round carries fitted.toml's hash only without a refinement), then the refined model by the
   // model that refined it, each with the error per trial, so the fall shows trial by trial.

@@ -311,7 +311,7 @@ class RunRecorder {
               const RunIdentity& identity, ProgressLine& progress, const std::string& resume_body)
       : dir_(dir), bm_(bm), asmb_(asmb), opt_(opt), identity_(identity), progress_(progress),
         ntrials_(static_cast<int>(bm.load.trials.size())), want_vtu_(bm.output.vtu != "none"),
-        pvd_((dir / "results.pvd").string()) {
+        pvd_((dir / "results.pvd").string()), segments_(QuasiStaticRun::segments(bm.load)) {
     if (want_vtu_) fs::create_directories(dir / "vtu");
     if (opt.resume) {
       std::istringstream in(resume_body, std::ios::binary);
@@ -319,9 +319,36 @@ class RunRecorder {
           QuasiStaticCheckpoint::read(in, static_cast<std::size_t>(asmb.num_dofs()), asmb.state_size()));
       app_ = read_app_section(in);
       for (const auto& [t, f] : app_.vtu) pvd_.add(t, f);
+      resumed_exactly_ = resumes_exactly(resume_from_->next_segment);
+      if (!resumed_exactly_) {
+        const std::string note =
+            "--resume: this checkpoint was taken before a hold or rest (written during a long one, or with "
+            "--checkpoint-every 0), "
+            "so the fields after it differ from an uninterrupted run's in the last bits (~1e-9 relative at most: "
+            "angles.csv and metrics.json agree, states.csv can differ in its last digit): the solver's last "
+            "factorisation, which preconditions the steps at "
+            "constant pressure, is not in the checkpoint (engine/quasi_static.h)";
+        std::fprintf(stderr, "note: %s\n", note.c_str());
+        notes_.push_back(note);
+      }
     }
     last_ckpt_ = std::chrono::steady_clock::now();
   }
+
+  /// Whether a run resumed before segment `next` gives the uninterrupted run's bytes: yes unless
+  /// the next segment that does any work is a hold or rest (constant pressure, time running), whose
+  /// Krylov steps the uninterrupted run preconditions with a factorisation the checkpoint lacks.
+  bool resumes_exactly(std::size_t next) const {
+    for (; next < segments_.size(); ++next) {
+      const QuasiStaticRun::Segment& g = segments_[next];
+      const bool time_runs = g.t1 > g.t0 || g.g1 > g.g0;
+      if (g.p0 == g.p1 && !time_runs) continue;  // no work
+      return g.p0 != g.p1;
+    }
+    return true;
+  }
+  bool resumed_exactly() const { return resumed_exactly_; }
+  const std::vector<std::string>& notes() const { return notes_; }
 
   std::vector<StateRecord>& records() { return app_.records; }
   /// The solver state to resume from (null for a fresh run).
@@ -366,6 +393,10 @@ class RunRecorder {
   void checkpoint(const QuasiStaticCheckpoint& c) {
     const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt_).count();
     if (since < opt_.checkpoint_every_s) return;
+    // Before a hold or rest a resume is exact only to the last bits (resumes_exactly): such a
+    // checkpoint is written only when none was for kInexactCheckpointAfter times the interval
+    // (a long hold), so a run killed anywhere else resumes to the uninterrupted run's bytes.
+    if (!resumes_exactly(c.next_segment) && since < kInexactCheckpointAfter * opt_.checkpoint_every_s) return;
     std::ostringstream os(std::ios::binary);
     c.write(os);
     write_app_section(os, app_);
@@ -386,6 +417,10 @@ class RunRecorder {
   PvdSeries pvd_;
   AppCheckpoint app_;
   std::unique_ptr<QuasiStaticCheckpoint> resume_from_;
+  std::vector<QuasiStaticRun::Segment> segments_;
+  bool resumed_exactly_ = true;
+  std::vector<std::string> notes_;
+  static constexpr double kInexactCheckpointAfter = 10.0;
   int checkpoints_ = 0;
   std::chrono::steady_clock::time_point last_ckpt_;
 };
@@ -424,16 +459,26 @@ bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& r
   return full;
 }
 
-/// The quasi-static march of the full FEM (from the checkpoint on --resume); its statistics to `solver_stats`.
+void full_fem_stats(const QuasiStaticRun& run, const BuiltModel& bm, const RunOptions& opt, const RunRecorder& rec,
+                    json::Object& solver_stats);
+
+/// The quasi-static march of the full FEM (from the checkpoint on --resume); its statistics to
+/// `solver_stats`, also when it fails.
 void run_full_fem(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
                   json::Object& solver_stats) {
   QuasiStaticRun run(asmb, bm.solver.quasi_static);
   try {
     run.run(bm.load, rec.observer(), rec.sink(), rec.resume_from());
   } catch (...) {
-    solver_stats.add("states", static_cast<double>(run.stats().states));
+    full_fem_stats(run, bm, opt, rec, solver_stats);  // a failed run's summary keeps what ran
     throw;
   }
+  full_fem_stats(run, bm, opt, rec, solver_stats);
+}
+
+/// The statistics of a full-FEM run (finished or failed) into `solver_stats`.
+void full_fem_stats(const QuasiStaticRun& run, const BuiltModel& bm, const RunOptions& opt, const RunRecorder& rec,
+                    json::Object& solver_stats) {
   const StaticStats& st = run.static_solver().stats();
   solver_stats.add_str("mode", "quasi_static")
       .add_str("model", "full")
@@ -456,55 +501,126 @@ void run_full_fem(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec,
       .add("relaxation_iterations", static_cast<double>(run.stats().relaxation_iterations))
       .add("assembly_s", st.assembly_s)
       .add("factor_solve_s", st.factor_s)
-      .add("resumed", opt.resume ? 1.0 : 0.0);
+      .add("resumed", opt.resume ? 1.0 : 0.0)
+      .add("resumed_bit_identical", opt.resume && !rec.resumed_exactly() ? "false" : "true");
   if (bm.solver.quasi_static.cycle_jump.on)
     solver_stats.add("cycle_jumps", static_cast<double>(run.stats().cycle_jumps))
         .add("trials_extrapolated", static_cast<double>(run.stats().trials_extrapolated));
 }
 
 /// Explicit dynamics through the concatenated trials; time_scale > 1 compresses the protocol
-/// (quasi-static by time scaling) and the reported times are protocol times.
-void run_explicit(const Assembler& asmb, const BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
+/// (quasi-static by time scaling) and the reported times are protocol times. Selective mass scaling
+/// (solver.target_dt_s) is reported (console, summary.json), warned about above
+/// kAddedMassWarnFraction of the model's mass, and refused where it changes the answer: at a report
+/// where the added mass takes more than kAddedMassForceShare of the loads
+/// (ExplicitIntegrator::added_mass_force_share says why that measures the answer's error), unless
+/// solver.force_mass_scaling. The statistics go to `solver_stats` also when the run fails.
+constexpr double kAddedMassWarnFraction = 0.05;
+constexpr double kAddedMassForceShare = 0.02;
+
+void run_explicit(const Assembler& asmb, BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
                   json::Object& solver_stats) {
   if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
   const QuasiStaticRun::Observer observe = rec.observer();
   const int ntrials = static_cast<int>(bm.load.trials.size());
   ExplicitIntegrator ex(asmb, bm.solver.explicit_dynamics);
   const double ts = bm.solver.time_scale;
-  double t0_protocol = 0.0, last_angle = 0.0;
-  for (int k = 0; k < ntrials; ++k) {
-    const TrialLoad& tl = bm.load.trials[k];
-    const double trial_start = t0_protocol;
-    auto pressure = [&](double tau) { return tl.pressure(tau * ts - trial_start); };
-    for (double t_out : tl.output_s) {
-      ex.run((trial_start + t_out) / ts, pressure, 1 << 30, nullptr);
-      StateRecord r;
-      r.trial = k + 1;
-      r.time_s = t_out;
-      r.global_time_s = trial_start + t_out;
-      r.pressure_Pa = tl.pressure(t_out);
-      const AngleResult a = bending_angle(bm.model, ex.u());
-      r.angle_deg = unwrap_deg(a.angle_deg, last_angle);
-      last_angle = r.angle_deg;
-      r.plane_rms_m = a.plane_rms_m;
-      r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
-      observe(r, ex.u(), ex.state());
+  const double target_dt = bm.solver.explicit_dynamics.target_dt_s;
+  double max_share = 0.0, max_share_t = 0.0;
+  bool warned = false;
+  // The added mass so far: a warning (console and summary.json) the first time it passes the limit.
+  auto report_mass = [&](const char* when, bool print) {
+    const double added = ex.stats().added_mass_kg, phys = ex.stats().physical_mass_kg;
+    if (target_dt <= 0.0 || phys <= 0.0) return;
+    char line[400];
+    std::snprintf(line, sizeof line,
+                  added >= phys ? "explicit: selective mass scaling (solver.target_dt_s = %g s) %s %.4g kg to the model's "
+                                  "%.4g kg (%.4g times it)"
+                                : "explicit: selective mass scaling (solver.target_dt_s = %g s) %s %.4g kg to the model's "
+                                  "%.4g kg (%.4g %% of it)",
+                  target_dt, when, added, phys, added >= phys ? added / phys : 100.0 * added / phys);
+    if (print) std::fprintf(stderr, "%s\n", line);
+    if (!warned && added > kAddedMassWarnFraction * phys) {
+      warned = true;
+      const std::string w = std::string(line) + ", more than " + json::num(100.0 * kAddedMassWarnFraction) +
+                            " %: the run is refused where that mass takes more than " +
+                            json::num(100.0 * kAddedMassForceShare) +
+                            " % of the loads (it would change the answer) unless solver.force_mass_scaling = true; "
+                            "a smaller solver.target_dt_s adds less";
+      std::fprintf(stderr, "warning: %s\n", w.c_str());
+      bm.warnings.push_back(w);
     }
-    t0_protocol += tl.duration() + bm.load.rest_between_trials_s;
+  };
+  auto add_stats = [&] {
+    solver_stats.add_str("mode", "explicit")
+        .add("steps", static_cast<double>(ex.stats().steps))
+        .add("dt_s", ex.stats().dt_s)
+        .add("dt_min_s", ex.stats().dt_min_s)
+        .add("time_scale", ts)
+        .add("physical_mass_kg", ex.stats().physical_mass_kg)
+        .add("added_mass_kg", ex.stats().added_mass_kg)
+        .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
+        .add("added_mass_max_force_share", max_share)
+        .add("added_mass_max_force_share_time_s", max_share_t)
+        .add("mass_scaling_forced", bm.solver.force_mass_scaling ? "true" : "false")
+        .add("stability_estimates", static_cast<double>(ex.stats().stability_estimates))
+        .add("energy_kinetic_J", ex.energy().kinetic_J)
+        .add("energy_internal_J", ex.energy().internal_J)
+        .add("energy_external_work_J", ex.energy().external_work_J)
+        .add("energy_damping_J", ex.energy().damping_J)
+        .add("energy_balance_relative_error", ex.energy().relative_error());
+  };
+  try {
+    if (target_dt > 0.0) {
+      (void)ex.estimate_stable_dt();  // the mass added at the start, reported before the work
+      report_mass("adds", true);
+    }
+    double t0_protocol = 0.0, last_angle = 0.0;
+    for (int k = 0; k < ntrials; ++k) {
+      const TrialLoad& tl = bm.load.trials[k];
+      const double trial_start = t0_protocol;
+      auto pressure = [&](double tau) { return tl.pressure(tau * ts - trial_start); };
+      for (double t_out : tl.output_s) {
+        ex.run((trial_start + t_out) / ts, pressure, 1 << 30, nullptr);
+        StateRecord r;
+        r.trial = k + 1;
+        r.time_s = t_out;
+        r.global_time_s = trial_start + t_out;
+        r.pressure_Pa = tl.pressure(t_out);
+        const AngleResult a = bending_angle(bm.model, ex.u());
+        r.angle_deg = unwrap_deg(a.angle_deg, last_angle);
+        last_angle = r.angle_deg;
+        r.plane_rms_m = a.plane_rms_m;
+        r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
+        if (!warned) report_mass("has added", false);
+        const double share = ex.added_mass_force_share();
+        if (share > max_share) {
+          max_share = share;
+          max_share_t = r.global_time_s;
+        }
+        if (share > kAddedMassForceShare && !bm.solver.force_mass_scaling) {
+          char m[900];
+          std::snprintf(m, sizeof m,
+                        "solver.target_dt_s = %g: selective mass scaling added %.4g kg to the model's %.4g kg (%.4g times "
+                        "it), and at trial %d, t = %g s (%.4g kPa) that mass takes %.3g %% of the loads (limit %.3g %%): "
+                        "the angles would be those of a heavier actuator, not of this one. Lower solver.target_dt_s (0 = "
+                        "no scaling), or set solver.time_scale lower so the load is slower, or use solver.mode = "
+                        "\"quasi_static\"; solver.force_mass_scaling = true runs it anyway",
+                        target_dt, ex.stats().added_mass_kg, ex.stats().physical_mass_kg,
+                        ex.stats().added_mass_kg / ex.stats().physical_mass_kg, r.trial, r.time_s, r.pressure_Pa * 1e-3,
+                        100.0 * share, 100.0 * kAddedMassForceShare);
+          throw InputError(m);
+        }
+        observe(r, ex.u(), ex.state());
+      }
+      t0_protocol += tl.duration() + bm.load.rest_between_trials_s;
+    }
+  } catch (...) {
+    add_stats();
+    throw;
   }
-  solver_stats.add_str("mode", "explicit")
-      .add("steps", static_cast<double>(ex.stats().steps))
-      .add("dt_s", ex.stats().dt_s)
-      .add("dt_min_s", ex.stats().dt_min_s)
-      .add("time_scale", ts)
-      .add("physical_mass_kg", ex.stats().physical_mass_kg)
-      .add("added_mass_kg", ex.stats().added_mass_kg)
-      .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
-      .add("energy_kinetic_J", ex.energy().kinetic_J)
-      .add("energy_internal_J", ex.energy().internal_J)
-      .add("energy_external_work_J", ex.energy().external_work_J)
-      .add("energy_damping_J", ex.energy().damping_J)
-      .add("energy_balance_relative_error", ex.energy().relative_error());
+  report_mass("added", true);
+  add_stats();
 }
 
 /// metrics.json (the paper's metrics of every trial against the ideal model); its summary.json
@@ -556,6 +672,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   std::exception_ptr failure;
   const IdealModel ideal = ideal_model(scene, opt, dir, *bm, rsetup.get());
   RunRecorder recorder(dir, *bm, asmb, opt, identity, progress, resume_body);
+  for (const std::string& n : recorder.notes()) bm->warnings.push_back(n);
 
   const auto t_solve = std::chrono::steady_clock::now();
   json::Object solver_stats;

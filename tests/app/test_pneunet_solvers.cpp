@@ -98,6 +98,28 @@ TEST(PneuNetSolvers, StallWithoutLimitPointPointsToMaxIterations) {
   EXPECT_NE(msg.find("solver.max_iterations = 2"), std::string::npos) << msg;
 }
 
+// Issue 30 item 6: at a limit point the hint recommends only what works. It suggested explicit
+// dynamics "beyond it", which on the same actuator runs away into an inverted element (past a limit
+// point under pressure there is no equilibrium near the last one). Driven far past its ballooning
+// pressure, the small actuator stalls with a tangent that is not positive definite.
+TEST(PneuNetSolvers, ALimitPointHintRecommendsOnlyWhatWorks) {
+  auto bm = build_model(Scene::load("", kSmall));
+  Assembler A(bm->model);
+  StaticSolver solver(A, bm->solver.quasi_static.newton);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());
+  std::vector<double> state = A.initial_state();
+  std::string msg;
+  try {
+    solver.advance(0.0, 400e3, 0.0, 0.0, state, u);
+  } catch (const PhysicsError& e) {
+    msg = e.what();
+  }
+  ASSERT_NE(msg.find("limit point"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("solver.mode = \"explicit\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("load.max_kPa"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("stiffer"), std::string::npos) << msg;
+}
+
 // Stiff-layer elimination (StaticSolver): the 6.5 GPa fabric makes plain Newton wander on a
 // bending actuator, and with 5 kPa increments a wandering iterate can land on another equilibrium
 // branch. The reference path is plain Newton (elimination off) in 1 kPa increments, which is small

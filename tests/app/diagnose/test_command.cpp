@@ -261,6 +261,7 @@ TEST(DiagnoseCache, ReRunGivesTheIdenticalDiagnosisFromTheCache) {
   o.out_dir = (dir / "out2").string();
   const DiagnosisResult second = run_diagnosis(scene, o);
   const std::string json2 = read_text(dir / "out2" / "diagnosis.json");
+  EXPECT_NE(json1.find("\"status\": \"ok\""), std::string::npos);  // a diagnosis that did not fail says so
   EXPECT_NE(json1.find("\"elastic_path_source\": \"computed\""), std::string::npos);
   EXPECT_NE(json2.find("\"elastic_path_source\": \"cache "), std::string::npos);
   int curves = 0;
@@ -400,6 +401,36 @@ TEST(CalibrationMesh, ChosenForLargeBuiltInMeshesUnlessGiven) {
   EXPECT_EQ(resolve_calibration_h(Scene::load("", {"geometry.chambers=3", "mesh.h_mm=2"}), -1.0, notes), 0.0);
   EXPECT_EQ(resolve_calibration_h(def.with({"mesh.h_mm=6"}), -1.0, notes), 0.0);
   EXPECT_TRUE(notes.empty());
+}
+
+// Issue 30 item 3: a diagnosis that fails late keeps what it had done. Before, a failure after
+// hours of fitting left an empty --out (everything is written at the end). Here a failure injected
+// after round 1 (DiagnoseOptions::fail_after_round, as any late exception would) must leave round
+// 1's candidates, its selection, the history (baseline and the model after round 1), fitted.toml of
+// the effect selected so far and a diagnosis.json and report.md that say it failed and why.
+TEST(Diagnose, ALateFailureWritesTheRoundsDoneAndSaysItFailed) {
+  DiagnoseOptions o = hidden_options("stiffness", "failed_late", 2, {"stiffness", "viscoelastic"});
+  o.fail_after_round = 1;
+  std::string error;
+  try {
+    run_diagnosis(Scene::load("", kScene), o);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  ASSERT_NE(error.find("injected failure after round 1"), std::string::npos) << error;
+  const fs::path out(o.out_dir);
+  const std::string json = read_text(out / "diagnosis.json");
+  EXPECT_NE(json.find("\"status\": \"failed: diagnose: injected failure after round 1"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"selected\": [\"stiffness\"]"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"effect\": \"viscoelastic\""), std::string::npos) << json;  // round 1's other candidate
+  EXPECT_EQ(json.find("\"round\": 2"), std::string::npos) << json;
+  const std::string history = read_text(out / "history.jsonl");
+  EXPECT_NE(history.find("diagnose baseline"), std::string::npos) << history;
+  EXPECT_NE(history.find("diagnose + stiffness"), std::string::npos) << history;
+  EXPECT_EQ(read_text(out / "report.md").rfind("> **This diagnosis failed** after 1 selected effect(s)", 0), 0u);
+  EXPECT_EQ(read_text(out / "fitted.toml").rfind("# pneufem diagnose FAILED (diagnose: injected failure", 0), 0u);
+  EXPECT_TRUE(fs::exists(out / "diagnosis.csv"));
+  EXPECT_TRUE(fs::exists(out / "calibration.csv"));
 }
 
 TEST(HiddenEffect, NoneGivesNoMissingEffect) {
