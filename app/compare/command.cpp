@@ -133,7 +133,8 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
   if (r.drive.model != "full") {  // the reduced model ran (and stood, or was replaced by the FEM: model says which)
     sim.add("reduced_offline_s", r.drive.reduced_offline_s)
         .add_str("reduced_basis", r.drive.reduced_basis_source)
-        .add("reduced_worst_check_deg", r.drive.reduced_worst_check_deg);
+        .add("reduced_worst_check_deg", r.drive.reduced_worst_check_deg)
+        .add("reduced_enrichments", static_cast<double>(r.drive.reduced_enrichments));
   }
   json::Object o;
   o.add_str("pneufem_version", version_string())

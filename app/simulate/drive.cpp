@@ -289,7 +289,7 @@ using StateObserver = std::function<void(const StateRecord&, const Eigen::Vector
 /// failure propagates and an estimate above the tolerance is only recorded. Bad input (a scene the reduced model cannot
 /// run) propagates as InputError.
 std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory& load, const DriveOptions& opt,
-                          const StateObserver& observe, DriveResult& result) {
+                          const StateObserver& observe, const std::function<void()>& clear_reports, DriveResult& result) {
   if (opt.progress) std::fprintf(stderr, "  reduced model: elastic path and basis ...\n");
   // The scene's own protocol (bm.load before the recording replaces it) and the recording's peak.
   const double peak_Pa = std::max(opt.reduced_peak_Pa, elastic_reference_peak_Pa(peak_pressure(bm.load), peak_pressure(load)));
@@ -299,12 +299,17 @@ std::string drive_reduced(const Scene& scene, BuiltModel& bm, const LoadHistory&
   bm.load = load;  // the measured pressure replaces the scene's protocol (run_reduced runs bm.load)
   ReducedRunResult rr;
   try {
-    rr = run_reduced(*setup, bm, observe, opt.reduced_check);
+    // With a fallback, a failed check first enriches the basis (app/simulate/reduced.h); each
+    // enriched run replaces the reports the observer has seen.
+    std::function<void(const ReducedRunResult::Enrichment&)> restart;
+    if (opt.reduced_check && opt.reduced_fallback) restart = [&](const ReducedRunResult::Enrichment&) { clear_reports(); };
+    rr = run_reduced(*setup, bm, observe, opt.reduced_check, restart);
   } catch (const PhysicsError& e) {
     if (!opt.reduced_fallback) throw;
     return std::string("the reduced model failed: ") + e.what();
   }
   result.states = rr.stats.states;
+  result.reduced_enrichments = static_cast<int>(rr.enrichments.size());
   result.reduced_worst_check_deg = opt.reduced_check ? rr.worst_check_deg : -1.0;
   if (opt.reduced_check && opt.reduced_fallback) {
     std::string why = reduced_check_failure(rr, bm.solver.reduced_check_deg);
@@ -396,7 +401,7 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
   try {
     const bool reduced =
         bm->solver.mode == SolverSettings::Mode::QuasiStatic && bm->solver.model == SolverSettings::Model::Reduced;
-    const std::string fallback = reduced ? drive_reduced(scene, *bm, load, opt, observe, result) : std::string();
+    const std::string fallback = reduced ? drive_reduced(scene, *bm, load, opt, observe, clear_traces, result) : std::string();
     if (!fallback.empty()) {
       clear_traces();
       result.model = "full (fallback: " + fallback + ")";

@@ -125,6 +125,7 @@ struct DriveResult {
   double reduced_offline_s = 0.0;   ///< reduced model: wall time of its offline part (trace + basis, or reading them)
   std::string reduced_basis_source; ///< reduced model: "computed" or "cache <file>"
   double reduced_worst_check_deg = -1.0;  ///< reduced model, checked: largest estimated angle error over the reports
+  int reduced_enrichments = 0;      ///< reduced model: basis enrichments made (solver.reduced_enrich_rounds)
 };
 
 DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt);
