@@ -8,7 +8,7 @@
 //     solved, Newton iterations per state, time per iteration, and the wall time of every trial.
 // Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
 //                     [--checksum] [--scene-force FILE] [--protocol FILE [--trials N] [--set KEY=VALUE]... [--angles CSV]
-//                     [--save-after-first-trial CKPT | --resume CKPT]]
+//                     [--save-after-first-trial CKPT | --save-each-trial PREFIX | --resume CKPT]]
 // --checksum prints a hash of the bits of f_int, of K's values and of the energy (1 and N threads),
 // so two builds of the kernel can be compared bit for bit (A/B of an optimisation).
 // --scene-force FILE times the force-only kernel of a scene with history (e.g. the story's
@@ -241,7 +241,8 @@ void orderings(double h_mm, int threads, int reps) {
 /// trials > 0, `sets` as simulate's --set), timed as a whole and per trial, with the solver's
 /// breakdown; with `angles` non-empty every report (trial, time, pressure, angle) goes to that CSV.
 void protocol(const std::string& file, double h_mm, bool set_h, int trials, int threads, std::vector<std::string> sets,
-              const std::string& angles, const std::string& save_after_first, const std::string& resume_file) {
+              const std::string& angles, const std::string& save_after_first, const std::string& resume_file,
+              const std::string& save_each) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
   if (set_h) sets.push_back("mesh.h_mm=" + std::to_string(h_mm));
   if (trials > 0) sets.push_back("load.trials=" + std::to_string(trials));
@@ -297,6 +298,12 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
       std::printf("\n  saved the state after trial 1 to %s (%.1f s wall)\n", save_after_first.c_str(), since(t0));
       if (csv) std::fclose(csv);
       std::exit(0);
+    }
+    // --save-each-trial PREFIX: the state after trial N (before the release) to PREFIX.tN, the run
+    // going on: a later gap can then be rerun (e.g. under another control) without trials 1..N.
+    if (!save_each.empty() && c.next_segment < segs.size() && segs[c.next_segment].trial == sg.trial + 1) {
+      std::ofstream out(save_each + ".t" + std::to_string(sg.trial + 1), std::ios::binary);
+      c.write(out);
     }
     if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 == sg.g0 && sg.p1 == 0.0 && sg.p0 != 0.0)
       release_end = mark();                                                                  // the release
@@ -354,7 +361,7 @@ int main(int argc, char** argv) {
   bool set_h = false, do_orderings = false;
   int trials = 0;
   std::vector<std::string> sets;
-  std::string angles, save_after_first, resume_file;
+  std::string angles, save_after_first, resume_file, save_each;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--h-mm") && i + 1 < argc) h = std::atof(argv[++i]), set_h = true;
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
@@ -370,6 +377,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--angles") && i + 1 < argc) angles = argv[++i];
     else if (!std::strcmp(argv[i], "--save-after-first-trial") && i + 1 < argc) save_after_first = argv[++i];
     else if (!std::strcmp(argv[i], "--resume") && i + 1 < argc) resume_file = argv[++i];
+    else if (!std::strcmp(argv[i], "--save-each-trial") && i + 1 < argc) save_each = argv[++i];
     else if (!std::strcmp(argv[i], "--orderings")) do_orderings = true;
   }
   if (do_orderings) {
@@ -378,7 +386,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!protocol_file.empty()) {
-    protocol(protocol_file, h, set_h, trials, threads, sets, angles, save_after_first, resume_file);
+    protocol(protocol_file, h, set_h, trials, threads, sets, angles, save_after_first, resume_file, save_each);
     return 0;
   }
   if (!scene_file.empty()) {

@@ -22,6 +22,7 @@ constexpr std::uint64_t kMagic2 = 0x32504b4346454e50ULL;  // "PNEFCKP2": + error
 constexpr std::uint64_t kMagic3 = 0x33504b4346454e50ULL;  // "PNEFCKP3": + ramp-start memory
 constexpr std::uint64_t kMagic4 = 0x34504b4346454e50ULL;  // "PNEFCKP4": + drive-control memory
 constexpr std::uint64_t kMagic5 = 0x35504b4346454e50ULL;  // "PNEFCKP5": + cycle-jump memory and counts
+constexpr std::uint64_t kMagic6 = 0x36504b4346454e50ULL;  // "PNEFCKP6": + drive control's unchecked damage
 
 template <class T>
 void put(std::ostream& os, const T& v) {
@@ -74,7 +75,7 @@ std::vector<StateRecord> get_records(std::istream& is) {
 }  // namespace
 
 void QuasiStaticCheckpoint::write(std::ostream& os) const {
-  put(os, kMagic5);
+  put(os, kMagic6);
   put(os, static_cast<std::uint64_t>(next_segment));
   put(os, dt_suggest_s);
   put(os, last_angle_deg);
@@ -102,13 +103,14 @@ void QuasiStaticCheckpoint::write(std::ostream& os) const {
   put(os, static_cast<std::uint64_t>(cycle_reports.size()));
   for (const std::vector<StateRecord>& r : cycle_reports) put_records(os, r);
   put_records(os, trial_reports);
+  put_vec(os, unchecked_damage.data(), unchecked_damage.size());
 }
 
 QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t dofs, std::size_t state_size) {
   QuasiStaticCheckpoint c;
   std::uint64_t magic = 0, seg = 0;
   get(is, magic);
-  if (magic != kMagic && magic != kMagic2 && magic != kMagic3 && magic != kMagic4 && magic != kMagic5) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
+  if (magic != kMagic && magic != kMagic2 && magic != kMagic3 && magic != kMagic4 && magic != kMagic5 && magic != kMagic6) throw InputError("checkpoint: not a pneufem checkpoint (bad magic number)");
   get(is, seg);
   c.next_segment = static_cast<std::size_t>(seg);
   get(is, c.dt_suggest_s);
@@ -125,24 +127,24 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
   get(is, c.stats.rejected_steps);
   get(is, c.stats.relaxation_iterations);
   get(is, c.stats.wall_s);
-  if (magic == kMagic2 || magic == kMagic3 || magic == kMagic4 || magic == kMagic5) {
+  if (magic == kMagic2 || magic == kMagic3 || magic == kMagic4 || magic == kMagic5 || magic == kMagic6) {
     c.hist_prev = get_vec(is);
     c.hist_cur = get_vec(is);
     get(is, c.h_prev_s);
     get(is, c.rate_prev_Pa_s);
   }
-  if (magic == kMagic3 || magic == kMagic4 || magic == kMagic5) {
+  if (magic == kMagic3 || magic == kMagic4 || magic == kMagic5 || magic == kMagic6) {
     get(is, c.ramp_start_dp_Pa[0]);
     get(is, c.ramp_start_dp_Pa[1]);
   }
-  if (magic == kMagic4 || magic == kMagic5) {
+  if (magic == kMagic4 || magic == kMagic5 || magic == kMagic6) {
     c.drive_prev = get_vec(is);
     c.drive_cur = get_vec(is);
     std::uint64_t grew = 0;
     get(is, grew);
     c.damage_grew = grew != 0;
   }
-  if (magic == kMagic5) {
+  if (magic == kMagic5 || magic == kMagic6) {
     get(is, c.stats.cycle_jumps);
     get(is, c.stats.trials_extrapolated);
     std::uint64_t n = 0;
@@ -154,8 +156,10 @@ QuasiStaticCheckpoint QuasiStaticCheckpoint::read(std::istream& is, std::size_t 
     for (std::uint64_t k = 0; k < n; ++k) c.cycle_reports.push_back(get_records(is));
     c.trial_reports = get_records(is);
   }
+  if (magic == kMagic6) c.unchecked_damage = get_vec(is);
   if (static_cast<std::size_t>(c.u.size()) != dofs || c.state.size() != state_size ||
       (!c.drive_cur.empty() && c.drive_cur.size() != c.hist_cur.size() * 3) ||
+      (!c.unchecked_damage.empty() && !c.hist_cur.empty() && c.unchecked_damage.size() * 2 != c.hist_cur.size()) ||
       std::any_of(c.cycle_ends.begin(), c.cycle_ends.end(), [&](const std::vector<double>& h) { return h.size() != state_size; }))
     throw InputError("checkpoint: it belongs to a different model (dofs or material history size differ); "
                      "resume with the run's own scene.toml");
@@ -293,6 +297,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     drive_prev_.clear();
     drive_cur_.clear();
     damage_grew_ = false;  // rates start afresh after a jump (a release stops the damage)
+    if (drive_control) unchecked_.assign(unchecked_.size(), 0.0);  // a new trial's budget
     ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
     return;
   }
@@ -352,9 +357,12 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     const StaticSolver::Path path_saved = newton_.path();
     try {
       equilibrium(p_at(t), p_at(t + h), t, t + h);
-    } catch (const PhysicsError&) {
+    } catch (const PhysicsError& e) {
       // A shorter physical step keeps the history change (and the equilibrium shift) smaller.
       if (minimal || h <= opt_.min_dt_s * (1.0 + 1e-9)) throw;
+      if (opt_.newton.verbose)
+        std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: equilibrium failed (rejected): %s\n",
+                     t + h, h, p_at(t + h) * 1e-3, e.what());
       u_ = u_saved;
       state_ = state_saved;
       newton_.set_path(path_saved);
@@ -366,7 +374,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     // otherwise time_tol bounds the change. `order`: how the measure scales with h.
     std::vector<double> hist_new = asm_.history_scalars(state_);
     if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
-    std::vector<double> drive_new;
+    std::vector<double> drive_new, unchecked_new;
     double change = 0.0, measure = 0.0, order = 1.0;
     int worst_point = -1;
     bool estimate = false;
@@ -390,6 +398,8 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       // the step's length (first_hold_step).
       const bool damage_only = hold_start && !estimate;
       const int n = static_cast<int>(hist_new.size() / 2);
+      if (unchecked_.size() != static_cast<std::size_t>(n)) unchecked_.assign(static_cast<std::size_t>(n), 0.0);
+      unchecked_new = unchecked_;
       int change_point = -1;
       step_damage_grew = false;
       for (int p = 0; p < n; ++p) {
@@ -399,14 +409,29 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
         if (c > change) change = c, change_point = p;
         if (dd != 0.0) step_damage_grew = true;
         double m = 0.0;
-        if (estimate && (dd != 0.0 || hist_cur_[i] != hist_prev_[i])) {
+        const int kind = drive_kind_[static_cast<std::size_t>(p)];
+        // The stress (in viscous-strain units) this step's damage change can move: |dd| |S0_undamaged|
+        // / (2 mu_inf) = |dd| max(|D|, |D'|) / (1 - d'), and whether the point's unchecked budget
+        // (engine/quasi_static.h) still covers it.
+        double moved = 0.0;
+        if (dd != 0.0 && kind >= 0) {
+          double n0 = 0.0, n1 = 0.0;
+          for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j)
+            n0 += drive_cur_[j] * drive_cur_[j], n1 += drive_new[j] * drive_new[j];
+          moved = std::abs(dd) * std::sqrt(std::max(n0, n1)) / std::max(1e-12, 1.0 - hist_new[i]);
+        }
+        const bool damaging = dd != 0.0 || (estimate && hist_cur_[i] != hist_prev_[i]);
+        const bool within_budget = kind >= 0 && unchecked_[static_cast<std::size_t>(p)] + moved <= opt_.time_tol;
+        const bool proxy = estimate && damaging && !within_budget;
+        if (estimate && damaging && !proxy) unchecked_new[static_cast<std::size_t>(p)] += moved;
+        if (proxy) {
           // A damaging point: Milne's estimate on damage and viscous strain, as the error control.
           for (std::size_t k = i; k < i + 2; ++k)
             m += std::abs((hist_new[k] - hist_cur_[k]) - r * (hist_cur_[k] - hist_prev_[k]));
           m *= r / (1.0 + r);
           ed_max = std::max(ed_max, m);
         } else if (estimate) {
-          const int k = drive_kind_[static_cast<std::size_t>(p)];
+          const int k = kind;
           if (k >= 0) {
             double c2 = 0.0;
             for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j) {
@@ -460,6 +485,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     if (drive_control) {
       drive_prev_ = std::move(drive_cur_);
       drive_cur_ = std::move(drive_new);
+      unchecked_ = std::move(unchecked_new);
       damage_grew_ = step_damage_grew;
     }
     hist_cur_ = std::move(hist_new);
@@ -598,6 +624,7 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
     drive_prev_ = resume->drive_prev;
     drive_cur_ = resume->drive_cur;
     damage_grew_ = resume->damage_grew;
+    unchecked_ = resume->unchecked_damage;
     cycle_ends_ = resume->cycle_ends;
     cycle_reports_ = resume->cycle_reports;
     trial_reports_ = resume->trial_reports;
@@ -663,6 +690,7 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       c.drive_prev = drive_prev_;
       c.drive_cur = drive_cur_;
       c.damage_grew = damage_grew_;
+      c.unchecked_damage = unchecked_;
       c.cycle_ends = cycle_ends_;
       c.cycle_reports = cycle_reports_;
       c.trial_reports = trial_reports_;
