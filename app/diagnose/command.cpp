@@ -836,6 +836,8 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
 
     const bool fem_refined = opt.refine > 0 && opt.refine_model == DiagnoseOptions::RefineModel::Full;
     if (opt.verify || fem_refined || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
+  } catch (const InputError&) {
+    throw;  // the recording is not what the model can be fitted to (e.g. the other sign convention): the fix, nothing written
   } catch (const std::exception& e) {
     // A late failure (hours into the fitting) keeps what was done: the rounds so far, the history
     // and a diagnosis.json whose status says it failed and why; then the error goes on as before.
