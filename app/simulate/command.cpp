@@ -392,7 +392,7 @@ class RunRecorder {
 };
 
 /// solver.model = "reduced": runs the reduced model and checks it (reduced_check.csv). When the
-/// check fails, the run falls back to the full FEM: its reports are dropped and true returned; else
+/// check fails, or the reduced run stops part-way (ReducedRunFailed), the run falls back to the full FEM: its reports are dropped and true returned; else
 /// the solver statistics go to `solver_stats`. `reduced_json` gets summary.json's reduced_model part.
 bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& rec, ProgressLine& progress,
                        const RunOptions& opt, const fs::path& dir, json::Object& solver_stats, std::string& reduced_json) {
