@@ -279,7 +279,9 @@ std::string selected_constants_text(const DiagnosisResult& r) {
   if (!r.intervals.empty() && r.intervals.back().computed) {
     const RoundIntervals& ri = r.intervals.back();
     char buf[200];
-    std::snprintf(buf, sizeof buf, "  joint intervals after round %d (the fit within %.0f %% of its RSS, the other constants re-adjusting):",
+    std::snprintf(buf, sizeof buf,
+                  "  joint intervals of the path model's constants after round %d (its fit within %.0f %% of its RSS, the "
+                  "other constants re-adjusting):",
                   ri.round, 100.0 * ri.rss_tol);
     std::string line = buf;
     for (std::size_t j = 0; j < ri.constants.size(); ++j) {
