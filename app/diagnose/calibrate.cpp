@@ -279,21 +279,23 @@ JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
   // box so that a constant at its bound still gets a two-sided stencil.
   const double h = 0.02;
   const Eigen::VectorXd xc = x0.cwiseMax(h).cwiseMin(1.0 - h);
-  std::vector<Eigen::VectorXd> stencil = {x0, xc};
+  const bool centred = xc == x0;  // else the best point lies within h of a bound: one run more
+  std::vector<Eigen::VectorXd> stencil = {xc};
   for (int i = 0; i < k; ++i) {
     stencil.push_back(xc + h * Eigen::VectorXd::Unit(k, i));
     stencil.push_back(xc - h * Eigen::VectorXd::Unit(k, i));
   }
   for (int i = 0; i < k; ++i)
     for (int j = i + 1; j < k; ++j) stencil.push_back(xc + h * (Eigen::VectorXd::Unit(k, i) + Eigen::VectorXd::Unit(k, j)));
+  if (!centred) stencil.push_back(x0);
   const std::vector<double> f = evaluate(stencil);
-  const double f0 = f[0], fc = f[1];
+  const double fc = f[0], f0 = centred ? fc : f.back();
   if (!std::isfinite(f0) || !std::isfinite(fc)) return out;
   Eigen::MatrixXd H(k, k);
-  for (int i = 0; i < k; ++i) H(i, i) = (f[2 + 2 * i] - 2.0 * fc + f[3 + 2 * i]) / (h * h);
-  std::size_t o = 2 + 2 * static_cast<std::size_t>(k);
+  for (int i = 0; i < k; ++i) H(i, i) = (f[1 + 2 * i] - 2.0 * fc + f[2 + 2 * i]) / (h * h);
+  std::size_t o = 1 + 2 * static_cast<std::size_t>(k);
   for (int i = 0; i < k; ++i)
-    for (int j = i + 1; j < k; ++j) H(i, j) = H(j, i) = (f[o++] - f[2 + 2 * i] - f[2 + 2 * j] + fc) / (h * h);
+    for (int j = i + 1; j < k; ++j) H(i, j) = H(j, i) = (f[o++] - f[1 + 2 * i] - f[1 + 2 * j] + fc) / (h * h);
   if (!H.allFinite()) return out;
   out.rss_best = f0;
   const double drss = rss_tol * f0;

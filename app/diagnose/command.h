@@ -111,7 +111,8 @@ struct DiagnoseOptions {
   int threads = 0;
   bool progress = false;
   /// After every round's selection, the joint intervals of the selected constants (RoundIntervals):
-  /// 1 + 2k + k(k - 1)/2 + 4k reduced-model runs for k constants in all (15-31 for two effects),
+  /// 1 + 2k + k(k - 1)/2 runs of the path model for the Hessian and 2k to 8k for the ends, for k
+  /// constants in all (measured: 11 for one effect's two, 30 for two effects' four),
   /// run in parallel; false = skip them.
   bool intervals = true;
   /// Tests only: fail (throw) right after this round, as a late failure would (0 = never). The

@@ -105,8 +105,8 @@ TEST(JointIntervals, AreTheExactProfileOfAQuadraticFit) {
     EXPECT_NEAR(i.rise_hi, 1.0, 1e-6);
   }
   EXPECT_DOUBLE_EQ(ji.rss_best, 1.0);
-  // Stencil 2 + 2k + k(k-1)/2 = 7, one check per end (4), no secant step.
-  EXPECT_EQ(ji.evaluations, 11);
+  // Stencil 1 + 2k + k(k-1)/2 = 6, one check per end (4), no secant step.
+  EXPECT_EQ(ji.evaluations, 10);
 }
 
 // Two constants the recording fixes only in combination (the RSS depends on a + b alone): each
@@ -129,8 +129,8 @@ TEST(JointIntervals, ConstantsFixedOnlyInCombinationAreNotIdentified) {
 // A non-quadratic valley: 1 + x^2 + 40 x^4 (dRSS = 0.25; exact contour |x| = 0.2599). The
 // quadratic model at the minimum says |x| <= 0.5, where the quartic term makes the RSS rise 11
 // dRSS; the check sees it and the secant steps bring each end to where the rise is within
-// [0.5, 2] dRSS, i.e. |x| within 0.2116 to 0.3162 (measured: 0.2510, rise 0.887, 10 runs:
-// stencil 4, checks 2 + 2 + 2).
+// [0.5, 2] dRSS, i.e. |x| within 0.2116 to 0.3162 (measured: 0.2510, rise 0.887, 9 runs:
+// stencil 3, checks 2 + 2 + 2).
 TEST(JointIntervals, CheckTheEndsOnTheRealFitAndCorrectThem) {
   CandidateEffect c;
   c.params = {{"a", "1", -1.0, 1.0, 0.0, 0.0, false}};
