@@ -23,6 +23,9 @@ class LinearSolver {
   /// Solves K x = b with the last successful factorisation.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   bool has_factor() const { return has_factor_; }
+  /// Drops the numeric factor (the symbolic analysis stays): solve() is invalid until the next
+  /// successful factorize().
+  void forget_factor() { has_factor_ = false; }
   int factorizations() const { return factorizations_; }
 
  private:

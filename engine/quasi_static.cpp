@@ -286,6 +286,9 @@ void QuasiStaticRun::equilibrium(double p0, double p1, double t0, double t1) {
 }
 
 void QuasiStaticRun::solve_segment(const Segment& s) {
+  // A segment starts from what a checkpoint holds, and the factorisation is not in it: forgetting
+  // it here makes a resumed run continue bit for bit from any segment boundary (engine/quasi_static.h).
+  newton_.forget_factor();
   const double span = s.g1 - s.g0;
   const bool drive_control = opt_.time_control == TimeControl::Drive;
   if (!rate_dependent_ || span <= 0.0) {

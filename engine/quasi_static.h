@@ -76,10 +76,11 @@
 //
 // The run is a list of segments (the intervals between the load's breakpoints and report
 // times, plus the rest between trials). After each segment the full state can be checkpointed;
-// resuming from a checkpoint continues as the uninterrupted run would: bit for bit from a checkpoint
-// before a ramp; from one before a hold or rest the results differ in the last bits (measured
-// 2026-11-27), most likely because the last factorisation, which preconditions the Krylov steps at
-// constant pressure, is not part of the checkpoint.
+// resuming from a checkpoint continues as the uninterrupted run would, bit for bit. The one piece of
+// solver state a checkpoint cannot hold, the last factorisation (it preconditions the Krylov steps
+// at constant pressure), is forgotten at every segment start (StaticSolver::forget_factor), so the
+// uninterrupted run also starts each segment without it. Cost: one factorisation at the start of
+// each hold and rest where a Krylov step would have reused the ramp's (measured in BENCHMARKS.md).
 #include <functional>
 #include <string>
 #include <vector>

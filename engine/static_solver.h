@@ -139,6 +139,11 @@ class StaticSolver {
     path_u_ = std::move(path.u);
     if (!path_p_.empty()) has_equilibrium_ = true;
   }
+  /// Forgets the last factorisation (the preconditioner of the Krylov steps at constant pressure
+  /// and the fallback of a tangent that is not positive definite): the next linear step
+  /// factorises afresh. A run calls it at every segment start, so that what the solver does next
+  /// depends only on what a checkpoint holds (engine/quasi_static.h).
+  void forget_factor() { linear_->forget_factor(); }
 
  private:
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).

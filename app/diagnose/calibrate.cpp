@@ -252,4 +252,129 @@ TradeOff trade_off(const CandidateEffect& c, const std::function<double(const st
   return out;
 }
 
+JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
+                               const std::function<std::vector<double>(const std::vector<std::vector<double>>&)>& rss_batch,
+                               const std::vector<double>& values, double rss_tol) {
+  JointIntervals out;
+  out.rss_tol = rss_tol;
+  const int k = static_cast<int>(params.size());
+  if (k < 1 || values.size() != params.size()) return out;
+  Eigen::VectorXd x0(k);
+  for (int i = 0; i < k; ++i) x0[i] = scale(params[i], values[i]);
+  auto to_values = [&](const Eigen::VectorXd& x) {
+    std::vector<double> v(k);
+    for (int i = 0; i < k; ++i) v[i] = unscale(params[i], x[i]);
+    return v;
+  };
+  auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs) {
+    std::vector<std::vector<double>> pts;
+    for (const Eigen::VectorXd& x : xs) pts.push_back(to_values(x));
+    std::vector<double> r = rss_batch(pts);
+    out.evaluations += static_cast<int>(pts.size());
+    for (double& v : r)
+      if (!std::isfinite(v)) v = std::numeric_limits<double>::infinity();
+    return r;
+  };
+  // The Hessian's stencil, as in trade_off: step 0.02 of the calibration scale, centred inside the
+  // box so that a constant at its bound still gets a two-sided stencil.
+  const double h = 0.02;
+  const Eigen::VectorXd xc = x0.cwiseMax(h).cwiseMin(1.0 - h);
+  const bool centred = xc == x0;  // else the best point lies within h of a bound: one run more
+  std::vector<Eigen::VectorXd> stencil = {xc};
+  for (int i = 0; i < k; ++i) {
+    stencil.push_back(xc + h * Eigen::VectorXd::Unit(k, i));
+    stencil.push_back(xc - h * Eigen::VectorXd::Unit(k, i));
+  }
+  for (int i = 0; i < k; ++i)
+    for (int j = i + 1; j < k; ++j) stencil.push_back(xc + h * (Eigen::VectorXd::Unit(k, i) + Eigen::VectorXd::Unit(k, j)));
+  if (!centred) stencil.push_back(x0);
+  const std::vector<double> f = evaluate(stencil);
+  const double fc = f[0], f0 = centred ? fc : f.back();
+  if (!std::isfinite(f0) || !std::isfinite(fc)) return out;
+  Eigen::MatrixXd H(k, k);
+  for (int i = 0; i < k; ++i) H(i, i) = (f[1 + 2 * i] - 2.0 * fc + f[2 + 2 * i]) / (h * h);
+  std::size_t o = 1 + 2 * static_cast<std::size_t>(k);
+  for (int i = 0; i < k; ++i)
+    for (int j = i + 1; j < k; ++j) H(i, j) = H(j, i) = (f[o++] - f[1 + 2 * i] - f[1 + 2 * j] + fc) / (h * h);
+  if (!H.allFinite()) return out;
+  out.rss_best = f0;
+  const double drss = rss_tol * f0;
+  // Flat directions: curvature below 2 dRSS / 4 (the RSS would rise by less than dRSS across two
+  // calibration ranges), negative ones included.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  const Eigen::VectorXd lam = eig.eigenvalues().cwiseMax(0.5 * drss);
+  const Eigen::MatrixXd Hinv = eig.eigenvectors() * lam.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  // Per constant and side: the quadratic model's end, then the check on the real RSS.
+  struct End {
+    Eigen::VectorXd dir;  // profile path direction (component i = +1 or -1)
+    double t = 0.0;       // distance along it (the change of constant i, calibration scale)
+    double t_max = 0.0;   // the box
+  };
+  std::vector<End> ends;
+  for (int i = 0; i < k; ++i)
+    for (const double sign : {-1.0, 1.0}) {
+      End e;
+      e.dir = sign * Hinv.col(i) / Hinv(i, i);
+      e.t_max = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < k; ++j) {
+        if (e.dir[j] > 1e-12) e.t_max = std::min(e.t_max, (1.0 - x0[j]) / e.dir[j]);
+        if (e.dir[j] < -1e-12) e.t_max = std::min(e.t_max, -x0[j] / e.dir[j]);
+      }
+      e.t = std::min(std::sqrt(2.0 * drss * Hinv(i, i)), e.t_max);
+      ends.push_back(e);
+    }
+  std::vector<double> rise(ends.size(), 0.0);
+  std::vector<char> due(ends.size(), 1);  // ends to (re-)measure
+  auto measure = [&] {
+    std::vector<Eigen::VectorXd> xs;
+    std::vector<std::size_t> which;
+    for (std::size_t n = 0; n < ends.size(); ++n)
+      if (due[n] && ends[n].t > 0.0) xs.push_back(x0 + ends[n].t * ends[n].dir), which.push_back(n);
+    const std::vector<double> fe = evaluate(xs);
+    for (std::size_t m = 0; m < which.size(); ++m) rise[which[m]] = (fe[m] - f0) / drss;
+    std::fill(due.begin(), due.end(), 0);
+  };
+  measure();
+  // Up to three corrections on the real RSS, where an end's rise is outside [0.5, 2]: the rise is
+  // taken as a power of t along the path, t^2 at first (the quadratic model) and then the power the
+  // last two measurements show (a secant in log-log, exact for one power; the power within [1, 8],
+  // each step at most 4x out or in). An end that did not rise at all goes 4x out, to the box at most.
+  std::vector<double> t_prev(ends.size(), 0.0), r_prev(ends.size(), 0.0);
+  for (int pass = 0; pass < 3; ++pass) {
+    bool moved = false;
+    for (std::size_t n = 0; n < ends.size(); ++n) {
+      End& e = ends[n];
+      if (e.t <= 0.0 || (rise[n] >= 0.5 && rise[n] <= 2.0)) continue;
+      if (rise[n] < 1.0 && e.t >= e.t_max) continue;  // the contour lies beyond the bound
+      double factor = 4.0;
+      if (rise[n] > 0.0) {
+        double power = 2.0;
+        if (t_prev[n] > 0.0 && r_prev[n] > 0.0 && t_prev[n] != e.t)
+          power = std::clamp(std::log(rise[n] / r_prev[n]) / std::log(e.t / t_prev[n]), 1.0, 8.0);
+        factor = std::clamp(std::pow(1.0 / rise[n], 1.0 / power), 0.25, 4.0);
+      }
+      t_prev[n] = e.t, r_prev[n] = rise[n];
+      e.t = std::min(e.t * factor, e.t_max);
+      due[n] = 1;
+      moved = true;
+    }
+    if (!moved) break;
+    measure();
+  }
+  out.c.resize(k);
+  for (int i = 0; i < k; ++i) {
+    JointInterval& ci = out.c[i];
+    const End& lo = ends[2 * i];
+    const End& hi = ends[2 * i + 1];
+    ci.lo = unscale(params[i], x0[i] - lo.t);
+    ci.hi = unscale(params[i], x0[i] + hi.t);
+    const bool lo_at_bound = lo.t >= lo.t_max && rise[2 * i] < 1.0;
+    const bool hi_at_bound = hi.t >= hi.t_max && rise[2 * i + 1] < 1.0;
+    ci.rise_lo = lo_at_bound ? std::numeric_limits<double>::quiet_NaN() : rise[2 * i];
+    ci.rise_hi = hi_at_bound ? std::numeric_limits<double>::quiet_NaN() : rise[2 * i + 1];
+    ci.identified = !(lo_at_bound && hi_at_bound);
+  }
+  return out;
+}
+
 }  // namespace pneufem::diagnose_detail

@@ -45,6 +45,11 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   c->cmd->add_flag_callback(
+      "--no-intervals", [o = &c->options] { o->intervals = false; },
+      "Skip the joint intervals of the selected constants after each round (by default: the range of each constant, "
+      "the others re-adjusting, within 25 % of the fit's RSS, and whether the recording identifies it; about 11 path-model "
+      "runs for one effect's two constants, 30 for two effects' four)");
+  c->cmd->add_flag_callback(
       "--all-rounds", [o = &c->options] { o->stop_at_noise_floor = false; },
       "Run every forward-selection round, even when the residual is already at the noise floor");
   c->cmd->add_flag("--trust-elastic-model", c->options.trust_elastic_model,

@@ -693,6 +693,87 @@ void select(Selection& s, int round, std::size_t pick, const CandidateResult& be
   s.out.after_round.push_back(model_after_round(s.out.selected, s.selected_sets, s.current));
 }
 
+}  // namespace
+
+std::vector<std::string> moved_outside_intervals(const RoundIntervals& before, const RoundIntervals& now) {
+  std::vector<std::string> notes;
+  if (!before.computed) return notes;
+  for (const ConstantInterval& b : before.constants)
+    for (const ConstantInterval& n : now.constants)
+      if (n.effect == b.effect && n.name == b.name && (n.value < b.lo || n.value > b.hi))
+        notes.push_back("round " + std::to_string(now.round) + " moved " + n.effect + "." + n.name + " from " +
+                        fmt("%.4g", b.value) + " to " + fmt("%.4g", n.value) + ", outside its interval after round " +
+                        std::to_string(before.round) + " (" + fmt("%.4g", b.lo) + " to " + fmt("%.4g", b.hi) +
+                        "): the effect's constants depend on which other effects are in the model more than one "
+                        "model's interval says; treat them as uncertain");
+  return notes;
+}
+
+namespace {
+
+/// The scene overrides of the selected effects with the constants `v` (all of them, in selection
+/// order), each effect's on the scene with the ones before it, as the selection builds them.
+std::vector<std::string> chosen_sets(const Scene& cal_scene, const ChosenEffects& chosen, const std::vector<double>& v) {
+  std::vector<std::string> sets;
+  std::size_t o = 0;
+  for (const auto& [e, vals] : chosen) {
+    const std::vector<double> own(v.begin() + static_cast<std::ptrdiff_t>(o),
+                                  v.begin() + static_cast<std::ptrdiff_t>(o + e->params.size()));
+    o += e->params.size();
+    const std::vector<std::string> es = e->sets(cal_scene.with(sets), own);
+    sets.insert(sets.end(), es.begin(), es.end());
+  }
+  return sets;
+}
+
+/// After round `round`'s selection: the joint intervals of every selected constant on the raw RSS
+/// of the selected model (joint_intervals, within the trade-off's 25 % of the RSS: closer than the
+/// reduced model's own error, so the recording cannot tell the values apart), into out.intervals;
+/// and a note for every constant of an earlier effect that this round's joint re-fit moved outside
+/// the interval it had after the round before (the constants then depend on which effects are in
+/// the model more than the intervals of one model say).
+void record_intervals(Selection& s, int round) {
+  constexpr double kIntervalRssTol = 0.25;  // = kTradeOffRssTol, kEquivalentRss - 1
+  std::vector<CandidateParameter> params;
+  std::vector<double> values;
+  RoundIntervals ri;
+  ri.round = round;
+  ri.rss_tol = kIntervalRssTol;
+  for (const auto& [e, v] : s.chosen)
+    for (std::size_t i = 0; i < e->params.size(); ++i) {
+      params.push_back(e->params[i]);
+      values.push_back(v[i]);
+      ri.constants.push_back({e->name, e->params[i].name, v[i], v[i], v[i], true});
+    }
+  const auto t_start = std::chrono::steady_clock::now();
+  const auto rss_batch = [&](const std::vector<std::vector<double>>& pts) {
+    std::vector<double> r(pts.size(), std::numeric_limits<double>::infinity());
+    tbb::parallel_for(std::size_t{0}, pts.size(), [&](std::size_t i) {
+      try {
+        r[i] = rss_of(s.rom.at_frames(s.cal_scene.with(chosen_sets(s.cal_scene, s.chosen, pts[i]))), s.frames);
+      } catch (const std::exception&) {
+        // no equilibrium: +infinity, outside every interval
+      }
+    });
+    return r;
+  };
+  const JointIntervals ji = joint_intervals(params, rss_batch, values, kIntervalRssTol);
+  ri.evaluations = ji.evaluations;
+  s.count_runs(ji.evaluations);
+  for (std::size_t i = 0; i < ji.c.size(); ++i) {
+    ri.constants[i].lo = ji.c[i].lo, ri.constants[i].hi = ji.c[i].hi;
+    ri.constants[i].identified = ji.c[i].identified;
+  }
+  ri.computed = !ji.c.empty();
+  if (s.opt.progress)
+    std::fprintf(stderr, "diagnose: joint intervals of the %zu selected constants after round %d (%d runs, %.1f s)\n",
+                 params.size(), round, ji.evaluations,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
+  if (!s.out.intervals.empty())
+    for (const std::string& n : moved_outside_intervals(s.out.intervals.back(), ri)) s.out.interval_notes.push_back(n);
+  s.out.intervals.push_back(std::move(ri));
+}
+
 /// One round of forward selection: every candidate not yet selected is calibrated on top of the
 /// current model and tested; the candidates go to out.candidates, ranked, and the best significant
 /// one is selected. False when the selection stops (nothing left, at the noise floor, nothing significant).
@@ -732,6 +813,7 @@ bool selection_round(Selection& s, int round, std::chrono::steady_clock::time_po
   if (pick == order.end()) return false;
   name_equivalents(s, round, results, order, *pick, by_static);
   select(s, round, *pick, results[*pick]);
+  if (opt.intervals) record_intervals(s, round);
   return true;
 }
 

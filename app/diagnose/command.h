@@ -110,6 +110,11 @@ struct DiagnoseOptions {
   double calibration_h_mm = -1.0;
   int threads = 0;
   bool progress = false;
+  /// After every round's selection, the joint intervals of the selected constants (RoundIntervals):
+  /// 1 + 2k + k(k - 1)/2 runs of the path model for the Hessian and 2k to 8k for the ends, for k
+  /// constants in all (measured: 11 for one effect's two, 30 for two effects' four),
+  /// run in parallel; false = skip them.
+  bool intervals = true;
   /// Tests only: fail (throw) right after this round, as a late failure would (0 = never). The
   /// failure path then writes what was done (run_diagnosis).
   int fail_after_round = 0;
@@ -167,6 +172,26 @@ struct CandidateResult {
   std::vector<double> refit_selected;
 };
 
+/// A selected constant after a round: its value and the range over which it can move, the other
+/// selected constants re-adjusting, while the fit stays within RoundIntervals::rss_tol of its RSS
+/// (app/diagnose/detail.h, joint_intervals: the profile of the RSS on a quadratic model, each end
+/// checked on the model). `identified` is false when that range reaches both ends of the
+/// constant's calibration range: the recording does not fix it.
+struct ConstantInterval {
+  std::string effect, name;
+  double value = 0.0, lo = 0.0, hi = 0.0;
+  bool identified = true;
+};
+
+/// The intervals of every constant selected up to a round, computed jointly after its selection.
+struct RoundIntervals {
+  int round = 0;
+  double rss_tol = 0.0;      ///< the fit may worsen by this fraction of its RSS inside the intervals
+  int evaluations = 0;       ///< reduced-model runs they took
+  bool computed = false;     ///< false: the RSS's Hessian could not be formed (a failed run at its stencil)
+  std::vector<ConstantInterval> constants;  ///< in selection order
+};
+
 /// The reduced model after a round's selection (the effects selected so far, with the constants
 /// they had then): one line of history.jsonl and one column of report.md each.
 struct ModelAfterRound {
@@ -194,6 +219,11 @@ struct DiagnosisResult {
   /// and fit as well (their RSS, beyond a static misfit from round 2 on, within 25 % of the chosen
   /// one's: below the reduced model's own error, so the recording cannot tell them apart), in words.
   std::vector<std::string> equivalents;
+  /// Constants with honest uncertainty: after each round, the joint intervals of all constants
+  /// selected so far (DiagnoseOptions::intervals), and in words every constant that a later round's
+  /// joint re-fit moved outside the interval it had after the round before.
+  std::vector<RoundIntervals> intervals;
+  std::vector<std::string> interval_notes;
   double final_nrmse = 0.0;                 ///< reduced model with the selected effects
   std::vector<double> final_nrmse_per_trial;      ///< ... per trial (the baseline's when none is selected)
   std::vector<double> final_rmse_deg_per_trial;
@@ -235,6 +265,11 @@ bool constants_trade_off(const CandidateResult& c);
 /// final values (re-fitted jointly by a later round, or refined with the FEM, when that happened)
 /// and, for values straight from their own calibration, the trade-off ranges. "" = none selected.
 std::string selected_constants_text(const DiagnosisResult& r);
+
+/// The constants of `before` (the intervals after a round) that `now` (after a later round, whose
+/// joint re-fit may have moved the earlier effects' constants) puts outside their interval: one
+/// sentence each, for DiagnosisResult::interval_notes. None when `before` was not computed.
+std::vector<std::string> moved_outside_intervals(const RoundIntervals& before, const RoundIntervals& now);
 
 /// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
 /// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more

@@ -97,6 +97,36 @@ struct TradeOff {
 TradeOff trade_off(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
                    const std::vector<double>& values, double rss_best, double rss_tol);
 
+/// Joint intervals of several constants (the selected effects' together): for each constant, the
+/// range over which it can move, the others re-adjusting, while the RSS stays within
+/// (1 + rss_tol) of the best. The profile of the RSS (Venzon & Moolgavkar 1988, the profile-
+/// likelihood interval of a least-squares fit) is taken on a quadratic model: H the finite-
+/// difference Hessian in the calibration scale (as trade_off's), the half-width of constant i is
+/// d_i = sqrt(2 dRSS (H^-1)_ii), and along the profile path x0 + t H^-1 e_i / (H^-1)_ii the
+/// other constants follow. Each end is then checked on the real RSS and, where the rise there is
+/// not within [0.5, 2] dRSS (a valley flatter or steeper than its curvature at the best point),
+/// moved by up to three secant steps in log-log. Directions of curvature below what moving across two calibration ranges would
+/// cost (2 dRSS / 4; also negative ones: the best point is then not a minimum along them) count as
+/// flat: the constants that lean on them reach both ends of their range, and such a constant is
+/// not identified by the data. `rss_batch` evaluates many points (catalog units), so the caller
+/// can run them in parallel; a failed evaluation is +infinity.
+struct JointInterval {
+  double lo = 0.0, hi = 0.0;   ///< catalog units, inside the calibration range
+  bool identified = true;      ///< false: the interval reaches both ends of the range
+  /// (RSS at the end - best) / dRSS after the check, per side (1 = exactly on the contour; NaN
+  /// where the end is a bound of the range that the contour lies beyond).
+  double rise_lo = 0.0, rise_hi = 0.0;
+};
+struct JointIntervals {
+  std::vector<JointInterval> c;  ///< per constant; empty when the Hessian could not be formed
+  double rss_best = 0.0;         ///< the RSS at the centre evaluation
+  double rss_tol = 0.0;
+  int evaluations = 0;
+};
+JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
+                               const std::function<std::vector<double>(const std::vector<std::vector<double>>&)>& rss_batch,
+                               const std::vector<double>& values, double rss_tol);
+
 // ---- evidence (evidence.cpp)
 
 /// Residual signature of a comparison: numbers the reasons are made of.

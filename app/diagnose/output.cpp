@@ -19,6 +19,32 @@ namespace fs = std::filesystem;
 
 namespace pneufem::diagnose_detail {
 
+namespace {
+
+/// diagnosis.json's "intervals": per round, each selected constant's value, interval and whether
+/// the recording identifies it.
+std::string intervals_json(const std::vector<RoundIntervals>& rounds) {
+  std::string s = "[";
+  for (std::size_t r = 0; r < rounds.size(); ++r) {
+    const RoundIntervals& ri = rounds[r];
+    std::string cs = "[";
+    for (std::size_t j = 0; j < ri.constants.size(); ++j) {
+      const ConstantInterval& c = ri.constants[j];
+      json::Object o;
+      o.add_str("effect", c.effect).add_str("name", c.name).add("value", c.value);
+      if (ri.computed) o.add("lo", c.lo).add("hi", c.hi).add("identified", c.identified ? "true" : "false");
+      cs += (j ? ",\n      " : "\n      ") + o.str(6);
+    }
+    json::Object o;
+    o.add("round", ri.round).add("rss_within", ri.rss_tol).add("computed", ri.computed ? "true" : "false");
+    o.add("evaluations", ri.evaluations).add("constants", cs + "\n    ]");
+    s += (r ? ",\n    " : "\n    ") + o.str(4);
+  }
+  return s + (rounds.empty() ? "]" : "\n  ]");
+}
+
+}  // namespace
+
 void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
                      const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out) {
   fs::create_directories(opt.out_dir);
@@ -76,6 +102,12 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
   root.add("selected", sel + "]");
+  root.add("intervals", intervals_json(out.intervals));
+  {
+    std::string notes = "[";
+    for (std::size_t j = 0; j < out.interval_notes.size(); ++j) notes += (j ? ", " : "") + json::quote(out.interval_notes[j]);
+    root.add("interval_notes", notes + "]");
+  }
   if (!out.refined_params.empty()) {
     std::string rp = "{";
     for (std::size_t j = 0; j < chosen.size(); ++j) {
@@ -244,6 +276,23 @@ std::string selected_constants_text(const DiagnosisResult& r) {
     }
     out += line + "\n";
   }
+  if (!r.intervals.empty() && r.intervals.back().computed) {
+    const RoundIntervals& ri = r.intervals.back();
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "  joint intervals of the path model's constants after round %d (its fit within %.0f %% of its RSS, the "
+                  "other constants re-adjusting):",
+                  ri.round, 100.0 * ri.rss_tol);
+    std::string line = buf;
+    for (std::size_t j = 0; j < ri.constants.size(); ++j) {
+      const ConstantInterval& c = ri.constants[j];
+      std::snprintf(buf, sizeof buf, "%s %s.%s %.4g to %.4g%s", j ? ";" : "", c.effect.c_str(), c.name.c_str(), c.lo, c.hi,
+                    c.identified ? "" : " (not identified: the recording does not fix it)");
+      line += buf;
+    }
+    out += line + "\n";
+  }
+  for (const std::string& n : r.interval_notes) out += "  note: " + n + "\n";
   return out;
 }
 

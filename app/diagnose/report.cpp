@@ -138,6 +138,19 @@ std::string round_section(const DiagnosisResult& out, int round) {
       s += ".";
     }
     s += "\n";
+    for (const RoundIntervals& ri : out.intervals) {
+      if (ri.round != round || !ri.computed) continue;
+      s += "\nJoint intervals of the constants selected so far (the fit within " + fmt("%.0f", 100.0 * ri.rss_tol) +
+           " % of its RSS, the other constants re-adjusting; " + std::to_string(ri.evaluations) + " runs):";
+      for (std::size_t j = 0; j < ri.constants.size(); ++j) {
+        const ConstantInterval& c = ri.constants[j];
+        s += (j ? "; " : " ") + c.effect + "." + c.name + " " + fmt("%.4g", c.value) + " (" + fmt("%.4g", c.lo) + " to " +
+             fmt("%.4g", c.hi) + (c.identified ? ")" : ", not identified)");
+      }
+      s += ".\n";
+    }
+    for (const std::string& n : out.interval_notes)
+      if (n.rfind("round " + std::to_string(round) + " ", 0) == 0) s += "\n**Moved:** " + n + ".\n";
   } else {
     s += "\nNo candidate is significant: the selection stops here.\n";
   }

@@ -139,10 +139,17 @@ ReducedRunResult run_and_check(const ReducedSetup& setup, const ReducedBasis& ba
   // Unchecked, each report goes to at_report as it is solved (without fields), so a run that fails
   // part-way has shown the reports before the failure.
   const Eigen::VectorXd no_field;
-  run.run(bm.load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) {
-    records.push_back(r);
-    if (!check && at_report) at_report(r, no_field, {});
-  });
+  const auto t_run = Clock::now();
+  try {
+    run.run(bm.load, [&](const StateRecord& r, const ReducedCoordinates&, const Eigen::VectorXd&) {
+      records.push_back(r);
+      if (!check && at_report) at_report(r, no_field, {});
+    });
+  } catch (const PhysicsError& e) {
+    ReducedRunStats stats = run.stats();
+    stats.wall_s = seconds_since(t_run);
+    throw ReducedRunFailed(e, stats, basis.num_modes());
+  }
   res.stats = run.stats();
   if (!check) {
     for (const StateRecord& r : records) res.reports.push_back({r, ReducedCheck{}});
@@ -216,7 +223,7 @@ ReducedRunResult run_reduced(const ReducedSetup& setup, const BuiltModel& bm,
     // nearer the full model's, and the earlier ones keep the shapes they added).
     const auto t0 = Clock::now();
     enriched = std::make_unique<ReducedBasis>(build_reduced_basis(setup.reference->model, setup.path, setup.options, snapshots));
-    done.push_back({why, static_cast<int>(snapshots.size()), enriched->num_modes(), seconds_since(t0)});
+    done.push_back({why, static_cast<int>(snapshots.size()), enriched->num_modes(), seconds_since(t0), ""});
     restart(done.back());
   }
 }

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "engine/rom.h"
 #include "scenes/build_model.h"
 
@@ -66,6 +67,17 @@ struct ReducedRunResult {
   };
   std::vector<Enrichment> enrichments;
   int modes = 0;               ///< modes of the basis of the last run
+  std::string failed;          ///< why the run stopped part-way (ReducedRunFailed), "" = it ran to its end
+};
+
+/// A reduced run that stopped part-way (its Newton or its step control gave up), with what it had
+/// done by then: a checked run's caller falls back to the full FEM and reports these statistics.
+class ReducedRunFailed : public PhysicsError {
+ public:
+  ReducedRunFailed(const PhysicsError& e, const ReducedRunStats& s, int basis_modes)
+      : PhysicsError(e.what(), e.element(), e.time_s()), stats(s), modes(basis_modes) {}
+  ReducedRunStats stats;
+  int modes = 0;  ///< of the basis that failed
 };
 
 /// Runs `bm` (the scene's model, same mesh as the setup's reference) through its load with the
@@ -79,6 +91,8 @@ struct ReducedRunResult {
 /// built) join the basis as snapshots (build_reduced_basis on the setup's path and options), the
 /// run and its check are repeated, and `restart` is called first (with what the enrichment did) so
 /// the caller can drop the reports it has seen. At most reduced_enrich_rounds times; the result is the last run's.
+/// A run that stops part-way throws ReducedRunFailed (in the first round; a later round's failure
+/// leaves the round before standing, see reduced.cpp).
 /// Why: the snapshots carry the damaged shapes the softening responses hold only to first order
 /// (measured on the 15-chamber story at h = 6: max error over three trials 0.90 -> 0.24 deg after
 /// two rounds; bench/results/rom_h6_pressure_order).

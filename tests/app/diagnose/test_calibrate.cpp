@@ -1,6 +1,9 @@
 // The calibration search and the trade-off report of diagnose (app/diagnose/calibrate.cpp) on
 // analytic objectives, where the minimiser and the RSS contour are known exactly.
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -62,6 +65,108 @@ TEST(TradeOff, NotComputedForOneConstant) {
   const TradeOff t = trade_off(c, [](const std::vector<double>& v) { return 1.0 + std::pow(v[0] - 1.0, 2); }, {1.0}, 1.0, 0.25);
   EXPECT_TRUE(t.lo.empty());
   EXPECT_EQ(t.evaluations, 0);
+}
+
+/// rss_batch of joint_intervals from a plain function (sequential).
+std::function<std::vector<double>(const std::vector<std::vector<double>>&)> batch(
+    const std::function<double(const std::vector<double>&)>& f) {
+  return [f](const std::vector<std::vector<double>>& pts) {
+    std::vector<double> r;
+    for (const auto& p : pts) r.push_back(f(p));
+    return r;
+  };
+}
+
+// A quadratic RSS, 1 + dx^T A dx in the calibration scale, with correlated constants: the profile
+// interval of constant i is exactly dx_i = +-sqrt(dRSS (A^-1)_ii) (minimise dx^T A dx with dx_i
+// fixed), and the finite-difference Hessian of a quadratic is exact, so the ends are the contour's
+// to round-off and the check finds RSS = best + dRSS there. The profile interval is wider than the
+// conditional one (the other constant held at its best: sqrt(dRSS / A_ii)), which is what a joint
+// interval is for.
+TEST(JointIntervals, AreTheExactProfileOfAQuadraticFit) {
+  const CandidateEffect c = two_linear();
+  const double a11 = 8.0, a12 = 6.0, a22 = 8.0;  // correlation 0.75
+  auto rss = [&](const std::vector<double>& v) {
+    const double x = v[0] - 0.4, y = v[1] - 0.55;
+    return 1.0 + a11 * x * x + 2.0 * a12 * x * y + a22 * y * y;
+  };
+  const JointIntervals ji = joint_intervals(c.params, batch(rss), {0.4, 0.55}, 0.25);
+  ASSERT_EQ(ji.c.size(), 2u);
+  const double det = a11 * a22 - a12 * a12;
+  const double d0 = std::sqrt(0.25 * a22 / det), d1 = std::sqrt(0.25 * a11 / det);
+  EXPECT_NEAR(ji.c[0].lo, 0.4 - d0, 1e-6);
+  EXPECT_NEAR(ji.c[0].hi, 0.4 + d0, 1e-6);
+  EXPECT_NEAR(ji.c[1].lo, 0.55 - d1, 1e-6);
+  EXPECT_NEAR(ji.c[1].hi, 0.55 + d1, 1e-6);
+  EXPECT_GT(d0, 1.5 * std::sqrt(0.25 / a11));  // wider than the conditional interval
+  for (const JointInterval& i : ji.c) {
+    EXPECT_TRUE(i.identified);
+    EXPECT_NEAR(i.rise_lo, 1.0, 1e-6);
+    EXPECT_NEAR(i.rise_hi, 1.0, 1e-6);
+  }
+  EXPECT_DOUBLE_EQ(ji.rss_best, 1.0);
+  // Stencil 1 + 2k + k(k-1)/2 = 6, one check per end (4), no secant step.
+  EXPECT_EQ(ji.evaluations, 10);
+}
+
+// Two constants the recording fixes only in combination (the RSS depends on a + b alone): each
+// can take any value of its range, the other compensating, so neither is identified, and the
+// interval is the whole range. The same RSS plus a weak term along the valley (rising by dRSS
+// only 0.6 away along it) still leaves each constant over most of its range.
+TEST(JointIntervals, ConstantsFixedOnlyInCombinationAreNotIdentified) {
+  const CandidateEffect c = two_linear();
+  auto valley = [](const std::vector<double>& v) { return 1.0 + 1000.0 * std::pow(v[0] + v[1] - 1.0, 2); };
+  const JointIntervals ji = joint_intervals(c.params, batch(valley), {0.5, 0.5}, 0.25);
+  ASSERT_EQ(ji.c.size(), 2u);
+  for (const JointInterval& i : ji.c) {
+    EXPECT_FALSE(i.identified);
+    EXPECT_NEAR(i.lo, 0.0, 1e-9);
+    EXPECT_NEAR(i.hi, 1.0, 1e-9);
+    EXPECT_TRUE(std::isnan(i.rise_lo));
+  }
+}
+
+// A non-quadratic valley: 1 + x^2 + 40 x^4 (dRSS = 0.25; exact contour |x| = 0.2599). The
+// quadratic model at the minimum says |x| <= 0.5, where the quartic term makes the RSS rise 11
+// dRSS; the check sees it and the secant steps bring each end to where the rise is within
+// [0.5, 2] dRSS, i.e. |x| within 0.2116 to 0.3162 (measured: 0.2510, rise 0.887, 9 runs:
+// stencil 3, checks 2 + 2 + 2).
+TEST(JointIntervals, CheckTheEndsOnTheRealFitAndCorrectThem) {
+  CandidateEffect c;
+  c.params = {{"a", "1", -1.0, 1.0, 0.0, 0.0, false}};
+  auto rss = [](const std::vector<double>& v) { return 1.0 + v[0] * v[0] + 40.0 * std::pow(v[0], 4); };
+  const JointIntervals ji = joint_intervals(c.params, batch(rss), {0.0}, 0.25);
+  ASSERT_EQ(ji.c.size(), 1u);
+  const JointInterval& i = ji.c[0];
+  std::printf("quartic valley: %.4f to %.4f, rise %.3f / %.3f, %d runs\n", i.lo, i.hi, i.rise_lo, i.rise_hi, ji.evaluations);
+  EXPECT_TRUE(i.identified);
+  EXPECT_GE(i.rise_hi, 0.5);
+  EXPECT_LE(i.rise_hi, 2.0);
+  EXPECT_NEAR(i.hi, -i.lo, 1e-9);  // symmetric
+  EXPECT_GT(i.hi, 0.2116);
+  EXPECT_LT(i.hi, 0.3162);
+}
+
+// A log-scaled constant: the interval is symmetric in log (the calibration scale), and a run that
+// fails at the Hessian's stencil leaves the intervals uncomputed rather than wrong.
+TEST(JointIntervals, LogConstantsAndFailedRuns) {
+  CandidateEffect c;
+  c.params = {{"tau_s", "s", 1.0, 1000.0, 10.0, 10.0, true}};
+  // RSS = 1 + 4 x^2 in the calibration scale x = log(tau / 1) / log(1000), minimum at tau = 10^1.5.
+  const double x0 = 0.5;
+  auto rss = [&](const std::vector<double>& v) {
+    const double x = std::log(v[0]) / std::log(1000.0) - x0;
+    return 1.0 + 4.0 * x * x;
+  };
+  const JointIntervals ji = joint_intervals(c.params, batch(rss), {std::pow(10.0, 1.5)}, 0.25);
+  ASSERT_EQ(ji.c.size(), 1u);
+  EXPECT_NEAR(std::log10(ji.c[0].lo), 1.5 - 3.0 * 0.25, 1e-6);  // dx = sqrt(0.25 / 4) = 0.25 of 3 decades
+  EXPECT_NEAR(std::log10(ji.c[0].hi), 1.5 + 3.0 * 0.25, 1e-6);
+  auto failing = [&](const std::vector<double>& v) {
+    return v[0] > std::pow(10.0, 1.5) * 1.01 ? std::numeric_limits<double>::quiet_NaN() : rss(v);
+  };
+  const JointIntervals jf = joint_intervals(c.params, batch(failing), {std::pow(10.0, 1.5)}, 0.25);
+  EXPECT_TRUE(jf.c.empty());
 }
 
 // A log-space valley like the Prony constants' (gamma tau ~ const): RSS = 1 + 500 ln^2(gamma tau

@@ -749,6 +749,52 @@ TEST(HiddenEffect, CreepAndFatigueTogetherAreBothFound) {
   ASSERT_NE(f, r.candidates.end());
   std::printf("fatigue: W_th %.4g MPa, tau %.4g s (truth 0.004, 200)\n", f->params[0], f->params[1]);
   EXPECT_NEAR(std::log10(f->params[0]), std::log10(0.004), std::log10(2.0));
+  // Issue 35 item 3: after each round, the joint intervals of every constant selected so far (the
+  // fit within 25 % of its RSS, the other constants re-adjusting). Each holds its value and has a
+  // width; diagnosis.json and report.md carry them. They are intervals of the path model's
+  // constants: measured here, the truth lies outside three of the four (gamma 0.57-0.72 vs 0.5,
+  // tau 2.6-3.7 s vs 4, W_th 0.0045-0.0060 vs 0.004 MPa; fatigue's tau 100-207 s holds 200), the
+  // path model's bias against the FEM that made the recording (docs/theory.md, "Uncertainty of
+  // the constants"), so the truth is printed, not asserted.
+  ASSERT_EQ(r.intervals.size(), 2u);
+  EXPECT_EQ(r.intervals[0].constants.size(), 2u);
+  const RoundIntervals& last = r.intervals.back();
+  ASSERT_TRUE(last.computed);
+  ASSERT_EQ(last.constants.size(), 4u);
+  const std::map<std::string, double> truth = {
+      {"viscoelastic.gamma", 0.5}, {"viscoelastic.tau_s", 4.0}, {"fatigue.W_th_MPa", 0.004}, {"fatigue.tau_s", 200.0}};
+  for (const ConstantInterval& c : last.constants) {
+    const std::string key = c.effect + "." + c.name;
+    std::printf("interval %s: %.4g (%.4g to %.4g)%s, truth %.4g\n", key.c_str(), c.value, c.lo, c.hi,
+                c.identified ? "" : " not identified", truth.at(key));
+    EXPECT_LE(c.lo, c.value) << key;
+    EXPECT_GE(c.hi, c.value) << key;
+    EXPECT_GT(c.hi, c.lo) << key;
+  }
+  const std::string json = read_text(fs::temp_directory_path() / "pneufem_diag_visco_fatigue" / "diagnosis.json");
+  EXPECT_NE(json.find("\"intervals\""), std::string::npos);
+  EXPECT_NE(json.find("\"identified\""), std::string::npos);
+  EXPECT_NE(read_text(fs::temp_directory_path() / "pneufem_diag_visco_fatigue" / "report.md").find("Joint intervals"), std::string::npos);
+}
+
+// A later round's joint re-fit that moves an earlier constant outside the interval it had is
+// said in words (DiagnosisResult::interval_notes); inside it, nothing is said.
+TEST(DiagnoseIntervals, AConstantMovedOutsideItsIntervalIsNamed) {
+  RoundIntervals one;
+  one.round = 1, one.computed = true, one.rss_tol = 0.25;
+  one.constants = {{"fatigue", "W_th_MPa", 0.0061, 0.004, 0.009, true}, {"fatigue", "tau_s", 3.0e4, 1.0e4, 5.0e4, true}};
+  RoundIntervals two = one;
+  two.round = 2;
+  two.constants[0].value = 0.041;  // outside 0.004 ... 0.009
+  two.constants[1].value = 2.0e4;  // inside
+  two.constants.push_back({"viscoelastic", "gamma", 0.3, 0.2, 0.4, true});
+  const std::vector<std::string> notes = moved_outside_intervals(one, two);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("round 2 moved fatigue.W_th_MPa from 0.0061 to 0.041, outside its interval after round 1 (0.004 to 0.009)"),
+            std::string::npos)
+      << notes[0];
+  one.computed = false;  // no interval, no claim
+  EXPECT_TRUE(moved_outside_intervals(one, two).empty());
 }
 
 }  // namespace

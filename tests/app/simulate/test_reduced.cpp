@@ -107,6 +107,29 @@ TEST(SimulateReduced, ABrokenBasisIsCaughtAndTheRunFallsBackToTheFullFem) {
   EXPECT_NEAR(worst_est, actual_at_worst, 0.3 * std::abs(actual_at_worst));
 }
 
+// A reduced run that stops part-way falls back to the full FEM (the FEM, not the reduction, judges
+// whether the actuator can follow the load; the recording drive did so already), and summary.json
+// keeps what the reduced run did. Here solver.max_segment_steps = 6 stalls the reduced run's step
+// control in trial 1 (it needs more steps on a fatigue ramp) and then the FEM's as well, so the
+// run fails: both runs' statistics must still be in the summary (issue 30 item 6).
+TEST(SimulateReduced, AReducedRunThatStopsFallsBackAndKeepsItsStatistics) {
+  const fs::path dir = temp_dir("stalled");
+  EXPECT_THROW(run(dir, {"solver.model=\"reduced\"", "solver.max_segment_steps=6"}), PhysicsError);
+  const nlohmann::json s = summary(dir);
+  EXPECT_EQ(s["status"].get<std::string>().rfind("physical time stepping stalled", 0), 0u) << s["status"];
+  EXPECT_EQ(s["solver"]["model"], "full");
+  EXPECT_GT(s["solver"]["states"].get<double>(), 0.0);
+  EXPECT_GT(s["solver"]["factorizations"].get<double>(), 0.0);
+  const nlohmann::json& r = s["reduced_model"];
+  const std::string why = r["fallback"];
+  EXPECT_EQ(why.rfind("full FEM: the reduced model failed: reduced model: physical time stepping stalled", 0), 0u) << why;
+  EXPECT_GT(r["online"]["states"].get<double>(), 0.0);
+  EXPECT_GT(r["online"]["newton_iterations"].get<double>(), 0.0);
+  EXPECT_GT(r["online"]["solve_s"].get<double>(), 0.0);
+  EXPECT_EQ(r["online"]["failed"].get<std::string>().rfind("reduced model: physical time stepping stalled", 0), 0u);
+  EXPECT_TRUE(r["check"]["worst_estimated_error_deg"].is_null());  // nothing was checked
+}
+
 /// reduced_check.csv's rows: trial, time, pressure (kPa), angle, adjoint estimate, corrected estimate.
 std::vector<std::vector<double>> check_rows(const fs::path& dir);
 
