@@ -20,7 +20,7 @@ if ! slurm_cluster_available; then
   exit 77
 fi
 
-T="$(mktemp -d /tmp/pneufem_slurm.XXXXXX)"
+T="$(mktemp -d "${TMPDIR:-/tmp}/pneufem_slurm.XXXXXX")"
 fail() {
   echo "FAIL: $*"
   echo "---- last output:"; cat "$T/out" 2>/dev/null
