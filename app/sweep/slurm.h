@@ -9,16 +9,15 @@
 //              its builders first and the other points as a second array that starts after it
 //              (--dependency=afterany), so no task holds an allocation waiting for a cache lock.
 //   caches     DIR/ideal_cache and DIR/rom_cache live in the sweep directory, which must be on the
-//              cluster's shared file system. Their entries are written atomically (a temporary
-//              file renamed into place, which NFS, Lustre, GPFS and BeeGFS make atomic within a
-//              directory) and the computation is serialised by flock() on DIR/<entry>.lock. Linux
-//              maps flock() on NFS onto POSIX byte-range locks, which the NFS lock manager (v3) or
-//              the protocol itself (v4) keeps across nodes; GPFS and BeeGFS (global file locks on)
-//              lock across nodes; Lustre does with the `flock` mount option, only node-locally
-//              with `localflock`, and refuses it without either. Where the lock is node-local two
-//              nodes may compute one entry at once: both write the same bytes (the runs are
-//              deterministic), so the cost is time, not correctness. Where flock() is refused the
-//              controller says so before submitting (docs/commands.md: the alternative).
+//              cluster's shared file system. Each entry is computed under flock() on its .lock file
+//              and written atomically (a temporary file renamed into place); readers take the lock
+//              too. Linux maps flock() on NFS onto POSIX byte-range locks, which the NFS lock
+//              manager (v3) or the protocol itself (v4) keeps across nodes; GPFS and BeeGFS (global
+//              file locks on) lock across nodes; Lustre does with the `flock` mount option, only
+//              node-locally with `localflock`, and refuses it without either. The controller's own
+//              flock() of DIR/.sweep.lock refuses a file system without locks before submitting;
+//              for node-local locks docs/commands.md gives the alternative (the caches built by
+//              one point first).
 //   controller the `pneufem sweep` command itself: it records each submitted job in
 //              DIR/slurm/jobs.tsv, and every invocation collects the finished points (the local
 //              sweep's resume check), asks squeue which points are still queued or running,
