@@ -1136,6 +1136,26 @@ std::vector<SweepArray> slurm_arrays(const SweepOptions& o, const fs::path& out,
   return arrays;
 }
 
+/// A local sweep must not run points that a SLURM job of the same directory still has queued or
+/// running (both would write points/NNNN). Without squeue (a directory copied off the cluster) there
+/// is nothing to ask.
+void refuse_points_on_slurm(const fs::path& out) {
+  const std::vector<SlurmJob> jobs = read_slurm_jobs(out / "slurm" / "jobs.tsv");
+  if (jobs.empty()) return;
+  std::vector<std::string> ids;
+  for (const SlurmJob& j : jobs) ids.push_back(j.id);
+  std::set<int> active;
+  try {
+    active = active_array_tasks(ids);
+  } catch (const std::runtime_error&) {
+    return;
+  }
+  if (active.empty()) return;
+  throw InputError("--out " + out.string() + ": " + std::to_string(active.size()) +
+                   " point(s) of this sweep are queued or running on SLURM (DIR/slurm/jobs.tsv); wait for them "
+                   "or scancel them before running the sweep here, or add --scheduler slurm to collect them");
+}
+
 /// --scheduler slurm: collects the points, writes the outputs of what has finished, and submits the
 /// failed, missing or changed points that are not queued or running.
 void run_sweep_slurm(const SweepOptions& o, const std::vector<ParamSpec>& params, const ModelPlan& plan,
@@ -1155,8 +1175,9 @@ void run_sweep_slurm(const SweepOptions& o, const std::vector<ParamSpec>& params
     say(o.log, std::to_string(result.pending) + " point(s) still queued or running; they are collected by the next call");
   std::vector<SweepArray> arrays;
   if (!to_submit.empty()) arrays = slurm_arrays(o, out, params, plan, to_submit, overrides, result);
-  if (const long max = max_array_size(); max > 0 && result.points.back().index >= max && !to_submit.empty())
-    throw InputError("--scheduler slurm: the task ids are the point numbers, up to " + std::to_string(result.points.back().index) +
+  const int top = to_submit.empty() ? 0 : result.points[to_submit.back()].index;
+  if (const long max = top > 0 ? max_array_size() : 0; max > 0 && top >= max)
+    throw InputError("--scheduler slurm: the task ids are the point numbers, up to " + std::to_string(top) +
                      ", and this cluster's MaxArraySize is " + std::to_string(max) + " (ids up to " + std::to_string(max - 1) +
                      "): sweep fewer points per --out, or ask the administrators to raise MaxArraySize");
   if (o.dry_run) {
@@ -1245,6 +1266,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   const fs::path out(o.out_dir);
   prepare_output_dir((out / "points").string(), "--out");
   const DirLock lock(out);
+  refuse_points_on_slurm(out);
   const WorkerSetup setup{o, out, o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string(), jobs};
   const std::vector<std::size_t> queue = points_to_run(o, out, params, scene_text, result);
   const fs::path csv = out / "sweep.csv";

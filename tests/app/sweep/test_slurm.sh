@@ -9,7 +9,9 @@
 #   the next call collects points 2 and 3, reports 1 (its error) and 4 (cancelled) and resubmits
 #   exactly those two, leaving 2 and 3 untouched;
 #   the last call collects point 4, resubmits only the failing point 1, writes the table, plots and
-#   sweep.json, and every finished point equals the same point of a local --jobs sweep.
+#   sweep.json, and every finished point equals the same point of a local --jobs sweep;
+#   a local sweep of the directory is refused while a job has its points queued;
+#   a reduced sweep submits the point that builds the offline part first and the others after it.
 # Usage: test_slurm.sh PNEUFEM_BINARY. Exit 77 (ctest: skipped) only when SLURM is not installed.
 set -uo pipefail
 PNEUFEM="$1"
@@ -88,6 +90,10 @@ sweep_slurm
 grep -q "2 point(s) still queued or running" "$T/out" || fail "the held points are not seen as queued"
 grep -q "submitted job" "$T/out" && fail "a call resubmitted points that were queued"
 [ "$(last_job)" = "$J2" ] || fail "jobs.tsv grew while the job was queued"
+# Nor does a local sweep of the directory run them under the queued job.
+"$PNEUFEM" "${SWEEP[@]}" --jobs 2 --out "$D" > "$T/out" 2>&1; code=$?
+[ $code -eq 2 ] || fail "a local sweep beside the queued job exited $code (2: refused)"
+grep -q "2 point(s) of this sweep are queued or running on SLURM" "$T/out" || fail "the local sweep's refusal"
 scontrol release "$J2" >/dev/null 2>&1 || fail "scontrol release $J2"
 wait_job "$J2"
 
@@ -111,4 +117,23 @@ for p in 2 3 4; do
   local_row=$(grep "^$p," "$T/local/sweep.csv" | cut -d, -f1-4,6-)
   [ "$slurm_row" = "$local_row" ] || fail "point $p: SLURM '$slurm_row' != local '$local_row'"
 done
-echo "PASS: dry run, one array, failed and cancelled points resubmitted exactly, queued points left alone, outputs"
+# A reduced sweep: the point that builds the offline part runs first, the others as a second array
+# that starts after it (--dependency=afterany) and read rom_cache/.
+R="$T/reduced"
+"$PNEUFEM" sweep --param "$TAU=100:1000:3:log" "${TINY[@]}" --model reduced --scheduler slurm --out "$R" > "$T/out" 2>&1 ||
+  fail "the reduced sweep's submission exited $?"
+RJ1=$(sed -n 2p "$R/slurm/jobs.tsv" | cut -f1)
+[ "$(sed -n 2p "$R/slurm/jobs.tsv" | cut -f2)" = "1" ] || fail "the reduced sweep's first array is not point 1"
+[ "$(sed -n 3p "$R/slurm/jobs.tsv" | cut -f2)" = "2,3" ] || fail "the reduced sweep's second array is not points 2,3"
+grep -q "^#SBATCH --dependency=afterany:$RJ1\$" "$R/slurm/array_2.sh" || fail "the second array does not start after $RJ1"
+wait_job "$RJ1"; wait_job "$(sed -n 3p "$R/slurm/jobs.tsv" | cut -f1)"
+"$PNEUFEM" sweep --param "$TAU=100:1000:3:log" "${TINY[@]}" --model reduced --scheduler slurm --out "$R" > "$T/out" 2>&1 ||
+  fail "the reduced sweep's collection exited $?"
+grep -q "3 points, 3 ok, 0 failed, 0 queued or running" "$T/out" || fail "the reduced sweep: not 3 ok"
+grep -q "submitted" "$T/out" && fail "the finished reduced sweep submitted again"
+grep -q '"basis": "computed"' "$R/points/0001/summary.json" || fail "point 1 did not build the basis"
+for p in 0002 0003; do
+  grep -q "\"basis\": \"cache $R/rom_cache" "$R/points/$p/summary.json" || fail "point $p did not read the basis from rom_cache"
+done
+
+echo "PASS: dry run, one array, failed and cancelled points resubmitted exactly, queued points left alone (also by a local sweep), outputs equal to a local sweep, reduced builders first"
