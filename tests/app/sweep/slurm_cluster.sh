@@ -30,7 +30,7 @@ SlurmctldHost=localhost
 SlurmctldPort=$base
 SlurmdPort=$((base + 1))
 SlurmUser=$user
-SlurmdUser=root
+SlurmdUser=$user
 AuthType=auth/munge
 CredType=cred/munge
 AuthInfo=socket=$d/munge/munge.sock
