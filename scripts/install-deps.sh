@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages pneufem needs (only those missing). Uses sudo when not root.
+# slurm-wlm and munge: the test of `sweep --scheduler slurm` starts its own one-node SLURM (their
+# system services stay unconfigured: Debian starts slurmctld/slurmd only with /etc/slurm/slurm.conf).
 set -euo pipefail
 PKGS=(
   build-essential cmake ninja-build pkg-config
@@ -8,6 +10,7 @@ PKGS=(
   libsuitesparse-dev libopenblas-dev libnlopt-cxx-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev
   clang-14 libclang-rt-14-dev
+  slurm-wlm munge
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -56,7 +56,20 @@ std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app) {
                  "sweep, into DIR/points/NNNN/fem/; sweep.csv gets their FEM NRMSE and largest |reduced - FEM| angle")
       ->delimiter(',');
   sw->add_option("--set", sweep.sets, "Override a scene key at every point, e.g. --set load.trials=10 (repeatable)");
-  sw->add_flag("--dry-run", sweep.dry_run, "List the points and exit without running them");
+  sw->add_flag("--dry-run", sweep.dry_run,
+               "List the points and exit without running them (with --scheduler slurm: print the sbatch script, submit nothing)");
+  sw->add_option("--scheduler", sweep.scheduler,
+                 "local: worker processes on this machine (--jobs); slurm: submit the points as one SLURM job array "
+                 "(one task per point) and return; the same command again collects the finished points, resubmits "
+                 "failed or missing ones and writes the table and plots. DIR must be on the cluster's shared file system")
+      ->check(CLI::IsMember({"local", "slurm"}))
+      ->capture_default_str();
+  sw->add_option("--partition", sweep.slurm.partition, "SLURM partition of the job array (sbatch --partition)");
+  sw->add_option("--time", sweep.slurm.time, "Time limit of each point's task, e.g. 2:00:00 (sbatch --time)");
+  sw->add_option("--mem", sweep.slurm.mem, "Memory of each point's task, e.g. 4G (sbatch --mem)");
+  sw->add_option("--account", sweep.slurm.account, "SLURM account charged (sbatch --account)");
+  sw->add_option("--max-parallel", sweep.slurm.max_parallel, "Points running at once on the cluster (the array's %N)")
+      ->check(CLI::Range(1, 100000));
   return c;
 }
 
@@ -66,6 +79,22 @@ int run_sweep_command(SweepCommand& c, const std::string& command_line) {
   sweep.command_line = command_line;
   const SweepResult r = run_sweep(sweep);
   if (sweep.dry_run) return 0;
+  if (sweep.scheduler == "slurm") {
+    std::printf("sweep: %zu points, %d ok, %d failed, %d queued or running; table %s\n", r.points.size(), r.ok, r.failed,
+                r.pending, (fs::path(sweep.out_dir) / "sweep.csv").c_str());
+    if (!r.submitted_jobs.empty()) {
+      std::string jobs;
+      for (const std::string& j : r.submitted_jobs) jobs += (jobs.empty() ? "" : ",") + j;
+      std::printf("sweep: submitted %zu point(s) as SLURM job %s; run this command again when it has finished "
+                  "(squeue -j %s) to collect them\n", r.submitted_points.size(), jobs.c_str(), jobs.c_str());
+    } else if (r.pending > 0) {
+      std::printf("sweep: nothing submitted; run this command again when the queued points have finished\n");
+    }
+    if (r.failed > 0)
+      std::fprintf(stderr, "error: %d of %zu points failed (their errors are in sweep.csv; they were submitted again)\n",
+                   r.failed, r.points.size());
+    return r.failed > 0 ? 1 : 0;
+  }
   std::printf("sweep: %zu points, %d ok (%d skipped), %d failed, %.1f s; table %s\n", r.points.size(), r.ok, r.skipped,
               r.failed, r.wall_s, (fs::path(sweep.out_dir) / "sweep.csv").c_str());
   if (r.failed > 0) std::fprintf(stderr, "error: %d of %zu points failed (their errors are in sweep.csv)\n", r.failed, r.points.size());

@@ -16,7 +16,8 @@ struct SweepCommand {
 };
 
 /// Adds `sweep [SCENE.toml] --param KEY=LO:HI:N[:log] ... --out DIR [--lhs N] [--seed S] [--jobs N]
-/// [--threads-per-job N] [--model auto|full|reduced] [--fem-points LIST] [--set k=v ...] [--dry-run]`
+/// [--threads-per-job N] [--model auto|full|reduced] [--fem-points LIST] [--set k=v ...] [--dry-run]
+/// [--scheduler local|slurm] [--partition P] [--time T] [--mem M] [--account A] [--max-parallel N]`
 /// to `app`; --param and --model are validated at parse time.
 std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app);
 

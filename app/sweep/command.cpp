@@ -253,7 +253,12 @@ class DirLock {
     fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd_ < 0) throw InputError("--out " + dir.string() + ": cannot create " + path + " (is the directory writable?)");
     if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
       close(fd_);
+      if (err != EWOULDBLOCK)  // ENOLCK, ENOSYS, EOPNOTSUPP: the file system does not lock
+        throw InputError("--out " + dir.string() + ": the file system refuses file locks (flock: " + strerror(err) +
+                         "), which the sweep and its shared caches need; on Lustre mount with -o flock, or choose "
+                         "an --out on a file system that locks (docs/commands.md, sweeps on SLURM)");
       throw InputError("--out " + dir.string() +
                        ": another pneufem sweep is running in this directory; wait for it or choose another --out");
     }
@@ -449,6 +454,7 @@ std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& para
       .add("offline_parts", r.offline_parts)
       .add("fem_points", json::array(std::vector<double>(o.fem_points.begin(), o.fem_points.end())))
       .add("jobs", o.jobs)
+      .add_str("scheduler", o.scheduler)
       .add("threads_per_job", o.threads_per_job)
       .add("points_total", static_cast<double>(r.points.size()))
       .add("ok", r.ok)
@@ -461,6 +467,18 @@ std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& para
       .add("plots", plot_list)
       .add("points", pts);
   return head.str() + "\n";
+}
+
+/// DIR/sweep_<key>.svg of each parameter and DIR/sweep.json.
+void write_plots_and_json(const SweepOptions& recorded, const fs::path& out, const std::vector<ParamSpec>& params,
+                          const SweepResult& result) {
+  std::vector<std::string> plots;
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    const std::string name = "sweep_" + file_key(params[j].key) + ".svg";
+    write_plot(out / name, params, j, result.points);
+    plots.push_back(name);
+  }
+  write_file_atomic((out / "sweep.json").string(), sweep_json(recorded, params, result, plots));
 }
 
 void say(std::FILE* log, const std::string& line) {
@@ -874,6 +892,20 @@ void check_sweep_options(const SweepOptions& o) {
   if (o.lhs < 0) throw InputError("--lhs " + std::to_string(o.lhs) + ": the number of samples must be at least 1");
   if (o.out_dir.empty() && !o.dry_run) throw InputError("--out DIR is required");
   if (!o.dry_run) check_output_dir(o.out_dir, "--out");  // before anything is read or run: a bad --out fails now
+  if (o.scheduler != "local" && o.scheduler != "slurm")
+    throw InputError("--scheduler " + o.scheduler + ": 'local' (worker processes here) or 'slurm' (a job array)");
+  if (o.scheduler == "slurm") {
+    if (o.jobs > 0) throw InputError("--jobs: with --scheduler slurm the cluster runs the points; --max-parallel N limits how many at once");
+    if (!o.fem_points.empty())
+      throw InputError("--fem-points: not with --scheduler slurm; when the SLURM sweep has finished, the same command "
+                       "without --scheduler slurm and with --fem-points runs the FEM re-runs here (the points are done)");
+    check_slurm_options(o.slurm);
+  } else {
+    const SlurmOptions none;
+    if (o.slurm.partition != none.partition || o.slurm.time != none.time || o.slurm.mem != none.mem ||
+        o.slurm.account != none.account || o.slurm.max_parallel != none.max_parallel)
+      throw InputError("--partition, --time, --mem, --account and --max-parallel are sbatch options: add --scheduler slurm");
+  }
 }
 
 // The parameters, checked against the scene: existing numeric keys, each once.
@@ -984,6 +1016,202 @@ void run_queue(const SweepOptions& o, const WorkerSetup& setup, const ModelPlan&
   run_workers(rest, jobs, point_finished);
 }
 
+// --- --scheduler slurm: the controller (app/sweep/slurm.h) ---
+
+/// A job this sweep submitted: its id and its points (DIR/slurm/jobs.tsv, "ID<TAB>1,2,5").
+struct SlurmJob {
+  std::string id;
+  std::vector<int> points;
+};
+
+std::vector<SlurmJob> read_slurm_jobs(const fs::path& tsv) {
+  std::vector<SlurmJob> jobs;
+  std::istringstream in(slurp(tsv));
+  for (std::string line; std::getline(in, line);) {
+    const std::size_t tab = line.find('\t');
+    if (tab == std::string::npos || line[0] == '#') continue;
+    SlurmJob j{line.substr(0, tab), {}};
+    std::istringstream ps(line.substr(tab + 1));
+    for (std::string p; std::getline(ps, p, ',');)
+      if (const std::optional<long long> v = parse_int(p)) j.points.push_back(static_cast<int>(*v));
+    jobs.push_back(j);
+  }
+  return jobs;
+}
+
+/// Why a submitted point that is no longer queued or running has no result of its scene.
+std::string missing_point_error(const fs::path& dir, const fs::path& slurm_dir, const std::vector<SlurmJob>& jobs, int index) {
+  std::string where;
+  for (auto j = jobs.rbegin(); j != jobs.rend() && where.empty(); ++j)
+    if (std::find(j->points.begin(), j->points.end(), index) != j->points.end()) where = j->id + "_" + std::to_string(index);
+  std::string tail = log_tail(dir / "log.txt");
+  if (tail.empty() && !where.empty()) tail = log_tail(slurm_dir / (where + ".out"));
+  return "no result: the task" + (where.empty() ? "" : " " + where) +
+         " ended without finishing (cancelled, out of time or memory, or its node failed; sacct -j " +
+         (where.empty() ? "JOB" : where) + " says which)" + (tail.empty() ? "" : ": " + tail);
+}
+
+/// The points' state on disk and in the queue; returns the indices to (re)submit: failed, missing
+/// or changed points that are not queued or running.
+std::vector<std::size_t> collect_slurm_points(const SweepOptions& o, const fs::path& out, const std::vector<ParamSpec>& params,
+                                              const std::vector<std::string>& scene_text, const std::vector<SlurmJob>& jobs,
+                                              SweepResult& result) {
+  std::vector<std::string> ids;
+  std::set<int> submitted_before;
+  for (const SlurmJob& j : jobs) {
+    ids.push_back(j.id);
+    submitted_before.insert(j.points.begin(), j.points.end());
+  }
+  const std::set<int> active = active_array_tasks(ids);  // before the points are read: a task ending now is read as ended
+  std::vector<std::size_t> to_submit;
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    SweepPoint& pt = result.points[i];
+    const fs::path dir = out / "points" / point_name(pt.index);
+    if (active.count(pt.index)) {
+      ++result.pending;
+      continue;
+    }
+    if (done_before(dir, scene_text[i])) {
+      read_point(pt, dir, -1, 0.0);
+      pt.skipped = true;
+      ++result.ok;
+      ++result.skipped;
+      continue;
+    }
+    to_submit.push_back(i);
+    const std::optional<std::string> status = run_status(read_json(dir / "summary.json"));
+    if (status && *status != "ok") {
+      read_point(pt, dir, 1, 0.0);  // its error is summary.json's status
+    } else if (!status && submitted_before.count(pt.index)) {
+      read_point(pt, dir, 1, 0.0);
+      pt.error = missing_point_error(dir, out / "slurm", jobs, pt.index);
+    } else {
+      continue;  // never submitted, or done with another scene: pending
+    }
+    ++result.failed;
+    say(o.log, "point " + point_name(pt.index) + " " + describe(params, pt) + ": failed: " + pt.error);
+  }
+  return to_submit;
+}
+
+/// The job arrays of `to_submit`: one, or (a reduced sweep) the offline parts' builders and the
+/// rest after them.
+std::vector<SweepArray> slurm_arrays(const SweepOptions& o, const fs::path& out, const std::vector<ParamSpec>& params,
+                                     const ModelPlan& plan, const std::vector<std::size_t>& to_submit,
+                                     const std::vector<std::vector<std::string>>& overrides, const SweepResult& result) {
+  const WorkerSetup setup{o, out, o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string(), 1};
+  // The worker's command with the point's directory and values as placeholders: the same for
+  // every point, whose overrides differ only in their first params.size() entries.
+  std::vector<std::string> point_tail(overrides[0].begin() + static_cast<std::ptrdiff_t>(params.size()), overrides[0].end());
+  point_tail.insert(point_tail.begin(), kPointWord);
+  std::vector<std::string> command = setup.argv(kDirWord, point_tail, plan.reduced);
+  const auto word = std::find(command.begin(), command.end(), std::string(kPointWord));
+  command.erase(word - 1);  // the "--set" before it: the script writes each --set KEY=VALUE
+  std::string name = "pneufem-sweep-" + file_key(out.filename().string());
+  std::vector<Worker> workers;
+  for (std::size_t i : to_submit) workers.push_back({i, {}, {}});
+  auto [first, rest] = offline_waves(std::move(workers), plan);
+  std::vector<std::vector<Worker>> waves;
+  if (!first.empty() && !rest.empty()) waves = {std::move(first), std::move(rest)};
+  else waves = {first.empty() ? std::move(rest) : std::move(first)};
+  std::vector<SweepArray> arrays;
+  for (std::vector<Worker>& wave : waves) {
+    std::sort(wave.begin(), wave.end(), [](const Worker& a, const Worker& b) { return a.i < b.i; });
+    SweepArray a;
+    a.job_name = name;
+    for (const Worker& w : wave) {
+      a.points.push_back(result.points[w.i].index);
+      a.values.push_back(result.points[w.i].texts);
+    }
+    for (const ParamSpec& p : params) a.keys.push_back(p.key);
+    a.command = command;
+    a.points_dir = (out / "points").string();
+    a.log_dir = (out / "slurm").string();
+    a.cpus_per_task = o.threads_per_job;
+    a.header = "# pneufem sweep on SLURM (docs/commands.md): one task per point, the task id is the point number.\n"
+               "# " + version_string() + ": " + o.command_line + "\n";
+    if (!arrays.empty()) a.dependency = "FIRST_ARRAY";  // the builders' job id, set when it is known
+    arrays.push_back(std::move(a));
+  }
+  return arrays;
+}
+
+/// A local sweep must not run points that a SLURM job of the same directory still has queued or
+/// running (both would write points/NNNN). Without squeue (a directory copied off the cluster) there
+/// is nothing to ask.
+void refuse_points_on_slurm(const fs::path& out) {
+  const std::vector<SlurmJob> jobs = read_slurm_jobs(out / "slurm" / "jobs.tsv");
+  if (jobs.empty()) return;
+  std::vector<std::string> ids;
+  for (const SlurmJob& j : jobs) ids.push_back(j.id);
+  std::set<int> active;
+  try {
+    active = active_array_tasks(ids);
+  } catch (const std::runtime_error&) {
+    return;
+  }
+  if (active.empty()) return;
+  throw InputError("--out " + out.string() + ": " + std::to_string(active.size()) +
+                   " point(s) of this sweep are queued or running on SLURM (DIR/slurm/jobs.tsv); wait for them "
+                   "or scancel them before running the sweep here, or add --scheduler slurm to collect them");
+}
+
+/// --scheduler slurm: collects the points, writes the outputs of what has finished, and submits the
+/// failed, missing or changed points that are not queued or running.
+void run_sweep_slurm(const SweepOptions& o, const std::vector<ParamSpec>& params, const ModelPlan& plan,
+                     const std::vector<std::vector<std::string>>& overrides, const std::vector<std::string>& scene_text,
+                     SweepResult& result) {
+  const fs::path out = fs::absolute(o.out_dir);
+  std::optional<DirLock> lock;
+  if (!o.dry_run) {
+    prepare_output_dir((out / "points").string(), "--out");
+    prepare_output_dir((out / "slurm").string(), "--out");
+    lock.emplace(out);  // one controller at a time: two would submit the same points
+  }
+  const fs::path jobs_tsv = out / "slurm" / "jobs.tsv";
+  const std::vector<SlurmJob> jobs = read_slurm_jobs(jobs_tsv);
+  const std::vector<std::size_t> to_submit = collect_slurm_points(o, out, params, scene_text, jobs, result);
+  if (result.pending > 0)
+    say(o.log, std::to_string(result.pending) + " point(s) still queued or running; they are collected by the next call");
+  std::vector<SweepArray> arrays;
+  if (!to_submit.empty()) arrays = slurm_arrays(o, out, params, plan, to_submit, overrides, result);
+  const int top = to_submit.empty() ? 0 : result.points[to_submit.back()].index;
+  if (const long max = top > 0 ? max_array_size() : 0; max > 0 && top >= max)
+    throw InputError("--scheduler slurm: the task ids are the point numbers, up to " + std::to_string(top) +
+                     ", and this cluster's MaxArraySize is " + std::to_string(max) + " (ids up to " + std::to_string(max - 1) +
+                     "): sweep fewer points per --out, or ask the administrators to raise MaxArraySize");
+  if (o.dry_run) {
+    if (arrays.empty()) say(o.log, "nothing to submit: every point is done, queued or running");
+    for (std::size_t k = 0; k < arrays.size(); ++k)
+      std::fprintf(stdout, "%s# ---- sbatch script %zu of %zu%s ----\n%s", k ? "\n" : "", k + 1, arrays.size(),
+                   k ? " (FIRST_ARRAY: the job id of script 1)" : "", slurm_array_script(arrays[k], o.slurm).c_str());
+    return;
+  }
+  write_file_atomic((out / "sweep.csv").string(), sweep_csv(params, result.points));
+  std::string first_id;
+  for (std::size_t k = 0; k < arrays.size(); ++k) {
+    SweepArray& a = arrays[k];
+    if (!a.dependency.empty()) a.dependency = first_id;
+    std::string stamp = std::to_string(jobs.size() + k + 1);
+    const fs::path script = out / "slurm" / ("array_" + stamp + ".sh");
+    write_file_atomic(script.string(), slurm_array_script(a, o.slurm));
+    const std::string id = sbatch_submit(script.string());
+    if (k == 0) first_id = id;
+    std::string list;
+    for (int p : a.points) list += (list.empty() ? "" : ",") + std::to_string(p);
+    std::string tsv = slurp(jobs_tsv);
+    if (tsv.empty()) tsv = "# job id\tpoints (= array task ids), one line per sbatch of this sweep\n";
+    write_file_atomic(jobs_tsv.string(), tsv + id + "\t" + list + "\n");
+    result.submitted_jobs.push_back(id);
+    result.submitted_points.insert(result.submitted_points.end(), a.points.begin(), a.points.end());
+    say(o.log, "submitted job " + id + ": array " + array_spec(a.points, o.slurm.max_parallel) + " (" +
+                   std::to_string(a.points.size()) + " point(s)" + (a.dependency.empty() ? "" : ", after job " + a.dependency) +
+                   "), script " + script.string());
+  }
+  result.pending += static_cast<int>(result.submitted_points.size());
+  std::sort(result.submitted_points.begin(), result.submitted_points.end());
+}
+
 }  // namespace
 
 SweepResult run_sweep(const SweepOptions& o) {
@@ -1019,6 +1247,14 @@ SweepResult run_sweep(const SweepOptions& o) {
   if (scene_model != result.model && scene_model != Scene::load("").string("solver.model"))
     say(o.log, "--model " + o.model + " decides over the scene's solver.model = \"" + scene_model + "\" (" +
                    base.origin("solver.model") + "): the points run the " + (plan.reduced ? "reduced model" : "full FEM"));
+  if (o.scheduler == "slurm") {
+    if (o.exe.empty()) throw std::logic_error("run_sweep: SweepOptions::exe (the pneufem binary) is not set");
+    run_sweep_slurm(o, params, plan, overrides, scene_text, result);
+    if (o.dry_run) return result;
+    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    write_plots_and_json(o, fs::path(o.out_dir), params, result);
+    return result;
+  }
   if (o.dry_run) {
     say(o.log, std::to_string(result.points.size()) + " points (" + (o.lhs > 0 ? "Latin hypercube" : "grid") + "), " +
                    std::to_string(jobs) + " worker process(es) x " + std::to_string(o.threads_per_job) + " thread(s):");
@@ -1030,6 +1266,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   const fs::path out(o.out_dir);
   prepare_output_dir((out / "points").string(), "--out");
   const DirLock lock(out);
+  refuse_points_on_slurm(out);
   const WorkerSetup setup{o, out, o.scene_path.empty() ? "" : fs::absolute(o.scene_path).string(), jobs};
   const std::vector<std::size_t> queue = points_to_run(o, out, params, scene_text, result);
   const fs::path csv = out / "sweep.csv";
@@ -1039,17 +1276,11 @@ SweepResult run_sweep(const SweepOptions& o) {
   run_queue(o, setup, plan, params, queue, overrides, csv, jobs, result);
   run_fem_points(setup, base, params, fem_points, overrides, result);
 
-  std::vector<std::string> plots;
-  for (std::size_t j = 0; j < params.size(); ++j) {
-    const std::string name = "sweep_" + file_key(params[j].key) + ".svg";
-    write_plot(out / name, params, j, result.points);
-    plots.push_back(name);
-  }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   SweepOptions recorded = o;
   recorded.jobs = jobs;
   recorded.fem_points.assign(fem_points.begin(), fem_points.end());
-  write_file_atomic((out / "sweep.json").string(), sweep_json(recorded, params, result, plots));
+  write_plots_and_json(recorded, out, params, result);
   return result;
 }
 

@@ -23,12 +23,17 @@
 //   outputs    DIR/sweep.csv (one row per point, rewritten atomically after every point),
 //              DIR/sweep_<key>.svg (final-trial NRMSE against each parameter), DIR/sweep.json.
 // A failed point is recorded with its error and does not stop the sweep.
+//   slurm      --scheduler slurm submits the points as a job array instead of running them here;
+//              the same command again collects, resubmits failed or missing points and writes the
+//              outputs (app/sweep/slurm.h).
 #include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "app/sweep/slurm.h"
 
 namespace pneufem {
 
@@ -72,7 +77,9 @@ struct SweepOptions {
   std::string exe;          ///< the pneufem binary the workers run
   std::string model = "auto";   ///< "auto", "full" or "reduced": the model of the workers (solver.model)
   std::vector<int> fem_points;  ///< points (1-based) re-run with the full FEM after the sweep
-  bool dry_run = false;     ///< print the points, run nothing, write nothing
+  bool dry_run = false;     ///< print the points (with SLURM: the sbatch script), run nothing, write nothing
+  std::string scheduler = "local";  ///< "local" (worker processes here) or "slurm" (a job array, app/sweep/slurm.h)
+  SlurmOptions slurm;               ///< sbatch options of --scheduler slurm
   std::string command_line;
   std::FILE* log = stdout;  ///< one line per point; nullptr = quiet
 };
@@ -106,6 +113,9 @@ struct SweepResult {
   int offline_parts = 0;     ///< distinct offline parts of a reduced sweep (0 with the full FEM)
   int ok = 0, failed = 0, skipped = 0;
   int fem_failed = 0;        ///< --fem-points whose FEM run failed
+  int pending = 0;           ///< --scheduler slurm: points queued or running, or submitted now
+  std::vector<std::string> submitted_jobs;  ///< --scheduler slurm: the job ids submitted by this call
+  std::vector<int> submitted_points;        ///< --scheduler slurm: the points they run
   double wall_s = 0.0;
 };
 

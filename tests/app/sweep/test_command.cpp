@@ -379,6 +379,13 @@ TEST(SweepCli, BadOptionsAreRejectedBeforeAnythingRuns) {
       {"--param " + kTau + "=1:2:2 --jobs 0", "--jobs"},
       {"--param " + kTau + "=1:2:2 --threads-per-job 0", "--threads-per-job"},
       {"--param " + kTau + "=1:2:2 --set solver.metod=newton", "did you mean 'solver.method'"},
+      {"--param " + kTau + "=1:2:2 --partition gpu", "sbatch options: add --scheduler slurm"},
+      {"--param " + kTau + "=1:2:2 --scheduler slurm --jobs 2", "--max-parallel N limits how many at once"},
+      {"--param " + kTau + "=1:2:2 --scheduler slurm --fem-points 1", "--fem-points: not with --scheduler slurm"},
+      {"--param " + kTau + "=1:2:2 --scheduler slurm --time 2h", "--time '2h': SLURM's form is MINUTES, HH:MM:SS"},
+      {"--param " + kTau + "=1:2:2 --scheduler slurm --mem 4GB", "--mem '4GB': memory per task"},
+      {"--param " + kTau + "=1:2:2 --scheduler slurm --partition 'a b'", "--partition 'a b': a partition name"},
+      {"--param " + kTau + "=1:2:2 --scheduler pbs", "--scheduler: pbs not in {local,slurm}"},
   };
   for (const Case& c : cases) {
     const Result r = run("sweep " + c.args + " --out " + d.string());
@@ -395,9 +402,24 @@ TEST(SweepCli, BadOptionsAreRejectedBeforeAnythingRuns) {
   EXPECT_EQ(count(dry.out, "load.max_kPa="), 4u);
   EXPECT_FALSE(fs::exists(d));
 
+  // With --scheduler slurm, --dry-run prints the array script (no SLURM needed) and writes nothing:
+  // the task id selects the point, whose run is the local worker's command.
+  const Result script = run("sweep --param " + kTau + "=100:1000:3:log " + kTiny +
+                            " --model full --scheduler slurm --partition short --time 1:00:00 --mem 2G --account lab "
+                            "--max-parallel 2 --threads-per-job 3 --dry-run --out " + d.string());
+  ASSERT_EQ(script.code, 0) << script.out;
+  for (const std::string& line :
+       {std::string("#SBATCH --array=1-3%2\n"), std::string("#SBATCH --partition=short\n"), std::string("#SBATCH --time=1:00:00\n"),
+        std::string("#SBATCH --mem=2G\n"), std::string("#SBATCH --account=lab\n"), std::string("#SBATCH --cpus-per-task=3\n"),
+        "keys=('" + kTau + "')\n", std::string("  2) values=('316.22776601683796') ;;\n"),
+        std::string("'--threads' '3' '--ideal-cache' '") + fs::absolute(d).string() + "/ideal_cache'",
+        std::string("\"${sets[@]}\" '--set' 'output.vtu=\"none\"' '--set' 'solver.model=\"full\"' > \"$dir/log.txt\" 2>&1\n")})
+    EXPECT_NE(script.out.find(line), std::string::npos) << line << "\n" << script.out;
+  EXPECT_FALSE(fs::exists(d));
+
   const Result help = run("sweep --help");
   for (const char* opt : {"--param", "--lhs", "--seed", "--out", "--jobs", "--threads-per-job", "--set", "--dry-run", "--model",
-                          "--fem-points"})
+                          "--fem-points", "--scheduler", "--partition", "--time", "--mem", "--account", "--max-parallel"})
     EXPECT_NE(help.out.find(opt), std::string::npos) << opt;
 }
 
