@@ -8,6 +8,7 @@ PKGS=(
   libsuitesparse-dev libopenblas-dev libnlopt-cxx-dev
   libgtest-dev libgmock-dev nlohmann-json3-dev
   clang-14 libclang-rt-14-dev
+  python3-dev python3-pybind11 python3-numpy python3-matplotlib python3-pytest
 )
 missing=()
 for p in "${PKGS[@]}"; do
