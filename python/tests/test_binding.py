@@ -1,5 +1,6 @@
 """The Python binding (python/pneufem, docs/python.md): scenes as dicts and their errors, each command
 from Python against the CLI on the same input, numpy shapes, the GIL and Ctrl-C."""
+import importlib.util
 import os
 import pathlib
 import signal
@@ -122,6 +123,41 @@ def test_simulate_equals_the_cli_and_has_numpy_fields(exe, tmp_path):
     np.testing.assert_allclose(f.stress, np.swapaxes(f.stress, 1, 2), rtol=0, atol=1e-6 * np.abs(f.stress).max())
     first = r.fields(0)
     assert np.abs(first.displacement).max() == 0.0  # the first report is at 0 kPa
+
+
+VTK_CHECK = textwrap.dedent("""
+    import sys
+    import numpy as np
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    sys.path.insert(0, {pkg!r})
+    from pneufem._vtu import read_vtu
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName({path!r})
+    r.Update()
+    g = r.GetOutput()
+    mine = read_vtu({path!r})
+    assert np.array_equal(vtk_to_numpy(g.GetPoints().GetData()), mine["points"])
+    for data, ours in ((g.GetPointData(), mine["point"]), (g.GetCellData(), mine["cell"])):
+        assert data.GetNumberOfArrays() == len(ours), sorted(ours)
+        for i in range(data.GetNumberOfArrays()):
+            a = data.GetArray(i)
+            theirs = vtk_to_numpy(a).reshape(ours[a.GetName()].shape)
+            assert np.array_equal(theirs, ours[a.GetName()], equal_nan=True), a.GetName()
+    print("same", g.GetNumberOfPoints(), g.GetCellData().GetNumberOfArrays())
+""")
+
+
+def test_vtu_reader_agrees_with_vtk(tmp_path):
+    # The package's own VTU reader (numpy + zlib) against VTK's, bit for bit, on a state with creep
+    # (every field non-trivial). VTK runs in another process: the package never loads it itself.
+    if importlib.util.find_spec("vtk") is None:
+        pytest.skip("VTK's Python module is not installed (Debian: python3-vtk9)")
+    r = pneufem.simulate(scene_of(TINY).set("materials.silicone.viscoelastic.enabled", True), out=tmp_path / "o", quiet=True)
+    path = str(r.state_files[-1][1])
+    pkg = str(pathlib.Path(pneufem.__file__).parent.parent)
+    out = subprocess.run([sys.executable, "-c", VTK_CHECK.format(pkg=pkg, path=path)], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.startswith("same"), out.stdout + out.stderr
 
 
 def test_to_pandas_when_available(tmp_path):
