@@ -160,6 +160,20 @@ def test_vtu_reader_agrees_with_vtk(tmp_path):
     assert out.returncode == 0 and out.stdout.startswith("same"), out.stdout + out.stderr
 
 
+def test_a_failed_simulation_raises_physics_error_with_what_was_solved(tmp_path):
+    # 0 -> 300 kPa in 100 kPa steps: the tiny actuator balloons (a limit point near 53 kPa, ~8 s).
+    # The CLI exits 3 with "simulation failed: <message>" after writing the run so far; Python
+    # raises PhysicsError with that message and the run read back.
+    scene = scene_of(TINY).update({"load.max_kPa": 300.0, "load.step_kPa": 100.0})
+    with pytest.raises(pneufem.PhysicsError) as e:
+        pneufem.simulate(scene, out=tmp_path / "o", threads=2, quiet=True)
+    assert isinstance(e.value, RuntimeError)
+    assert "limit point" in str(e.value)
+    r = e.value.result
+    assert r.status == str(e.value)  # summary.json's status is the CLI's message
+    assert len(r.angles) >= 2 and r.angles["pressure_kPa"].max() < 100.0
+
+
 def test_to_pandas_when_available(tmp_path):
     r = pneufem.simulate(scene_of(TINY), out=tmp_path / "o", quiet=True)
     try:
@@ -241,6 +255,34 @@ def test_ctrl_c_stops_cleanly_and_the_run_resumes_to_the_same_result(exe, tmp_pa
     run_cli(exe, "simulate", *cli_sets(LONGER), "--out", tmp_path / "cli", "--threads", "1")
     assert resumed.status == "ok"
     assert (out / "angles.csv").read_bytes() == (tmp_path / "cli" / "angles.csv").read_bytes()
+
+
+SWEEP_INTERRUPT = textwrap.dedent("""
+    import os, signal, threading, time
+    import pneufem
+    scene = pneufem.Scene.defaults().update({values!r})
+    threading.Timer({after}, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    try:
+        pneufem.sweep(scene, param="load.max_kPa=4:5:2", out={out!r}, jobs=2, model="full", quiet=True)
+        print("finished")
+    except KeyboardInterrupt:
+        print("interrupted")
+""")
+
+
+def test_ctrl_c_stops_a_sweep_and_its_workers(tmp_path):
+    # The sweep's worker processes (pneufem simulate, exec'd by the sweep) stop with it; the same
+    # sweep run again then completes every point (app/sweep/command.h: resume).
+    out = tmp_path / "sweep"
+    script = SWEEP_INTERRUPT.format(values=LONGER, after=1.5, out=str(out))
+    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert r.stdout.strip() == "interrupted", r.stdout + r.stderr
+    time.sleep(0.2)
+    ps = subprocess.run(["ps", "-eo", "args"], capture_output=True, text=True).stdout
+    assert str(out) not in ps, "a worker of the interrupted sweep is still running"
+    assert not list(out.rglob("*.tmp"))
+    s = pneufem.sweep(scene_of(LONGER), param="load.max_kPa=4:5:2", out=out, jobs=2, model="full", quiet=True)
+    assert s.ok == 2 and s.failed == 0
 
 
 # ---- synth, compare, diagnose, sweep ------------------------------------------------------------
