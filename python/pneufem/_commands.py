@@ -248,6 +248,8 @@ def simulate(scene=None, out=None, threads=None, resume=False, quiet=False, **op
     what was solved before the failure."""
     out = _out_dir(out, "run")
     if resume:
+        if scene is not None or options.get("sets"):
+            raise InputError("--resume continues a run with its own scene.toml; do not give a scene or --set")
         args = ["simulate", "--resume", out]
     else:
         args = ["simulate"] + _as_scene(scene).cli_args() + ["--out", out]

@@ -251,6 +251,8 @@ def test_ctrl_c_stops_cleanly_and_the_run_resumes_to_the_same_result(exe, tmp_pa
     assert not (out / "summary.json").exists()
     assert not list(out.rglob("*.tmp"))
     assert (out / "checkpoint.bin").exists(), "interrupted before the first checkpoint: make LONGER longer"
+    with pytest.raises(pneufem.InputError, match="--resume"):  # the CLI's rule: the run's own scene
+        pneufem.simulate(scene_of(LONGER), out=out, resume=True, quiet=True)
     resumed = pneufem.simulate(out=out, resume=True, threads=1, quiet=True)
     run_cli(exe, "simulate", *cli_sets(LONGER), "--out", tmp_path / "cli", "--threads", "1")
     assert resumed.status == "ok"
