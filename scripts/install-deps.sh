@@ -11,6 +11,7 @@ PKGS=(
   libgtest-dev libgmock-dev nlohmann-json3-dev
   clang-14 libclang-rt-14-dev
   slurm-wlm munge
+  python3-dev python3-pybind11 python3-numpy python3-matplotlib python3-pytest
 )
 missing=()
 for p in "${PKGS[@]}"; do

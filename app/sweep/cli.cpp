@@ -73,9 +73,11 @@ std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app) {
   return c;
 }
 
-int run_sweep_command(SweepCommand& c, const std::string& command_line) {
+int run_sweep_command(SweepCommand& c, const std::string& command_line, const std::string& exe) {
   SweepOptions& sweep = c.options;
-  sweep.exe = fs::read_symlink("/proc/self/exe").string();
+  sweep.exe = exe.empty() ? fs::read_symlink("/proc/self/exe").string() : exe;
+  if (!fs::exists(sweep.exe))
+    throw InputError("sweep: the pneufem binary that runs the points, " + sweep.exe + ", does not exist");
   sweep.command_line = command_line;
   const SweepResult r = run_sweep(sweep);
   if (sweep.dry_run) return 0;

@@ -21,8 +21,10 @@ struct SweepCommand {
 /// to `app`; --param and --model are validated at parse time.
 std::unique_ptr<SweepCommand> add_sweep_command(CLI::App& app);
 
-/// Runs a parsed sweep command (its workers are this executable) and prints a one-line summary;
-/// returns the exit code.
-int run_sweep_command(SweepCommand& c, const std::string& command_line);
+/// Runs a parsed sweep command and prints a one-line summary; returns the exit code. Its workers
+/// (local processes or SLURM tasks) run `exe`, by default this executable; the Python package
+/// gives the pneufem binary (its own executable is the interpreter). Throws InputError when `exe`
+/// does not exist.
+int run_sweep_command(SweepCommand& c, const std::string& command_line, const std::string& exe = "");
 
 }  // namespace pneufem

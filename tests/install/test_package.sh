@@ -12,10 +12,11 @@
 # CHOLMOD); the files (binary, example scenes, ParaView state, docs); `pneufem --version`; one small
 # simulation of the installed example scene; and, when the package holds the Python module,
 # `import pneufem` from the prefix.
-# Usage: test_package.sh BUILD_DIR VERSION
+# Usage: test_package.sh BUILD_DIR VERSION [WITH_PYTHON: 1 = the build has the Python module, so the package must]
 set -uo pipefail
 BUILD="$1"
 VERSION="$2"
+WITH_PYTHON="${3:-0}"
 T="$(mktemp -d "${TMPDIR:-/tmp}/pneufem_package.XXXXXX")"
 trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -61,7 +62,9 @@ if [ -n "$pydir" ]; then
   env -i PATH=/usr/bin:/bin PYTHONPATH="$site" /usr/bin/python3 -c "import pneufem; print(pneufem.__file__)" > py.log 2>&1 ||
     { cat py.log; fail "import pneufem from the package"; }
   grep -q "^$T/root" py.log || fail "import pneufem did not load the packaged module: $(cat py.log)"
+elif [ "$WITH_PYTHON" = 1 ]; then
+  fail "the build has the Python module (PNEUFEM_PYTHON) but the package holds none"
 else
-  echo "note: the package has no Python module (no python3 directory under /usr/lib); import not tested"
+  echo "note: this build has no Python module (PNEUFEM_PYTHON off); import not tested"
 fi
 echo "PASS: $(basename "$deb") unpacked with dpkg -x; --version and a simulation of the installed example ran"
