@@ -101,7 +101,9 @@ double deck_density(double rho_kg_m3, const std::string& length_unit);
 std::vector<double> abaqus_g(const std::vector<double>& gamma);
 
 /// The scene's K_over_mu of a deck's D1: 2 / (D1 mu0), as the shortest decimal whose abaqus_d1 is D1
-/// exactly (so the K_over_mu a deck was written from comes back: 100, not 99.99999999999999).
+/// exactly (so the K_over_mu a deck was written from comes back: 100, not 99.99999999999999). Exact for
+/// ratios of up to 15 significant digits: the ratios with one D1 span ~2 ulps, which holds no other
+/// decimal that short. A hand-written D1 that no ratio reproduces gives 2 / (D1 mu0).
 double k_over_mu_from_d1(double D1_per_MPa, double mu0_MPa);
 /// kg/m^3 of a deck density, the shortest decimal whose deck_density is the deck's number exactly.
 double density_from_deck(double rho_deck, const std::string& length_unit);
