@@ -138,7 +138,14 @@ std::vector<std::string> deck_notes(const DeckInfo& info, const Scene& s,
     return it != info.origins.end() && s.has(key) && origin_of(key) == it->second;
   };
   std::vector<std::string> used;  // the materials of the scene's parts
-  for (int i = 0; i < s.array_size("parts"); ++i) used.push_back(s.string("parts[" + std::to_string(i) + "].material"));
+  for (int i = 0; i < s.array_size("parts"); ++i) {
+    const std::string key = "parts[" + std::to_string(i) + "].material";
+    try {
+      used.push_back(s.string(key));
+    } catch (const InputError&) {
+      // a part without a material string: build_model names it
+    }
+  }
   for (const DeckInfo::Material& m : info.materials) {
     const std::string name = m.table.substr(std::string("materials.").size());
     const bool is_used = std::find(used.begin(), used.end(), name) != used.end();

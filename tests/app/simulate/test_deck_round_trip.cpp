@@ -8,7 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "scenes/build_model.h"
+#include "scenes/calculix_deck.h"
+#include "scenes/inp/deck.h"
+#include "scenes/inp/materials.h"
 #include "scenes/scene.h"
 #include "tests/app/cli_helpers.h"
 
@@ -95,6 +99,34 @@ TEST(DeckRoundTrip, AnExportedDeckReimportsToTheSameScene) {
   // summary.json records the notes.
   EXPECT_NE(test::slurp(d / "b" / "summary.json").find("materials.fabric from the deck (*MATERIAL FABRIC, "), std::string::npos);
   fs::remove_all(d);
+}
+
+// What the export writes besides: a material's stiffness_scale times its constants (K/mu unchanged, so
+// D1 follows mu0), fatigue named in a note (Abaqus has no keyword for it), a region's scale refused.
+TEST(DeckRoundTrip, TheExportScalesConstantsNamesWhatItCannotWriteAndRefusesRegionScales) {
+  const std::vector<std::string> small = {"geometry.chambers=2", "mesh.h_mm=6.0"};
+  std::vector<std::string> sets = small;
+  sets.insert(sets.end(), {"materials.silicone.stiffness_scale=0.5", "materials.silicone.fatigue.enabled=true"});
+  const Scene s = Scene::load("", sets);
+  std::vector<std::string> notes;
+  const std::string deck = calculix_deck(s, *build_model(s), &notes);
+  const std::string yeoh = "*HYPERELASTIC, YEOH\n" + inp_real_text(0.5 * 0.019) + ", " + inp_real_text(0.5 * 9.0e-4) + ", " +
+                           inp_real_text(0.5 * -4.75e-6) + ", " + inp_real_text(abaqus_d1(100.0, 2 * (0.5 * 0.019))) + ", 0, 0\n";
+  EXPECT_NE(deck.find(yeoh), std::string::npos) << deck.substr(deck.find("*MATERIAL"), 300);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("materials.silicone.fatigue is not written to the deck"), std::string::npos) << notes[0];
+  EXPECT_NE(deck.find("** pneufem: materials.silicone.fatigue is not written"), std::string::npos);
+  std::vector<std::string> region = small;
+  region.push_back("regions.roof.stiffness_scale=0.8");
+  const Scene r = Scene::load("", region);
+  try {
+    (void)calculix_deck(r, *build_model(r));
+    ADD_FAILURE() << "no error for a region's scale";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'regions.roof.stiffness_scale': the CalculiX export writes one material per"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
