@@ -448,6 +448,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   const MeshSettings::Source source = mesh_settings(s).source;
   InpDeck deck;
   model.mesh = read_model_mesh(s, source, deck, out->warnings);
+  out->warnings.insert(out->warnings.end(), s.notes().begin(), s.notes().end());  // a deck's materials
   Mesh& mesh = model.mesh;
   mesh.ensure_ids();
   const bool membrane_fabric = fabric_is_membrane(s);

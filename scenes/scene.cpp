@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "core/message_text.h"
 #include "core/number_text.h"
+#include "scenes/deck_materials.h"
 #include "scenes/default_scene_text.h"
 #include "scenes/effect_tables.h"
 #include "scenes/key_limits.h"
@@ -133,11 +134,128 @@ toml::table parse_text(const std::string& text, const std::string& origin) {
 
 }  // namespace
 
+// A scene is built from layers, later ones winning key by key: the default scene, a deck's materials
+// (mesh.source = "inp": scenes/deck_materials.h), the scene file, the overrides. The layers are kept
+// so that the table can be built again when an override changes which deck it is (Scene::with).
 struct Scene::Impl {
   toml::table table;
   std::string dir;
   Origins origins;  ///< where non-default values came from
+  std::string user_text, user_source;  ///< the scene file's text and name ("" = none)
+  std::vector<std::string> overrides;  ///< every override applied, in order
+  std::string deck_id;                 ///< the deck whose materials are a layer: "<path>|<unit>", "" = none
+  std::shared_ptr<const DeckInfo> deck;
+  std::vector<std::string> notes;      ///< deck_notes of the merged scene
 };
+
+namespace {
+
+const toml::table& default_table() {
+  static const toml::table t = parse_text(Scene::default_text(), kDefaultOrigin);
+  return t;
+}
+
+/// Applies one "key=value" override to `impl` (its table and origins).
+void apply_override(Scene::Impl& impl, const std::string& ov) {
+  const auto eq = ov.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(printable("--set " + ov + ": expected key=value, e.g. --set load.trials=10"));
+  const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
+  const std::string origin = "--set " + key;
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value, origin);
+  } catch (const toml::parse_error&) {
+    toml::table t;
+    t.insert("v", value);  // bare word: a string
+    parsed = t;
+  }
+  // Build {a = {b = {c = v}}} and merge it, after checking the key against the defaults.
+  std::vector<std::string> parts;
+  std::stringstream ks(key);
+  for (std::string p; std::getline(ks, p, '.');) parts.push_back(p);
+  toml::table nested;
+  parsed.get("v")->visit([&](auto&& node) { nested.insert_or_assign(parts.back(), node); });
+  for (int i = static_cast<int>(parts.size()) - 2; i >= 0; --i) {
+    toml::table outer;
+    outer.insert(parts[i], nested);
+    nested = outer;
+  }
+  try {
+    check_known(nested, default_table(), "");
+  } catch (const InputError&) {
+    // A key that exists in the current scene (e.g. a user-defined material) is fine too.
+    if (!impl.table.at_path(key)) throw;
+  }
+  Origins ignored;  // the nested copy lost its source; record the override itself
+  merge(impl.table, nested, "", ignored);
+  for (auto it = impl.origins.lower_bound(key + "."); it != impl.origins.end() && it->first.rfind(key + ".", 0) == 0;)
+    it = impl.origins.erase(it);
+  impl.origins[key] = origin;
+}
+
+/// The table of `impl`'s layers: the default scene, `deck` (or none), the scene file, the overrides.
+void build_table(Scene::Impl& impl, const DeckLayer* deck) {
+  impl.table = default_table();
+  impl.origins.clear();
+  if (deck) {
+    merge(impl.table, deck->table, "", impl.origins);
+    for (const auto& [key, where] : deck->info.origins) impl.origins[key] = where;
+  }
+  if (!impl.user_source.empty()) {
+    const toml::table user = parse_text(impl.user_text, impl.user_source);
+    check_known(user, default_table(), "");
+    merge(impl.table, user, "", impl.origins);
+  }
+  for (const std::string& ov : impl.overrides) apply_override(impl, ov);
+}
+
+/// "<path>|<unit>" of the deck whose materials the table's mesh keys ask for, or "" (no deck, or one
+/// build_model will report: a source other than "inp", no file, a file that is not there, an unknown
+/// unit).
+std::string deck_identity(const Scene::Impl& impl, std::string& path, std::string& unit) {
+  const toml::table& t = impl.table;
+  if (t.at_path("mesh.source").value<std::string>().value_or("") != "inp") return "";
+  const std::string file = t.at_path("mesh.file").value<std::string>().value_or("");
+  unit = t.at_path("mesh.length_unit").value<std::string>().value_or("");
+  if (file.empty() || (unit != "mm" && unit != "m")) return "";
+  std::filesystem::path p(file);
+  if (!p.is_absolute()) p = (std::filesystem::path(impl.dir) / p).lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec)) return "";
+  path = p.string();
+  return path + "|" + unit;
+}
+
+}  // namespace
+
+void Scene::settle_deck() {
+  Impl& impl = const_cast<Impl&>(*impl_);  // impl_ is this scene's own, not yet shared
+  std::string path, unit;
+  const std::string id = deck_identity(impl, path, unit);
+  if (id != impl.deck_id) {
+    if (id.empty()) {
+      build_table(impl, nullptr);
+      impl.deck.reset();
+    } else {
+      DeckDefaults defaults;
+      defaults.K_over_mu = *default_table().at_path("materials.silicone.K_over_mu").value<double>();
+      defaults.density_kg_m3 = *default_table().at_path("materials.silicone.density_kg_m3").value<double>();
+      const DeckLayer layer = deck_layer(path, unit, defaults);
+      build_table(impl, &layer);
+      impl.deck = std::make_shared<const DeckInfo>(layer.info);
+    }
+    impl.deck_id = id;
+  }
+  impl.notes.clear();
+  if (impl.deck)
+    impl.notes = deck_notes(*impl.deck, *this, [&impl](const std::string& key) {
+      const auto it = impl.origins.find(key);
+      return it == impl.origins.end() ? std::string() : it->second;
+    });
+}
+
+const std::vector<std::string>& Scene::notes() const { return impl_->notes; }
 
 const std::string& Scene::default_text() {
   static const std::string text = expand_effect_tables(kDefaultSceneText);  // the registry's effect tables
@@ -162,15 +280,13 @@ Scene Scene::from_text(const std::string& text, const std::string& source, const
 
 Scene Scene::parse(const std::string& text, const std::string& source, const std::string& dir) {
   auto impl = std::make_shared<Impl>();
-  impl->table = parse_text(default_text(), kDefaultOrigin);
-  if (!source.empty()) {
-    const toml::table user = parse_text(text, source);
-    check_known(user, impl->table, "");
-    merge(impl->table, user, "", impl->origins);
-  }
+  impl->user_text = source.empty() ? std::string() : text;
+  impl->user_source = source;
   impl->dir = dir;
+  build_table(*impl, nullptr);
   Scene s;
   s.impl_ = impl;
+  s.settle_deck();
   return s;
 }
 
@@ -178,46 +294,13 @@ Scene Scene::with(const std::vector<std::string>& overrides) const {
   if (overrides.empty()) return *this;
   auto impl = std::make_shared<Impl>(*impl_);
   for (const std::string& ov : overrides) {
-    const auto eq = ov.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(printable("--set " + ov + ": expected key=value, e.g. --set load.trials=10"));
-    const std::string key = ov.substr(0, eq), value = ov.substr(eq + 1);
-    const std::string origin = "--set " + key;
-    toml::table parsed;
-    try {
-      parsed = toml::parse("v = " + value, origin);
-    } catch (const toml::parse_error&) {
-      toml::table t;
-      t.insert("v", value);  // bare word: a string
-      parsed = t;
-    }
-    // Build {a = {b = {c = v}}} and merge it, after checking the key against the defaults.
-    std::vector<std::string> parts;
-    std::stringstream ks(key);
-    for (std::string p; std::getline(ks, p, '.');) parts.push_back(p);
-    toml::table nested;
-    parsed.get("v")->visit([&](auto&& node) { nested.insert_or_assign(parts.back(), node); });
-    for (int i = static_cast<int>(parts.size()) - 2; i >= 0; --i) {
-      toml::table outer;
-      outer.insert(parts[i], nested);
-      nested = outer;
-    }
-    toml::table defaults = parse_text(default_text(), kDefaultOrigin);
-    try {
-      check_known(nested, defaults, "");
-    } catch (const InputError&) {
-      // A key that exists in the current scene (e.g. a user-defined material) is fine too.
-      if (!impl->table.at_path(key)) throw;
-    }
-    Origins ignored;  // the nested copy lost its source; record the override itself
-    merge(impl->table, nested, "", ignored);
-    for (auto it = impl->origins.lower_bound(key + "."); it != impl->origins.end() && it->first.rfind(key + ".", 0) == 0;)
-      it = impl->origins.erase(it);
-    impl->origins[key] = origin;
+    apply_override(*impl, ov);
+    impl->overrides.push_back(ov);
   }
   Scene s;
   s.impl_ = impl;
   s.path_ = path_;
+  s.settle_deck();  // an override may name another deck, or override a deck's key
   return s;
 }
 

@@ -80,6 +80,13 @@ class Scene {
   /// A copy with more overrides applied (used by sweeps and diagnosis).
   Scene with(const std::vector<std::string>& overrides) const;
 
+  /// Notes on keys a run should say where they came from: the materials and parts taken from a deck
+  /// (mesh.source = "inp", scenes/deck_materials.h), and which of the deck's keys the scene overrides.
+  /// build_model adds them to its notes (simulate's summary.json "warnings"). Empty without a deck.
+  const std::vector<std::string>& notes() const;
+
+  struct Impl;  ///< (scene.cpp)
+
  private:
   /// `v`, read from `key` (`entry` names a list's element in the message), if it is finite and in
   /// the key's declared range; else a failure with the value and the range.
@@ -87,7 +94,10 @@ class Scene {
   /// The default scene merged with `text` (named `source`; "" = none), paths resolved from `dir`.
   static Scene parse(const std::string& text, const std::string& source, const std::string& dir);
 
-  struct Impl;
+  /// Builds the table again with the deck layer of its mesh keys when they name another deck than
+  /// the one it has, and refreshes notes(). Only on a scene whose impl_ is its own (parse, with).
+  void settle_deck();
+
   std::shared_ptr<const Impl> impl_;
   std::string path_;
 };

@@ -209,12 +209,14 @@ MaterialPtr make_material(const Scene& s, const std::string& name, double region
   std::size_t rank = 0;
   for (const MaterialEffect* fx : material_effects()) {
     ++rank;
+    // An effect's error names its table, and so where its constants were set (a deck's line, too).
+    const std::string K = T + "." + fx->name;
     if (fx->name == "mullins" && e.mullins)
-      layers.push_back({fx->order, rank, T, [p = *e.mullins](MaterialPtr b) { return make_mullins(std::move(b), p); }});
+      layers.push_back({fx->order, rank, K, [p = *e.mullins](MaterialPtr b) { return make_mullins(std::move(b), p); }});
     else if (fx->name == "fatigue" && e.fatigue)
-      layers.push_back({fx->order, rank, T, [p = *e.fatigue](MaterialPtr b) { return make_fatigue(std::move(b), p); }});
+      layers.push_back({fx->order, rank, K, [p = *e.fatigue](MaterialPtr b) { return make_fatigue(std::move(b), p); }});
     else if (fx->name == "viscoelastic" && e.viscoelastic)
-      layers.push_back({fx->order, rank, T, [p = *e.viscoelastic](MaterialPtr b) { return make_viscoelastic(std::move(b), p); }});
+      layers.push_back({fx->order, rank, K, [p = *e.viscoelastic](MaterialPtr b) { return make_viscoelastic(std::move(b), p); }});
     else if (!is_builtin_effect(fx->name))
       if (auto l = registered_layer(s, T, *fx, rank)) layers.push_back(std::move(*l));
   }

@@ -114,7 +114,9 @@ int run_mesh_command(const MeshCommand& c) {
   const Scene scene = mesh_command_scene(c);
   std::unique_ptr<BuiltModel> bm = build_model(scene);
   if (ext == ".inp") {
-    write_file_atomic(c.out, calculix_deck(scene, *bm));
+    std::vector<std::string> notes;
+    write_file_atomic(c.out, calculix_deck(scene, *bm, &notes));
+    bm->warnings.insert(bm->warnings.end(), notes.begin(), notes.end());
   } else {
     const Assembler asmb(bm->model);
     const Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs());

@@ -176,6 +176,7 @@ void require_checkpoint(const fs::path& dir, const std::string& name) {
 /// Quasi-static run of a scene with no outputs (the ideal model of the metrics).
 std::vector<StateRecord> records_of(const Scene& scene) {
   std::unique_ptr<BuiltModel> bm = build_model(scene);
+  for (const std::string& n : scene.notes()) std::fprintf(stderr, "note: %s\n", n.c_str());  // a deck's materials
   const Assembler asmb(bm->model);
   QuasiStaticRun run(asmb, bm->solver.quasi_static);
   std::vector<StateRecord> recs;
@@ -627,6 +628,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
 
   const auto t_build = std::chrono::steady_clock::now();
   std::unique_ptr<BuiltModel> bm = build_model(scene);
+  for (const std::string& n : scene.notes()) std::fprintf(stderr, "note: %s\n", n.c_str());  // a deck's materials
   const Assembler asmb(bm->model);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
   if (!opt.resume) start_fresh_run(dir, opt, scene, *bm);

@@ -35,8 +35,10 @@
 //        constants are the instantaneous or the long-term response of a viscoelastic material), with
 //        the *MATERIAL, NAME= above it, into InpDeck::moduli (build_model applies it to the scene's
 //        materials.<m>.viscoelastic.moduli); any other value is an error naming the line
-// Everything else (materials, sections, steps, outputs, amplitudes) is skipped with a warning:
-// the scene maps sets to materials. Ties, couplings, equations and contact (*TIE, *COUPLING,
+// Materials and *SOLID SECTION lines are read by a pass of their own (scenes/inp/materials.h), which a
+// scene makes into its materials and parts where it does not set them (scenes/deck_materials.h); this
+// reader passes over them without a note. Everything else (steps, outputs, amplitudes) is skipped
+// with a warning. Ties, couplings, equations and contact (*TIE, *COUPLING,
 // *MPC, *EQUATION, *CONTACT PAIR, ...) are ignored with a warning that says to merge the
 // instances in Abaqus (Merge/Cut Instances): pneufem needs one conforming mesh.
 // Not supported (an error says what to do): *INSTANCE imported from an earlier analysis
@@ -121,6 +123,10 @@ struct InpDeck {
 
 /// Reads a deck; `length_to_m` converts the deck's length unit to metres (1e-3 for mm).
 InpDeck read_inp(const std::string& path, double length_to_m);
+
+/// The shortest text that reads back to exactly `v`, if it fits CalculiX's 20-character real field;
+/// otherwise the most significant digits that fit (>= 14). How the writers put numbers in a deck.
+std::string inp_real_text(double v);
 
 /// Writes *NODE, *ELEMENT (grouped by region as ELSET=<region>), every node set, element set
 /// and surface (element-face form) of `mesh`, coordinates divided by `length_to_m`

@@ -25,6 +25,16 @@ bool constraint_keyword(const std::string& name) {
   return constraints.count(name) != 0;
 }
 
+/// Keywords read by the materials pass (scenes/inp/materials.h), which a scene runs over the same deck:
+/// no note that they are skipped here.
+bool material_pass_keyword(const std::string& name) {
+  static const std::set<std::string> material = {
+      "MATERIAL", "HYPERELASTIC", "ELASTIC", "DENSITY", "MULLINS EFFECT", "VISCOELASTIC", "SOLID SECTION",
+      "UNIAXIAL TEST DATA", "BIAXIAL TEST DATA", "PLANAR TEST DATA", "VOLUMETRIC TEST DATA", "SHEAR TEST DATA",
+      "SIMPLE SHEAR TEST DATA"};
+  return material.count(name) != 0;
+}
+
 // A C3D10 whose Jacobian falls below this fraction of its straight-sided tetrahedron's anywhere
 // (nodes, integration points) is refused: at 0 it folds over itself (a mid-node a quarter of its
 // edge off the midpoint, along the edge) and near 0 its stiffness and stresses are meaningless.
@@ -141,11 +151,11 @@ void DeckReader::begin_block(std::string_view text, const Loc& loc) {
                   ": its elements are read as a surface, without stiffness; to model them as the fabric set "
                   "mesh.fabric_model = \"membrane\" and mesh.fabric_surface = \"" + upper(kw.get("ELSET")) +
                   "\" (thickness geometry.fabric_thickness_mm, E and nu from [materials.fabric])");
-  else
+  else if (!material_pass_keyword(kw.name))
     warn_once("keyword " + kw.name, loc,
               "*" + kw.name +
-                  " skipped (only the mesh, sets, surfaces, *DLOAD Pn, *DSLOAD P and *BOUNDARY are read; "
-                  "materials and steps come from the scene)");
+                  " skipped (only the mesh, sets, surfaces, *DLOAD Pn, *DSLOAD P and *BOUNDARY are read here, the "
+                  "materials and *SOLID SECTION lines by a scene; steps, amplitudes and outputs come from the scene)");
 }
 
 // Abaqus: *HYPERELASTIC, MODULI=LONG TERM | INSTANTANEOUS (the default) says which response the

@@ -59,6 +59,8 @@ void write_id_lines(std::ostream& os, const std::vector<long>& ids) {
 
 }  // namespace
 
+std::string inp_real_text(double v) { return format_real(v); }
+
 void write_inp_mesh(std::ostream& os, const Mesh& mesh, double length_to_m) {
   if (!(length_to_m > 0.0) || !std::isfinite(length_to_m))
     throw InputError(printable("write_inp_mesh: length_to_m = " + std::to_string(length_to_m) +
