@@ -54,6 +54,7 @@ std::unique_ptr<CompareCommand> add_compare_command(CLI::App& app) {
 int run_compare_command(CompareCommand& c, const std::string& command_line) {
   c.options.command_line = command_line;
   c.options.progress = isatty(fileno(stderr));
+  c.options.progress_log_every_s = c.options.progress ? 0.0 : 60.0;  // a log gets a line a minute
   std::vector<std::string> sets = c.sets;
   if (!c.model.empty()) sets.push_back("solver.model=\"" + c.model + "\"");  // after --set: the option decides
   const Scene scene = Scene::load(c.scene_path, sets);

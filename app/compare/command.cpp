@@ -205,6 +205,7 @@ std::vector<RegionSensitivity> region_sensitivities(const Scene& scene, const Re
   DriveOptions dopt;
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
+  dopt.progress_log_every_s = opt.progress_log_every_s;
   dopt.cache_dir = opt.cache_dir;
   std::vector<RegionSensitivity> out;
   const double d_scale = opt.region_scale - 1.0;
@@ -259,6 +260,7 @@ CompareRunResult run_compare(const Scene& scene, const CompareRunOptions& opt) {
   DriveOptions dopt;
   dopt.threads = opt.threads;
   dopt.progress = opt.progress;
+  dopt.progress_log_every_s = opt.progress_log_every_s;
   dopt.vtu_dir = staging.string();
   dopt.cache_dir = opt.cache_dir;
   // A model the FEM cannot follow to the end (a limit point, failed walls) still gives the

@@ -66,7 +66,8 @@ struct CompareRunOptions {
   bool regions = false;      ///< region sensitivity (one simulation per region)
   double region_scale = 0.9; ///< stiffness scale of the perturbed region
   int threads = 0;
-  bool progress = false;
+  bool progress = false;             ///< a progress line redrawn in place (a terminal)
+  double progress_log_every_s = 0.0; ///< else a progress line every this many seconds (0 = none)
   std::string command_line;
   CompareOptions compare;
   /// The reduced model's cached offline part (solver.model = "reduced"; app/simulate/drive.h);

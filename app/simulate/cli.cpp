@@ -71,9 +71,12 @@ int run_simulate_command(SimulateCommand& c, const std::string& command_line) {
   opt.ideal_cache_dir = c.ideal_cache_dir;
   opt.cache_dir = c.cache_dir;
   opt.progress = isatty(fileno(stderr));
+  opt.progress_log_every_s = opt.progress ? 0.0 : 60.0;  // a log gets a line a minute
   opt.command_line = command_line;
   const Scene scene = opt.resume ? Scene::load("") : Scene::load(c.scene_path, c.sets);
   const RunResult r = run_simulation(scene, opt);
+  std::printf("%s", top_angles_text(r.records).c_str());
+  for (const std::string& w : r.warnings) std::printf("warning (also in summary.json): %s\n", w.c_str());
   std::printf("%zu states, %.1f s; results in %s (angles.csv, summary.json, results.pvd)\n", r.records.size(), r.wall_s,
               out_dir.c_str());
   return 0;

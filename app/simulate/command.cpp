@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/output_dir.h"
+#include "core/progress.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "damage/registry.h"
@@ -100,21 +101,33 @@ std::vector<std::string> ideal_overrides(const Scene& scene, bool& any_effect) {
   return sets;
 }
 
+/// The run's progress on stderr (core/progress.h): the share of the load's physical time reported
+/// so far, with the trial, pressure and angle of the last report.
 class ProgressLine {
  public:
-  explicit ProgressLine(bool on) : on_(on) {}
-  void update(const StateRecord& r, int trials, const char* what) {
-    if (!on_) return;
-    std::fprintf(stderr, "\r  %s trial %d/%d  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", what, r.trial, trials,
-                 r.time_s, r.pressure_Pa * 1e-3, r.angle_deg);
-    std::fflush(stderr);
+  ProgressLine(const RunOptions& opt, const LoadHistory& load)
+      : meter_("simulate", opt.progress                     ? ProgressMeter::Mode::Terminal
+                           : opt.progress_log_every_s > 0.0 ? ProgressMeter::Mode::Log
+                                                            : ProgressMeter::Mode::Off,
+               opt.progress_log_every_s),
+        trials_(static_cast<int>(load.trials.size())) {
+    for (const TrialLoad& t : load.trials) total_s_ += t.duration();
+    if (trials_ > 1) total_s_ += (trials_ - 1) * load.rest_between_trials_s;
   }
-  void done() {
-    if (on_) std::fprintf(stderr, "\n");
+  void update(const StateRecord& r) {
+    char d[160];
+    std::snprintf(d, sizeof d, "trial %d/%d, t = %.1f s, %.1f kPa, %.2f deg", r.trial, trials_, r.time_s, r.pressure_Pa * 1e-3,
+                  r.angle_deg);
+    meter_.update(total_s_ > 0.0 ? r.global_time_s / total_s_ : 0.0, d);
   }
+  /// A line of its own (a stage, a fallback), in both the terminal's and the log's mode.
+  void message(const std::string& text) { meter_.message(text); }
+  void done() { meter_.done(); }
 
  private:
-  bool on_;
+  ProgressMeter meter_;
+  int trials_ = 0;
+  double total_s_ = 0.0;
 };
 
 // Application part of a checkpoint: the reports so far and the VTU series.
@@ -312,7 +325,7 @@ class RunRecorder {
   RunRecorder(const fs::path& dir, const BuiltModel& bm, const Assembler& asmb, const RunOptions& opt,
               const RunIdentity& identity, ProgressLine& progress, const std::string& resume_body)
       : dir_(dir), bm_(bm), asmb_(asmb), opt_(opt), identity_(identity), progress_(progress),
-        ntrials_(static_cast<int>(bm.load.trials.size())), want_vtu_(bm.output.vtu != "none"),
+        want_vtu_(bm.output.vtu != "none"),
         pvd_((dir / "results.pvd").string()) {
     if (want_vtu_) fs::create_directories(dir / "vtu");
     if (opt.resume) {
@@ -362,7 +375,7 @@ class RunRecorder {
       pvd_.add(r.global_time_s, name);
       app_.vtu.emplace_back(r.global_time_s, name);
     }
-    progress_.update(r, ntrials_, "");
+    progress_.update(r);
   }
 
   void checkpoint(const QuasiStaticCheckpoint& c) {
@@ -383,7 +396,6 @@ class RunRecorder {
   const RunOptions& opt_;
   const RunIdentity& identity_;
   ProgressLine& progress_;
-  const int ntrials_;
   const bool want_vtu_;
   PvdSeries pvd_;
   AppCheckpoint app_;
@@ -401,10 +413,8 @@ bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& r
   ReducedRunResult rr;
   try {
     rr = run_reduced(setup, bm, rec.observer(), true, [&](const ReducedRunResult::Enrichment& e) {
-      progress.done();
-      if (opt.progress)
-        std::fprintf(stderr, "  reduced model: %s; the basis takes the %d corrected states (%d modes) and runs again\n",
-                     e.why.c_str(), e.snapshots, e.modes);
+      progress.message("  reduced model: " + e.why + "; the basis takes the " + std::to_string(e.snapshots) +
+                       " corrected states (" + std::to_string(e.modes) + " modes) and runs again");
       rec.restart();  // the next run's reports and VTU files replace these
     });
   } catch (const ReducedRunFailed& e) {
@@ -420,8 +430,7 @@ bool run_reduced_model(const ReducedSetup& setup, BuiltModel& bm, RunRecorder& r
       !why.empty()) {
     fallback = "full FEM: " + why;
     bm.warnings.push_back(fallback);
-    progress.done();
-    if (opt.progress) std::fprintf(stderr, "  %s\n", fallback.c_str());
+    progress.message("  " + fallback);
     rec.restart();  // the FEM's reports and VTU files replace the reduced ones
   } else {
     full = false;
@@ -617,6 +626,30 @@ std::string write_metrics(const fs::path& dir, const BuiltModel& bm, const std::
 
 }  // namespace
 
+std::string top_angles_text(const std::vector<StateRecord>& records) {
+  double p_top = -1.0;
+  for (const StateRecord& r : records) p_top = std::max(p_top, r.pressure_Pa);
+  if (records.empty()) return "";
+  std::vector<const StateRecord*> last;  // per trial, its last report at p_top
+  for (const StateRecord& r : records) {
+    if (r.pressure_Pa != p_top) continue;
+    if (!last.empty() && last.back()->trial == r.trial) last.back() = &r;
+    else last.push_back(&r);
+  }
+  char b[96];
+  std::snprintf(b, sizeof b, "angle at the top pressure, %.1f kPa (the last report there):", p_top * 1e-3);
+  std::string s = b;
+  bool any_extrapolated = false;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    std::snprintf(b, sizeof b, "%s trial %d %.2f deg%s", i ? "," : "", last[i]->trial, last[i]->angle_deg,
+                  last[i]->extrapolated ? "*" : "");
+    s += b;
+    any_extrapolated = any_extrapolated || last[i]->extrapolated;
+  }
+  if (any_extrapolated) s += " (* extrapolated by a cycle jump)";
+  return s + "\n";
+}
+
 RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   const auto wall0 = std::chrono::steady_clock::now();
   const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
@@ -645,7 +678,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
   }
 
   RunResult result;
-  ProgressLine progress(opt.progress);
+  ProgressLine progress(opt, bm->load);
   std::exception_ptr failure;
   const IdealModel ideal = ideal_model(scene, opt, dir, *bm, rsetup.get());
   RunRecorder recorder(dir, *bm, asmb, opt, identity, progress, resume_body);
@@ -694,6 +727,7 @@ RunResult run_simulation(const Scene& scene_arg, const RunOptions& opt) {
       .add("states_reported", static_cast<double>(records.size()))
       .add("scene", scene.to_json());
   write_file_atomic((dir / "summary.json").string(), summary.str() + "\n");
+  result.warnings = bm->warnings;
   if (failure) std::rethrow_exception(failure);
   return result;
 }

@@ -27,7 +27,10 @@ namespace pneufem {
 struct RunOptions {
   std::string out_dir;
   int threads = 0;                     ///< 0 = all cores
-  bool progress = false;               ///< print a progress line (terminal)
+  bool progress = false;               ///< a progress line redrawn in place, and the stages (a terminal)
+  /// Not on a terminal: a progress line (share done, elapsed, estimate left) every this many
+  /// seconds of wall time, and the stages; 0 = none (core/progress.h).
+  double progress_log_every_s = 0.0;
   std::string command_line;
   bool resume = false;                 ///< continue the run in out_dir from its checkpoint
   double checkpoint_every_s = 30.0;    ///< wall-clock seconds between checkpoints (0 = every segment)
@@ -44,6 +47,7 @@ struct RunResult {
   std::vector<StateRecord> records;
   std::string status = "ok";  ///< "ok" or the error message
   double wall_s = 0.0;
+  std::vector<std::string> warnings;  ///< summary.json's, to print at the end
 };
 
 /// Runs the scene and writes the run directory. Physics failures are recorded in summary.json
@@ -51,5 +55,10 @@ struct RunResult {
 /// scene argument is ignored and out_dir/scene.toml is used; a missing, damaged or foreign
 /// checkpoint (another scene, mesh, protocol or build) is an InputError before any work.
 RunResult run_simulation(const Scene& scene, const RunOptions& options);
+
+/// What a run found, in one line for the console: the angle at the largest reported pressure (its
+/// last report there in each trial: the end of the top hold on a staircase), per trial, with
+/// trials a cycle jump extrapolated marked "*". "" when nothing was reported.
+std::string top_angles_text(const std::vector<StateRecord>& records);
 
 }  // namespace pneufem

@@ -17,6 +17,7 @@
 #include "analysis/steps.h"
 #include "app/simulate/reduced.h"
 #include "core/errors.h"
+#include "core/progress.h"
 #include "engine/assembly.h"
 #include "engine/quasi_static.h"
 #include "scenes/build_model.h"
@@ -371,6 +372,13 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
 
   result.trials.resize(rec.trials.size());
   for (std::size_t k = 0; k < rec.trials.size(); ++k) result.trials[k].trial = rec.trials[k].trial;
+  // Progress (core/progress.h): the share of the recording's time solved.
+  ProgressMeter progress(opt.progress_label, opt.progress                     ? ProgressMeter::Mode::Terminal
+                                             : opt.progress_log_every_s > 0.0 ? ProgressMeter::Mode::Log
+                                                                              : ProgressMeter::Mode::Off,
+                         opt.progress_log_every_s);
+  std::vector<double> before(load.trials.size() + 1, 0.0);  // the recording's time before each trial
+  for (std::size_t k = 0; k < load.trials.size(); ++k) before[k + 1] = before[k] + load.trials[k].duration();
   auto observe = [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
     const std::size_t k = static_cast<std::size_t>(r.trial - 1);
     TrialTrace& tt = result.trials[k];
@@ -379,9 +387,12 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     tt.states_angle_deg.value.push_back(r.angle_deg);
     tt.states_pressure_kPa.t_s.push_back(t);
     tt.states_pressure_kPa.value.push_back(r.pressure_Pa * 1e-3);
-    if (opt.progress)
-      std::fprintf(stderr, "\r  trial %d (%zu/%zu)  t = %7.2f s  p = %6.2f kPa  angle = %8.2f deg   ", tt.trial, k + 1,
-                   rec.trials.size(), t, r.pressure_Pa * 1e-3, r.angle_deg);
+    if (progress.mode() != ProgressMeter::Mode::Off) {
+      char d[160];
+      std::snprintf(d, sizeof d, "trial %d (%zu/%zu), t = %.1f s, %.1f kPa, %.2f deg", tt.trial, k + 1, rec.trials.size(), t,
+                    r.pressure_Pa * 1e-3, r.angle_deg);
+      progress.update(before.back() > 0.0 ? (before[k] + r.time_s) / before.back() : 0.0, d);
+    }
     if (!want_vtu || u.size() == 0) return;  // an unchecked reduced run has no full fields
     const double meas = value_at(measured[k], t);
     if (!std::isfinite(meas)) return;
@@ -405,7 +416,7 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     if (!fallback.empty()) {
       clear_traces();
       result.model = "full (fallback: " + fallback + ")";
-      if (opt.progress) std::fprintf(stderr, "\n  %s\n", result.model.c_str());
+      progress.message("  " + result.model);
     }
     if (!reduced || !fallback.empty()) {
       // A recording is compared frame by frame and its measured trials differ: every trial is solved.
@@ -429,7 +440,7 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     const Series& solved = result.trials[failed_trial].states_angle_deg;
     result.failure_time_s = solved.t_s.empty() ? 0.0 : solved.t_s.back();
   }
-  if (opt.progress) std::fprintf(stderr, "\n");
+  progress.done();
   result.mesh = bm->stats;
 
   for (std::size_t k = 0; k < rec.trials.size(); ++k) {

@@ -55,7 +55,10 @@ struct DriveOptions {
   double median_window_s = 0.05;        ///< running-median window of the pressure (20 samples at 400 Hz)
   double max_report_gap_s = 0.25;       ///< solved states at least this dense (see above)
   int threads = 0;                      ///< 0 = all cores
-  bool progress = false;                ///< progress line on stderr
+  bool progress = false;                ///< progress line on stderr, redrawn in place (a terminal)
+  /// Not on a terminal: a progress line every this many seconds of wall time (0 = none; core/progress.h).
+  double progress_log_every_s = 0.0;
+  std::string progress_label = "compare";  ///< the progress line's first word
   std::string vtu_dir;                  ///< "" = no files; else VTU of the `vtu_worst` worst states
   int vtu_worst = 3;                    ///< states with the largest |model - measured| angle
   /// On a PhysicsError (e.g. the actuator past its limit point): false = rethrow; true = return

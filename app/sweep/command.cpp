@@ -30,6 +30,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/output_dir.h"
+#include "core/progress.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "scenes/build_model.h"
@@ -1002,6 +1003,7 @@ void run_queue(const SweepOptions& o, const WorkerSetup& setup, const ModelPlan&
   }
   int finished = result.skipped;
   const int total = static_cast<int>(result.points.size());
+  const auto t_start = std::chrono::steady_clock::now();
   const auto point_finished = [&](const Worker& w, int exit_code, double measured_s) {
     SweepPoint& pt = result.points[w.i];
     read_point(pt, w.dir, exit_code, measured_s);
@@ -1009,7 +1011,12 @@ void run_queue(const SweepOptions& o, const WorkerSetup& setup, const ModelPlan&
     ++finished;
     char head[64];
     std::snprintf(head, sizeof head, "[%d/%d] ", finished, total);
-    say(o.log, head + outcome_line(params, pt, plan.reduced));
+    // Elapsed and an estimate of the time left from the points this call ran (core/progress.h).
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    const int ran = finished - result.skipped, left = total - finished;
+    std::string pace = "; elapsed " + duration_text(elapsed);
+    if (left > 0 && ran > 0) pace += ", ~" + duration_text(elapsed * left / ran) + " left";
+    say(o.log, head + outcome_line(params, pt, plan.reduced) + pace);
     write_file_atomic(csv.string(), sweep_csv(params, result.points));
   };
   run_workers(first, jobs, point_finished);

@@ -1,5 +1,7 @@
 #include "app/synth/cli.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 
 namespace pneufem {
@@ -46,6 +48,8 @@ std::unique_ptr<SynthCommand> add_synth_command(CLI::App& app) {
 int run_synth_command(SynthCommand& c, const std::string& command_line) {
   c.options.hidden = parse_hidden(c.hidden);
   c.options.command_line = command_line;
+  c.options.progress = isatty(fileno(stderr));
+  c.options.progress_log_every_s = c.options.progress ? 0.0 : 60.0;  // a log gets a line a minute
   const SynthResult r = run_synth(c.options);
   std::printf("synth: %zu trial(s), %ld model states, %d outlier frames, %.1f s; wrote %s (+ .truth.csv, .truth.json)\n",
               r.data.trials.size(), r.states, r.outliers, r.wall_s, c.options.out_csv.c_str());

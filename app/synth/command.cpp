@@ -15,6 +15,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/output_dir.h"
+#include "core/progress.h"
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "engine/assembly.h"
@@ -320,13 +321,22 @@ struct ModelAngles {
   std::vector<std::vector<double>> t_s, angle_deg;
 };
 
-ModelAngles solve_angles(const BuiltModel& bm, const LoadHistory& chamber, SynthResult& res) {
+ModelAngles solve_angles(const BuiltModel& bm, const LoadHistory& chamber, const SynthOptions& o, SynthResult& res) {
   ModelAngles m{std::vector<std::vector<double>>(chamber.trials.size()), std::vector<std::vector<double>>(chamber.trials.size())};
   const Assembler asmb(bm.model);
   QuasiStaticRun run(asmb, bm.solver.quasi_static);
+  ProgressMeter progress("synth", o.progress                     ? ProgressMeter::Mode::Terminal
+                                  : o.progress_log_every_s > 0.0 ? ProgressMeter::Mode::Log
+                                                                 : ProgressMeter::Mode::Off,
+                         o.progress_log_every_s);
+  std::vector<double> before(chamber.trials.size() + 1, 0.0);  // the protocol's time before each trial
+  for (std::size_t k = 0; k < chamber.trials.size(); ++k) before[k + 1] = before[k] + chamber.trials[k].duration();
   run.run(chamber, [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
     m.t_s[r.trial - 1].push_back(r.time_s);
     m.angle_deg[r.trial - 1].push_back(r.angle_deg);
+    char d[96];
+    std::snprintf(d, sizeof d, "trial %d/%zu, %.1f kPa, %.2f deg", r.trial, chamber.trials.size(), r.pressure_Pa * 1e-3, r.angle_deg);
+    progress.update(before.back() > 0.0 ? (before[static_cast<std::size_t>(r.trial - 1)] + r.time_s) / before.back() : 0.0, d);
   });
   res.states = run.stats().states;
   return m;
@@ -413,7 +423,7 @@ SynthResult run_synth(const SynthOptions& o) {
   const LoadHistory commanded = inlet_load(h.scene);
   const ControllerInlet ci = controller_inlet(commanded, o);
   const LoadHistory chamber = chamber_history(h.scene, commanded, ci.inlet, o);
-  const ModelAngles m = solve_angles(*bm, chamber, res);
+  const ModelAngles m = solve_angles(*bm, chamber, o, res);
   for (std::size_t k = 0; k < chamber.trials.size(); ++k) sample_trial(k, chamber.trials[k].duration(), ci, m, o, res);
   write_outputs(o, h, res, wall0);
   return res;

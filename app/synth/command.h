@@ -55,6 +55,8 @@ struct SynthOptions {
   double report_every_s = 0.25;        ///< densest spacing of solved states during holds
   double inlet_tolerance_kPa = 0.05;   ///< piecewise-linear fit of the inlet driving the model: half the
                                        ///< sensor's 1-sigma noise, 1 % of a 5 kPa step
+  bool progress = false;               ///< a progress line redrawn in place (a terminal; core/progress.h)
+  double progress_log_every_s = 0.0;   ///< else a progress line every this many seconds (0 = none)
   std::string command_line;
 };
 

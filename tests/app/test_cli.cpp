@@ -38,6 +38,13 @@ TEST(Cli, SimulateTinySceneWritesAllOutputs) {
   EXPECT_EQ(angles.rfind("trial,time_s,pressure_kPa,angle_deg\n", 0), 0u);
   // 2 levels (0, 5 kPa) x (2.5 s mark + end of hold) = 4 rows + header
   EXPECT_EQ(std::count(angles.begin(), angles.end(), '\n'), 5);
+  // The console says what the run found (issue 31 item 4): the angle at the top pressure, the
+  // last row of angles.csv, to two decimals.
+  const std::string last_row = angles.substr(angles.rfind('\n', angles.size() - 2) + 1);
+  char expect[96];
+  std::snprintf(expect, sizeof expect, "angle at the top pressure, 5.0 kPa (the last report there): trial 1 %.2f deg",
+                std::stod(last_row.substr(last_row.rfind(',') + 1)));
+  EXPECT_NE(r.out.find(expect), std::string::npos) << r.out;
   const std::string summary = slurp(d / "summary.json");
   for (const char* key : {"\"pneufem_version\"", "\"status\": \"ok\"", "\"mesh\"", "\"nodes\"", "\"solver\"", "\"timings\"",
                           "\"scene\"", "\"elements_per_region\""})
