@@ -14,6 +14,13 @@
 #                                                 PNEUFEM_DEB_DEPENDS below for what it needs at run time)
 # The package's library dependencies are found by dpkg-shlibdeps from the binary (libtbb12,
 # libvtk9.1, libopenvdb10.0, libcholmod3, ...); PNEUFEM_DEB_DEPENDS adds those it cannot see.
+# What the package holds that a build must make first: `./scripts/build.sh packaged` builds them
+# (the main job builds the executable alone, and cpack does not build).
+add_custom_target(packaged)
+add_dependencies(packaged pneufem)
+if(TARGET pneufem_python)
+  add_dependencies(packaged pneufem_python)
+endif()
 install(TARGETS pneufem RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/examples/ DESTINATION ${CMAKE_INSTALL_DATADIR}/pneufem/examples
         FILES_MATCHING PATTERN "*.toml")
