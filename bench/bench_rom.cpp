@@ -3,12 +3,17 @@
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--dump-points]
+//             [--galerkin-theta] [--fabric-strain]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --corrected reports|tops adds the
 // corrected history's estimate (ReplayOptions), corrected at every loaded report or at the top
 // level's reports only (as simulate's check); --dump-points runs the FEM beside
-// the reduced model and compares damage and largest stretch at the kept points at every trial's end.
+// the reduced model and compares damage and largest stretch at the kept points at every trial's end;
+// --galerkin-theta tests the theta row with the path tangent (RomBasisOptions::galerkin_theta_row);
+// --fabric-strain prints, per report, the stiff parts' largest Green and small strain of the reduced
+// state and of the FEM snapshot at the same report, and the reduced coordinates (theta, |q|, the
+// gauge multiplier lambda).
 // Prints the offline cost (elastic trace, basis), the online cost (states, Newton iterations,
 // wall), and with --fem the FEM's record and the differences: every report angle, and the paper's
 // NRMSE per trial against the ideal elastic model, for both. --work DIR keeps the elastic trace
@@ -105,7 +110,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
-  bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false;
+  bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
   std::string save_corrected, extra_snapshots;
   int threads = 0;
@@ -126,6 +131,7 @@ int main(int argc, char** argv) {
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
     else if (a == "--dump-points") dump = true;  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
+    else if (a == "--fabric-strain") fabric_strain = true;  // largest Green strain of the stiff parts per report, ROM vs the snapshot
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
     else if (a == "--clusters") ro.clusters = std::stoi(next());
@@ -133,6 +139,7 @@ int main(int argc, char** argv) {
     else if (a == "--ecsw-tol") ro.ecsw_tolerance = std::stod(next());
     else if (a == "--pod-tol") ro.pod_tolerance = std::stod(next());
     else if (a == "--no-hyper") ro.hyper_reduce = false;
+    else if (a == "--galerkin-theta") ro.galerkin_theta_row = true;  // the theta row tested with the path tangent
     else if (a == "--softened") ro.softened_levels = std::stoi(next());  // softened equilibria as snapshots (levels)
     else if (a == "--softened-max") ro.softened_max = std::stod(next());
     else if (a[0] != '-') scene_path = a;
@@ -229,6 +236,7 @@ int main(int argc, char** argv) {
     std::string snap_key;
     for (const std::string& s : snap_sets) snap_key += s + ";";
     if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
+    if (ro.galerkin_theta_row) snap_key += "galerkin-theta";
     const fs::path f = fs::path(work) / ("basis_" + std::to_string(fnv(ref_scene.model_toml() + opts + snap_key)) + ".bin");
     std::vector<double> d;
     if (read_doubles(f, d)) {
@@ -276,11 +284,13 @@ int main(int argc, char** argv) {
   const auto t_on = Clock::now();
   const ReducedOrderModel rom(ref->model, basis, bm->model);
   ReducedRun run(rom, bm->solver.quasi_static);
-  std::vector<Eigen::VectorXd> rom_u;
+  std::vector<Eigen::VectorXd> rom_u, strain_u;
+  std::vector<double> strain_lambda, strain_q, strain_theta;
   std::vector<std::vector<double>> rom_h;
   try {
     run.run(bm->load, [&](const StateRecord& r, const ReducedCoordinates& z, const Eigen::VectorXd& u) {
       if (dump) rom_u.push_back(u), rom_h.push_back(rom.history_scalars(run.history()));
+      if (fabric_strain) strain_u.push_back(u), strain_lambda.push_back(z.lambda), strain_q.push_back(z.q.norm()), strain_theta.push_back(z.theta);
       red.trial.push_back(r.trial);
       red.t.push_back(r.time_s);
       red.p.push_back(r.pressure_Pa);
@@ -454,6 +464,34 @@ int main(int argc, char** argv) {
       }
       std::printf("FEM: %.1f s wall, %ld states\n", since(t0), q.stats().states);
     }
+  }
+  if (fabric_strain) {
+    // The stiff parts' (fabric's) largest Green strain, from each element's corner nodes (the linear
+    // part of its F): where the reduced model keeps the fabric linear in q, a state that stretches it
+    // is not charged for the stretch's second order.
+    const Mesh& mesh = bm->model.mesh;
+    auto largest = [&](const Eigen::VectorXd& u, bool linear) {
+      double worst = 0.0;
+      for (int e = 0; e < mesh.num_elements(); ++e) {
+        if (!basis.stiff_part.empty() && !basis.stiff_part[static_cast<std::size_t>(bm->model.element_part[static_cast<std::size_t>(e)])]) continue;
+        const int* n = mesh.element(e);
+        Eigen::Matrix3d dX, dx;
+        for (int c = 0; c < 3; ++c) {
+          dX.col(c) = mesh.X[n[c + 1]] - mesh.X[n[0]];
+          dx.col(c) = dX.col(c) + u.segment<3>(3 * n[c + 1]) - u.segment<3>(3 * n[0]);
+        }
+        const Eigen::Matrix3d F = dx * dX.inverse();
+        const Eigen::Matrix3d H = F - Eigen::Matrix3d::Identity();
+        const Eigen::Matrix3d E = linear ? Eigen::Matrix3d(0.5 * (H + H.transpose())) : Eigen::Matrix3d(0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity()));
+        worst = std::max(worst, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E).eigenvalues().cwiseAbs().maxCoeff());
+      }
+      return worst;
+    };
+    std::printf("stiff parts' largest Green strain per report (trial, t, rom, snapshot; then the small strain's, rom, snapshot):\n");
+    for (std::size_t i = 0; i < strain_u.size(); ++i)
+      std::printf("  %d %7.2f %.3e %.3e   %.3e %.3e   theta %8.3f |q| %.3e lambda %+.3e\n", red.trial[i], red.t[i], largest(strain_u[i], false),
+                  i < snapshots.size() ? largest(snapshots[i], false) : std::nan(""), largest(strain_u[i], true),
+                  i < snapshots.size() ? largest(snapshots[i], true) : std::nan(""), strain_theta[i], strain_q[i], strain_lambda[i]);
   }
   // 5. Comparison.
   const std::size_t n = std::min(red.angle.size(), full.angle.size());

@@ -117,6 +117,11 @@ struct RomBasisOptions {
   /// softening levels per field and mode sample.
   int softened_levels = 0;
   double softened_max = 0.9;      ///< the largest isochoric softening of the most strained element
+  /// The theta row's test vector (see the header): the bending angle's influence vector (Petrov-
+  /// Galerkin, the default) or the path tangent u_el' / V' (Galerkin). For experiments: with a basis
+  /// rich in damaged shapes the Petrov-Galerkin row can admit a spurious root that the Galerkin row
+  /// does not, at the price of the Galerkin row's bias on softening (bench/results/rom_h6_ceiling).
+  bool galerkin_theta_row = false;
   bool verbose = false;
 };
 

@@ -591,7 +591,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
       SparseMatrix Kc = KT;
       A.apply_constraints(Kc, 1.0);
       LinearSolver ls;
-      if (ls.factorize(Kc)) {
+      if (!opt.galerkin_theta_row && ls.factorize(Kc)) {
         Eigen::VectorXd a = ls.solve(ga);
         A.zero_fixed(a);
         const double ag = a.dot(g);
