@@ -383,8 +383,9 @@ LoadHistory chamber_load(const Scene& s) {
   // First order, or second (load.pressure_lag2_s > 0) with the same tolerance.
   const PressureLag lag = scene_pressure_lag(s);
   if (lag.on()) {
-    const bool staircase = load_settings(s).protocol == LoadSettings::Protocol::Staircase;
-    load = apply_pressure_lag(load, lag, staircase ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+    const LoadSettings settings = load_settings(s);
+    const bool staircase = settings.protocol == LoadSettings::Protocol::Staircase;
+    load = apply_pressure_lag(load, lag, staircase ? 0.005 * settings.step_Pa : 0.05 * kkPa);
   }
   return load;
 }
@@ -404,9 +405,9 @@ LoadHistory inlet_load(const Scene& s) {
   LoadHistory load;
   const LoadSettings settings = load_settings(s);
   if (settings.protocol == LoadSettings::Protocol::Staircase) {
-    const double p_max = s.number("load.max_kPa") * kkPa, dp = s.number("load.step_kPa") * kkPa;
-    const double hold_s = s.number("load.hold_s"), every_s = s.number("load.output_every_s");
-    const int trials = s.integer("load.trials");
+    const double p_max = settings.max_Pa, dp = settings.step_Pa;
+    const double hold_s = settings.hold_s, every_s = settings.output_every_s;
+    const int trials = settings.trials;
     // The size first, so that the key and where it was set are named (staircase() checks it too).
     const StaircaseSize size = staircase_size(p_max, dp, hold_s, trials, every_s);
     if (size.levels > kMaxStaircaseLevels)
@@ -421,7 +422,7 @@ LoadHistory inlet_load(const Scene& s) {
                  "; report less often (load.output_every_s) or run fewer trials");
     // The keys that must agree with each other, with where they were set (staircase() checks them
     // too, but knows no scene).
-    const double ramp_s = s.number("load.ramp_s"), mark_s = s.number("load.mark_s");
+    const double ramp_s = settings.ramp_s, mark_s = settings.mark_s;
     if (!(ramp_s < hold_s))
       s.fail("load.ramp_s", "got " + short_num(ramp_s) + "; it must be shorter than load.hold_s = " + short_num(hold_s));
     if (!(mark_s >= ramp_s && mark_s <= hold_s))
@@ -429,10 +430,10 @@ LoadHistory inlet_load(const Scene& s) {
                                 "load.ramp_s = " + short_num(ramp_s) + " to load.hold_s = " + short_num(hold_s) + " s");
     load = staircase(p_max, dp, hold_s, ramp_s, trials, mark_s, settings.rest_s, every_s);
   } else {  // LoadSettings::Protocol::Csv
-    const std::string csv = s.string("load.csv");
+    const std::string& csv = settings.csv;
     if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
     try {
-      load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+      load = pressure_history_from_csv(s.resolve_path(csv), 0.25, settings.output_every_s);
     } catch (const InputError& e) {
       if (std::string(e.what()).find("load.output_every_s") == std::string::npos) throw;
       s.fail("load.output_every_s", e.what());

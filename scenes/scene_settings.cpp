@@ -24,6 +24,14 @@ LoadSettings load_settings(const Scene& s) {
   l.protocol = choice<LoadSettings::Protocol>(s, "load.protocol", {{"staircase", LoadSettings::Protocol::Staircase},
                                                                    {"csv", LoadSettings::Protocol::Csv}});
   l.rest_s = s.number("load.rest_s");
+  l.output_every_s = s.number("load.output_every_s");
+  l.max_Pa = s.number("load.max_kPa") * kkPa;
+  l.step_Pa = s.number("load.step_kPa") * kkPa;
+  l.hold_s = s.number("load.hold_s");
+  l.ramp_s = s.number("load.ramp_s");
+  l.mark_s = s.number("load.mark_s");
+  l.trials = s.integer("load.trials");
+  l.csv = s.string("load.csv");
   return l;
 }
 

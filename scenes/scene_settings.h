@@ -24,12 +24,23 @@ struct MeshSettings {
 /// The [mesh] settings above. Fails naming mesh.source for an unknown source.
 MeshSettings mesh_settings(const Scene& scene);
 
-/// [load]: the protocol of the pressure history (its levels and times are read into the
-/// LoadHistory by inlet_load, scenes/build_model.h).
+/// [load]: the protocol of the pressure history, pressures in Pa. inlet_load (scenes/build_model.h)
+/// builds the LoadHistory from it and checks the keys that must agree with each other (ramp, mark
+/// and hold; the protocol's size), naming the key.
 struct LoadSettings {
   enum class Protocol { Staircase, Csv };
   Protocol protocol = Protocol::Staircase;  ///< load.protocol: "staircase" or "csv" (load.csv)
   double rest_s = 0.0;                      ///< load.rest_s: rest between trials (s)
+  double output_every_s = 0.0;              ///< load.output_every_s: extra reports inside each hold (0 = none)
+  // The staircase (protocol = "staircase"):
+  double max_Pa = 0.0;   ///< load.max_kPa: the top level
+  double step_Pa = 0.0;  ///< load.step_kPa: the step between levels
+  double hold_s = 0.0;   ///< load.hold_s: each level's hold
+  double ramp_s = 0.0;   ///< load.ramp_s: the controller's time to reach a level
+  double mark_s = 0.0;   ///< load.mark_s: the mark after each step's start (the paper's 2.5 s)
+  int trials = 1;        ///< load.trials
+  // protocol = "csv":
+  std::string csv;       ///< load.csv as written (Scene::resolve_path makes it a path)
 };
 
 /// The [load] settings above. Fails naming load.protocol for an unknown protocol.

@@ -3,6 +3,7 @@
 #include "scenes/scene_settings.h"
 
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -83,6 +84,26 @@ TEST(SceneSettings, LoadProtocolAndRest) {
   const std::string msg = error_of([&] { load_settings(base.with({"load.protocol=\"ramp\""})); });
   EXPECT_NE(msg.find("load.protocol"), std::string::npos) << msg;
   EXPECT_NE(msg.find("must be \"staircase\" or \"csv\", got \"ramp\""), std::string::npos) << msg;
+}
+
+// The staircase's numbers, read once in SI units; inlet_load builds the protocol from them.
+TEST(SceneSettings, StaircaseNumbersInSI) {
+  const Scene s = Scene::load("", {"load.max_kPa=30", "load.step_kPa=7.5", "load.hold_s=4", "load.ramp_s=0.25",
+                                   "load.mark_s=2", "load.trials=3", "load.output_every_s=1", "load.csv=\"p.csv\""});
+  const LoadSettings l = load_settings(s);
+  EXPECT_EQ(l.max_Pa, 30e3);
+  EXPECT_EQ(l.step_Pa, 7.5e3);
+  EXPECT_EQ(l.hold_s, 4.0);
+  EXPECT_EQ(l.ramp_s, 0.25);
+  EXPECT_EQ(l.mark_s, 2.0);
+  EXPECT_EQ(l.trials, 3);
+  EXPECT_EQ(l.output_every_s, 1.0);
+  EXPECT_EQ(l.csv, "p.csv");
+  const LoadHistory h = inlet_load(s);
+  ASSERT_EQ(h.trials.size(), 3u);
+  EXPECT_EQ(h.trials[0].step_level_Pa, (std::vector<double>{0.0, 7.5e3, 15e3, 22.5e3, 30e3}));
+  EXPECT_EQ(h.trials[0].mark_s, 2.0);
+  EXPECT_EQ(h.trials[0].time_s[2], 4.25);  // the first ramp ends ramp_s after the hold
 }
 
 TEST(SceneSettings, SolverAndOutput) {
