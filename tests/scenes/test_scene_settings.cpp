@@ -30,6 +30,45 @@ TEST(SceneSettings, MeshSourceOfTheDefaultSceneAndOfADeck) {
   EXPECT_EQ(mesh_settings(base.with({"mesh.source=\"stl\""})).source, MeshSettings::Source::Stl);
 }
 
+// The meshers' keys in SI units, read for the sources that use them; each bad value names its key.
+TEST(SceneSettings, MesherKeysAndTheGeometry) {
+  const Scene base = Scene::load("", {"mesh.h_mm=4", "mesh.h_z_mm=2.5", "mesh.half=false", "mesh.element=\"tet4\"",
+                                      "mesh.fabric_layers=2", "mesh.fabric_model=\"membrane\""});
+  const MeshSettings m = mesh_settings(base);
+  EXPECT_EQ(m.h_m, 4e-3);
+  EXPECT_EQ(m.h_z_m, 2.5e-3);
+  EXPECT_FALSE(m.half);
+  EXPECT_EQ(m.element, ElementType::Tet4);
+  EXPECT_EQ(m.fabric_layers, 2);
+  EXPECT_TRUE(m.membrane_fabric);
+  const PneuNetParams p = pneunet_settings(base.with({"geometry.chambers=7", "geometry.width_mm=20"}));
+  EXPECT_EQ(p.chambers, 7);
+  EXPECT_EQ(p.width, 20e-3);
+  EXPECT_EQ(p.h, 4e-3);
+  EXPECT_EQ(p.h_z, 2.5e-3);
+  EXPECT_EQ(p.element, ElementType::Tet4);
+  EXPECT_EQ(p.fabric_model, FabricModel::Membrane);
+  EXPECT_FALSE(p.half);
+  // A deck's unit; the mesher's keys keep their defaults.
+  const MeshSettings deck = mesh_settings(base.with({"mesh.source=\"inp\"", "mesh.length_unit=\"m\""}));
+  EXPECT_EQ(deck.length_unit_m, 1.0);
+  EXPECT_EQ(deck.h_m, 0.0);
+  EXPECT_EQ(mesh_settings(Scene::load("")).length_unit_m, 1e-3);
+  const Scene d = Scene::load("");
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.element=\"hex8\""})); })
+                .find("key 'mesh.element': must be \"tet10\" or \"tet4\", got \"hex8\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.h_z_mm=-1"})); }).find("mesh.h_z_mm"), std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.fabric_model=\"cloth\""})); })
+                .find("must be \"solid\" or \"membrane\", got \"cloth\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.source=\"inp\"", "mesh.length_unit=\"in\""})); })
+                .find("must be \"mm\" or \"m\", got \"in\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.source=\"stl\"", "mesh.h_mm=0"})); }).find("mesh.h_mm"),
+            std::string::npos);
+}
+
 // The message build_model gave before the settings were typed: the key, where it was set, the values.
 TEST(SceneSettings, UnknownMeshSourceNamesTheKeyAndTheSources) {
   const Scene s = Scene::load("", {"mesh.source=\"gmsh\""});
