@@ -106,45 +106,24 @@ class DlcReader {
 
     std::vector<double> t, raw;
     std::vector<Point> fixed(map_.fixed_parts.size()), tip(map_.tip_parts.size());
-    int frames = 0, low = 0, untracked = 0, degenerate = 0, first_low_line = 0;
-    long previous_frame = 0;
-    int previous_line = 0, first_data_line = 0;
+    FrameCounts n;
     while (lines.next(line)) {
       if (csv::trim(line.text).empty()) continue;
-      if (first_data_line == 0) first_data_line = line.number;
-      csv::split(line.text, fields_);
-      if (fields_.size() != width_)
-        csv::fail(source_, line.number, static_cast<int>(std::min(fields_.size(), width_)) + 1,
-                  "the row has " + std::to_string(fields_.size()) + " fields, the header rows " +
-                      std::to_string(width_),
-                  "give every frame the same columns as the header (frame, then x, y, likelihood per body part)");
-      long frame = 0;
-      if (csv::parse_int(fields_[0], frame) != csv::Number::ok)
-        csv::fail(source_, line.number, 1, "frame index " + csv::quoted(fields_[0]) + " is not an integer",
-                  "give DeepLabCut's CSV from analyze_videos (its first column is the frame number)");
-      if (frames > 0 && frame <= previous_frame)
-        csv::fail(source_, line.number, 1,
-                  "frame " + std::to_string(frame) + " does not follow frame " + std::to_string(previous_frame) +
-                      " (line " + std::to_string(previous_line) + ")",
-                  "keep the rows in frame order, one row per frame");
-      previous_frame = frame;
-      previous_line = line.number;
-      ++frames;
-
+      const long frame = frame_row(line, n);
       Status status = Status::ok;
       for (std::size_t k = 0; k < fixed.size(); ++k) status = worst(status, point(line, fixed_cols_[k], fixed[k]));
       for (std::size_t k = 0; k < tip.size(); ++k) status = worst(status, point(line, tip_cols_[k], tip[k]));
       if (status == Status::untracked) {
-        ++untracked;
+        ++n.untracked;
         continue;
       }
       if (status == Status::low) {
-        if (low++ == 0) first_low_line = line.number;
+        if (n.low++ == 0) n.first_low_line = line.number;
         continue;
       }
       double fx = 0.0, fy = 0.0, tx = 0.0, ty = 0.0;
       if (!line_direction(fixed, fx, fy) || !line_direction(tip, tx, ty)) {
-        ++degenerate;
+        ++n.degenerate;
         continue;
       }
       double a = std::atan2(fx * ty - fy * tx, fx * tx + fy * ty) * kDegPerRad;
@@ -153,46 +132,19 @@ class DlcReader {
       t.push_back(map_.t0_s + static_cast<double>(frame) / map_.fps);
       raw.push_back(a);
     }
-    if (frames == 0)
+    if (n.frames == 0)
       csv::fail(source_, line.number + 1, 1, "no frame rows after the header rows",
                 "give DeepLabCut's CSV output of a video analysis");
     if (raw.empty())
-      csv::fail(source_, first_data_line, 1,
-                "none of the " + std::to_string(frames) + " frames has all of the mapped body parts tracked above "
+      csv::fail(source_, n.first_data_line, 1,
+                "none of the " + std::to_string(n.frames) + " frames has all of the mapped body parts tracked above "
                     "likelihood " + csv::number_text(map_.likelihood_cut),
                 "check that fixed_parts and tip_parts name the intended body parts, or lower likelihood_cut");
 
     Recording rec;
     rec.source = source_;
-    const int dropped = low + untracked + degenerate;
-    if (dropped > 0) {
-      std::string w = source_ + ": trial " + std::to_string(map_.trial) + ": dropped " + std::to_string(dropped) +
-                      " of " + std::to_string(frames) + " frames:";
-      if (low > 0)
-        w += ' ' + std::to_string(low) + " with a mapped body part below likelihood " +
-             csv::number_text(map_.likelihood_cut) + " (first at line " + std::to_string(first_low_line) + ");";
-      if (untracked > 0) w += ' ' + std::to_string(untracked) + " with empty or NaN coordinates;";
-      if (degenerate > 0) w += ' ' + std::to_string(degenerate) + " with coincident points of one end;";
-      w.back() = '.';
-      rec.warnings.push_back(w);
-    }
-
-    // Zero reference (see the header): the raw angle that maps to 0.
-    double zero = 0.0;
-    if (map_.zero_raw_deg) {
-      zero = *map_.zero_raw_deg;
-      const double shift = unwrap_deg(raw.front(), zero) - raw.front();  // first frame's branch nearest zero
-      for (double& a : raw) a += shift;
-    } else {
-      std::vector<double> head(raw.begin(),
-                               raw.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
-                                                 raw.size(), static_cast<std::size_t>(map_.zero_frames))));
-      const std::size_t mid = head.size() / 2;
-      std::nth_element(head.begin(), head.begin() + static_cast<std::ptrdiff_t>(mid), head.end());
-      zero = head[mid];
-      if (head.size() % 2 == 0) zero = 0.5 * (zero + *std::max_element(head.begin(), head.begin() +
-                                                                          static_cast<std::ptrdiff_t>(mid)));
-    }
+    if (n.low + n.untracked + n.degenerate > 0) rec.warnings.push_back(dropped_warning(n));
+    const double zero = zero_reference(raw);
     TrialRecording tr;
     tr.trial = map_.trial;
     tr.angle_deg.t_s = std::move(t);
@@ -203,6 +155,72 @@ class DlcReader {
   }
 
  private:
+  /// The rows read so far: frames, and the frames dropped by why (with the first low one's line).
+  struct FrameCounts {
+    int frames = 0, low = 0, untracked = 0, degenerate = 0, first_low_line = 0;
+    long previous_frame = 0;
+    int previous_line = 0, first_data_line = 0;
+  };
+
+  /// Splits a frame row into fields_ and returns its frame index, checked: the header's width, an
+  /// integer, after the previous frame's. Counts it in `n`.
+  long frame_row(const csv::Line& line, FrameCounts& n) {
+    if (n.first_data_line == 0) n.first_data_line = line.number;
+    csv::split(line.text, fields_);
+    if (fields_.size() != width_)
+      csv::fail(source_, line.number, static_cast<int>(std::min(fields_.size(), width_)) + 1,
+                "the row has " + std::to_string(fields_.size()) + " fields, the header rows " + std::to_string(width_),
+                "give every frame the same columns as the header (frame, then x, y, likelihood per body part)");
+    long frame = 0;
+    if (csv::parse_int(fields_[0], frame) != csv::Number::ok)
+      csv::fail(source_, line.number, 1, "frame index " + csv::quoted(fields_[0]) + " is not an integer",
+                "give DeepLabCut's CSV from analyze_videos (its first column is the frame number)");
+    if (n.frames > 0 && frame <= n.previous_frame)
+      csv::fail(source_, line.number, 1,
+                "frame " + std::to_string(frame) + " does not follow frame " + std::to_string(n.previous_frame) +
+                    " (line " + std::to_string(n.previous_line) + ")",
+                "keep the rows in frame order, one row per frame");
+    n.previous_frame = frame;
+    n.previous_line = line.number;
+    ++n.frames;
+    return frame;
+  }
+
+  /// The warning that lists the dropped frames by why.
+  std::string dropped_warning(const FrameCounts& n) const {
+    const int dropped = n.low + n.untracked + n.degenerate;
+    std::string w = source_ + ": trial " + std::to_string(map_.trial) + ": dropped " + std::to_string(dropped) +
+                    " of " + std::to_string(n.frames) + " frames:";
+    if (n.low > 0)
+      w += ' ' + std::to_string(n.low) + " with a mapped body part below likelihood " +
+           csv::number_text(map_.likelihood_cut) + " (first at line " + std::to_string(n.first_low_line) + ");";
+    if (n.untracked > 0) w += ' ' + std::to_string(n.untracked) + " with empty or NaN coordinates;";
+    if (n.degenerate > 0) w += ' ' + std::to_string(n.degenerate) + " with coincident points of one end;";
+    w.back() = '.';
+    return w;
+  }
+
+  /// Zero reference (see the header): the raw angle that maps to 0 - map.zero_raw_deg (the raw
+  /// angles then shifted to the first frame's branch nearest it) or the median of the first
+  /// map.zero_frames kept frames.
+  double zero_reference(std::vector<double>& raw) const {
+    if (map_.zero_raw_deg) {
+      const double zero = *map_.zero_raw_deg;
+      const double shift = unwrap_deg(raw.front(), zero) - raw.front();  // first frame's branch nearest zero
+      for (double& a : raw) a += shift;
+      return zero;
+    }
+    std::vector<double> head(raw.begin(),
+                             raw.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(
+                                               raw.size(), static_cast<std::size_t>(map_.zero_frames))));
+    const std::size_t mid = head.size() / 2;
+    std::nth_element(head.begin(), head.begin() + static_cast<std::ptrdiff_t>(mid), head.end());
+    double zero = head[mid];
+    if (head.size() % 2 == 0)
+      zero = 0.5 * (zero + *std::max_element(head.begin(), head.begin() + static_cast<std::ptrdiff_t>(mid)));
+    return zero;
+  }
+
   enum class Status { ok = 0, low = 1, untracked = 2 };
   static Status worst(Status a, Status b) { return static_cast<int>(a) >= static_cast<int>(b) ? a : b; }
 

@@ -145,6 +145,160 @@ void convention_hints(Comparison& c) {
 }
 }  // namespace
 
+namespace {
+
+/// The residual sums that pool over every trial's steps: the binned profiles (all trials, the
+/// early half, the late half) and the mean residual before and after each step's mark.
+struct PooledResiduals {
+  Binner all, early, late;
+  double before_sum = 0, after_sum = 0;
+  long before_n = 0, after_n = 0;
+  explicit PooledResiduals(double bin_s) : all{bin_s, {}, {}}, early{bin_s, {}, {}}, late{bin_s, {}, {}} {}
+};
+
+/// The frame-by-frame comparison of one trial: the model at the kept frames `mod`, the trial's
+/// RSS, frame count, range, RMSE and NRMSE, the compared frames appended to `out.frames`, and the
+/// warnings for frames outside the model's span and for outliers.
+void compare_trial_frames(const Recording& rec, std::size_t k, const Series& meas, const std::vector<double>& mod,
+                          TrialComparison& tc, Range& pooled_range, Comparison& out) {
+  const TrialRecording& tr = rec.trials[k];
+  Range range;
+  long skipped = 0;
+  for (std::size_t i = 0; i < meas.t_s.size(); ++i) {
+    range.add(meas.value[i]);
+    pooled_range.add(meas.value[i]);
+    if (!std::isfinite(mod[i])) {
+      ++skipped;
+      continue;
+    }
+    const double r = mod[i] - meas.value[i];
+    tc.rss_deg2 += r * r;
+    ++tc.frames;
+    out.frames.push_back({static_cast<int>(k), meas.t_s[i], meas.value[i], mod[i]});
+  }
+  if (skipped > 0)
+    out.warnings.push_back(rec.source + ": trial " + std::to_string(tr.trial) + ": " + std::to_string(skipped) +
+                           " frame(s) outside the model's time span were not compared");
+  if (tc.outliers > 0)
+    out.warnings.push_back(rec.source + ": trial " + std::to_string(tr.trial) + ": " + std::to_string(tc.outliers) +
+                           " outlier frame(s) dropped (Hampel filter)");
+  tc.range_deg = range.span();
+  tc.rmse_deg = tc.frames > 0 ? std::sqrt(tc.rss_deg2 / static_cast<double>(tc.frames)) : kNaN;
+  tc.nrmse = tc.range_deg > 0 ? tc.rmse_deg / tc.range_deg : kNaN;
+}
+
+/// One detected step of a trial against the model: the mark (opt.mark_s after the step's start)
+/// and end values, the step's mean residual and the slopes after the mark, and whether measured
+/// and model are steady there. The step's frames are [t_start, t_end) (the last step includes its
+/// end); their residuals are added to `pooled`.
+StepComparison compare_step(const Step& st, bool last, const Series& meas, const std::vector<double>& mod,
+                            const Series& model, double noise_deg, bool is_early, const CompareOptions& opt,
+                            PooledResiduals& pooled) {
+  StepComparison sc;
+  sc.t_start_s = st.t_start_s;
+  sc.t_end_s = st.t_end_s;
+  sc.level_kPa = st.level_kPa;
+  const double t_mark = st.t_start_s + opt.mark_s;
+  const std::ptrdiff_t i_end = last_at_or_before(meas.t_s, st.t_end_s);
+  const bool has_mark = t_mark <= st.t_end_s && i_end >= 0 && meas.t_s.front() <= t_mark &&
+                        meas.t_s[static_cast<std::size_t>(i_end)] >= t_mark;
+  sc.measured_mark_deg = has_mark ? value_at(meas, t_mark) : kNaN;
+  sc.model_mark_deg = has_mark ? value_at(model, t_mark) : kNaN;
+  sc.abs_error_deg = std::abs(sc.model_mark_deg - sc.measured_mark_deg);
+  if (has_mark) {
+    sc.measured_end_deg = meas.value[static_cast<std::size_t>(i_end)];
+    sc.model_end_deg = mod[static_cast<std::size_t>(i_end)];
+  } else {
+    sc.measured_end_deg = sc.model_end_deg = kNaN;
+  }
+  sc.spread_measured_deg = sc.measured_end_deg - sc.measured_mark_deg;
+  sc.spread_model_deg = sc.model_end_deg - sc.model_mark_deg;
+  std::vector<double> st_t, st_m, st_p, st_r;
+  double rsum = 0;
+  for (std::size_t i = 0; i < meas.t_s.size(); ++i) {
+    const double t = meas.t_s[i];
+    if (t < st.t_start_s || t > st.t_end_s || (t == st.t_end_s && !last) || !std::isfinite(mod[i])) continue;
+    const double r = mod[i] - meas.value[i];
+    rsum += r;
+    ++sc.frames;
+    pooled.all.add(t - st.t_start_s, r);
+    (is_early ? pooled.early : pooled.late).add(t - st.t_start_s, r);
+    if (t < t_mark) {
+      pooled.before_sum += r;
+      ++pooled.before_n;
+    } else {
+      pooled.after_sum += r;
+      ++pooled.after_n;
+      st_t.push_back(t);
+      st_m.push_back(meas.value[i]);
+      st_p.push_back(mod[i]);
+      st_r.push_back(r);
+    }
+  }
+  sc.mean_residual_deg = sc.frames > 0 ? rsum / static_cast<double>(sc.frames) : kNaN;
+  sc.slope_measured_deg_s = ls_slope(st_t, st_m);
+  sc.slope_model_deg_s = ls_slope(st_t, st_p);
+  sc.slope_residual_deg_s = ls_slope(st_t, st_r);
+  const double settled_s = st_t.empty() ? 0.0 : st_t.back() - st_t.front();
+  const double threshold_deg = std::max(opt.steady_k * noise_deg, opt.steady_floor_deg);
+  sc.steady = std::abs(sc.slope_measured_deg_s * settled_s) < threshold_deg;
+  sc.steady_model = std::abs(sc.slope_model_deg_s * settled_s) < threshold_deg;
+  return sc;
+}
+
+/// Trial k of the recording against its model trace: the frames (compare_trial_frames), then each
+/// detected step (compare_step), the trial's NRMSE at the marks, and its row of the residual map.
+void compare_trial(const Recording& rec, std::size_t k, const Series& model, const std::vector<TrialSteps>& all_steps,
+                   const CompareOptions& opt, PooledResiduals& pooled, Range& pooled_range, Comparison& out) {
+  const TrialRecording& tr = rec.trials[k];
+  const HampelResult hr = hampel_filter(tr.angle_deg, opt.hampel);
+  const Series& meas = hr.series;
+  if (meas.t_s.empty())
+    throw InputError(rec.source + ": trial " + std::to_string(tr.trial) +
+                     " has no angle frames to compare; give its angle_deg record or leave the trial out");
+  // Model at the kept frames.
+  std::vector<double> mod(meas.t_s.size());
+  for (std::size_t i = 0; i < meas.t_s.size(); ++i) mod[i] = value_at(model, meas.t_s[i]);
+  TrialComparison tc;
+  tc.trial = tr.trial;
+  tc.outliers = static_cast<long>(hr.flagged.size());
+  tc.noise_deg = angle_noise_deg(meas);
+  compare_trial_frames(rec, k, meas, mod, tc, pooled_range, out);
+
+  // Steps of this trial.
+  const StepDetection* det = nullptr;
+  for (const TrialSteps& ts : all_steps)
+    if (ts.trial == tr.trial) det = &ts.detection;
+  if (det) out.warnings.insert(out.warnings.end(), det->warnings.begin(), det->warnings.end());
+  const bool is_early = k < rec.trials.size() / 2;  // with an odd count the middle trial counts as late
+  double mark_ss = 0;
+  long marks = 0;
+  Range mark_range;
+  std::vector<double> map_row;
+  const std::vector<Step> no_steps;
+  const std::vector<Step>& steps = det ? det->steps : no_steps;
+  for (std::size_t si = 0; si < steps.size(); ++si) {
+    StepComparison sc =
+        compare_step(steps[si], si + 1 == steps.size(), meas, mod, model, tc.noise_deg, is_early, opt, pooled);
+    if (std::isfinite(sc.abs_error_deg)) {
+      mark_ss += sc.abs_error_deg * sc.abs_error_deg;
+      ++marks;
+      mark_range.add(sc.measured_mark_deg);
+    }
+    map_row.push_back(sc.mean_residual_deg);
+    tc.steps.push_back(sc);
+  }
+  tc.nrmse_mark = (marks >= 2 && mark_range.span() > 0)
+                      ? std::sqrt(mark_ss / static_cast<double>(marks)) / mark_range.span()
+                      : kNaN;
+  out.residual_map_deg.push_back(map_row);
+  out.rss_deg2 += tc.rss_deg2;
+  out.n += tc.frames;
+  out.trials.push_back(std::move(tc));
+}
+
+}  // namespace
+
 Comparison compare_recording(const Recording& rec, const std::vector<Series>& model, const CompareOptions& opt) {
   if (model.size() != rec.trials.size())
     throw InputError("compare: " + std::to_string(model.size()) + " model traces for " +
@@ -153,131 +307,10 @@ Comparison compare_recording(const Recording& rec, const std::vector<Series>& mo
     throw InputError("compare: mark_s, steady_k, steady_floor_deg must be >= 0 and bin_s > 0");
   Comparison out;
   const std::vector<TrialSteps> all_steps = detect_steps(rec, opt.steps);
-  Binner all{opt.bin_s, {}, {}}, early{opt.bin_s, {}, {}}, late{opt.bin_s, {}, {}};
-  double before_sum = 0, after_sum = 0;
-  long before_n = 0, after_n = 0;
+  PooledResiduals pooled(opt.bin_s);
   Range pooled_range;
-  const std::size_t ntr = rec.trials.size();
-
-  for (std::size_t k = 0; k < ntr; ++k) {
-    const TrialRecording& tr = rec.trials[k];
-    const HampelResult hr = hampel_filter(tr.angle_deg, opt.hampel);
-    const Series& meas = hr.series;
-    if (meas.t_s.empty())
-      throw InputError(rec.source + ": trial " + std::to_string(tr.trial) +
-                       " has no angle frames to compare; give its angle_deg record or leave the trial out");
-    // Model at the kept frames.
-    std::vector<double> mod(meas.t_s.size());
-    for (std::size_t i = 0; i < meas.t_s.size(); ++i) mod[i] = value_at(model[k], meas.t_s[i]);
-    TrialComparison tc;
-    tc.trial = tr.trial;
-    tc.outliers = static_cast<long>(hr.flagged.size());
-    tc.noise_deg = angle_noise_deg(meas);
-    Range range;
-    long skipped = 0;
-    for (std::size_t i = 0; i < meas.t_s.size(); ++i) {
-      range.add(meas.value[i]);
-      pooled_range.add(meas.value[i]);
-      if (!std::isfinite(mod[i])) {
-        ++skipped;
-        continue;
-      }
-      const double r = mod[i] - meas.value[i];
-      tc.rss_deg2 += r * r;
-      ++tc.frames;
-      out.frames.push_back({static_cast<int>(k), meas.t_s[i], meas.value[i], mod[i]});
-    }
-    if (skipped > 0)
-      out.warnings.push_back(rec.source + ": trial " + std::to_string(tr.trial) + ": " + std::to_string(skipped) +
-                             " frame(s) outside the model's time span were not compared");
-    if (tc.outliers > 0)
-      out.warnings.push_back(rec.source + ": trial " + std::to_string(tr.trial) + ": " + std::to_string(tc.outliers) +
-                             " outlier frame(s) dropped (Hampel filter)");
-    tc.range_deg = range.span();
-    tc.rmse_deg = tc.frames > 0 ? std::sqrt(tc.rss_deg2 / static_cast<double>(tc.frames)) : kNaN;
-    tc.nrmse = tc.range_deg > 0 ? tc.rmse_deg / tc.range_deg : kNaN;
-
-    // Steps of this trial.
-    const StepDetection* det = nullptr;
-    for (const TrialSteps& ts : all_steps)
-      if (ts.trial == tr.trial) det = &ts.detection;
-    if (det) out.warnings.insert(out.warnings.end(), det->warnings.begin(), det->warnings.end());
-    const bool is_early = k < ntr / 2;  // with an odd count the middle trial counts as late
-    double mark_ss = 0;
-    long marks = 0;
-    Range mark_range;
-    std::vector<double> map_row;
-    const std::vector<Step> no_steps;
-    const std::vector<Step>& steps = det ? det->steps : no_steps;
-    for (std::size_t si = 0; si < steps.size(); ++si) {
-      const Step& st = steps[si];
-      StepComparison sc;
-      sc.t_start_s = st.t_start_s;
-      sc.t_end_s = st.t_end_s;
-      sc.level_kPa = st.level_kPa;
-      const double t_mark = st.t_start_s + opt.mark_s;
-      const std::ptrdiff_t i_end = last_at_or_before(meas.t_s, st.t_end_s);
-      const bool has_mark = t_mark <= st.t_end_s && i_end >= 0 && meas.t_s.front() <= t_mark &&
-                            meas.t_s[static_cast<std::size_t>(i_end)] >= t_mark;
-      sc.measured_mark_deg = has_mark ? value_at(meas, t_mark) : kNaN;
-      sc.model_mark_deg = has_mark ? value_at(model[k], t_mark) : kNaN;
-      sc.abs_error_deg = std::abs(sc.model_mark_deg - sc.measured_mark_deg);
-      if (has_mark) {
-        sc.measured_end_deg = meas.value[static_cast<std::size_t>(i_end)];
-        sc.model_end_deg = mod[static_cast<std::size_t>(i_end)];
-      } else {
-        sc.measured_end_deg = sc.model_end_deg = kNaN;
-      }
-      sc.spread_measured_deg = sc.measured_end_deg - sc.measured_mark_deg;
-      sc.spread_model_deg = sc.model_end_deg - sc.model_mark_deg;
-      if (std::isfinite(sc.abs_error_deg)) {
-        mark_ss += sc.abs_error_deg * sc.abs_error_deg;
-        ++marks;
-        mark_range.add(sc.measured_mark_deg);
-      }
-      // Frames of the step: [t_start, t_end) (the last step includes its end).
-      std::vector<double> st_t, st_m, st_p, st_r;
-      double rsum = 0;
-      const bool last = si + 1 == steps.size();
-      for (std::size_t i = 0; i < meas.t_s.size(); ++i) {
-        const double t = meas.t_s[i];
-        if (t < st.t_start_s || t > st.t_end_s || (t == st.t_end_s && !last) || !std::isfinite(mod[i])) continue;
-        const double r = mod[i] - meas.value[i];
-        rsum += r;
-        ++sc.frames;
-        all.add(t - st.t_start_s, r);
-        (is_early ? early : late).add(t - st.t_start_s, r);
-        if (t < t_mark) {
-          before_sum += r;
-          ++before_n;
-        } else {
-          after_sum += r;
-          ++after_n;
-          st_t.push_back(t);
-          st_m.push_back(meas.value[i]);
-          st_p.push_back(mod[i]);
-          st_r.push_back(r);
-        }
-      }
-      sc.mean_residual_deg = sc.frames > 0 ? rsum / static_cast<double>(sc.frames) : kNaN;
-      sc.slope_measured_deg_s = ls_slope(st_t, st_m);
-      sc.slope_model_deg_s = ls_slope(st_t, st_p);
-      sc.slope_residual_deg_s = ls_slope(st_t, st_r);
-      const double settled_s = st_t.empty() ? 0.0 : st_t.back() - st_t.front();
-      const double threshold_deg = std::max(opt.steady_k * tc.noise_deg, opt.steady_floor_deg);
-      sc.steady = std::abs(sc.slope_measured_deg_s * settled_s) < threshold_deg;
-      sc.steady_model = std::abs(sc.slope_model_deg_s * settled_s) < threshold_deg;
-      map_row.push_back(sc.mean_residual_deg);
-      tc.steps.push_back(sc);
-    }
-    tc.nrmse_mark = (marks >= 2 && mark_range.span() > 0)
-                        ? std::sqrt(mark_ss / static_cast<double>(marks)) / mark_range.span()
-                        : kNaN;
-    out.residual_map_deg.push_back(map_row);
-    out.rss_deg2 += tc.rss_deg2;
-    out.n += tc.frames;
-    out.trials.push_back(std::move(tc));
-  }
+  for (std::size_t k = 0; k < rec.trials.size(); ++k)
+    compare_trial(rec, k, model[k], all_steps, opt, pooled, pooled_range, out);
   out.range_deg = pooled_range.span();
   if (out.n == 0 || out.range_deg <= 0)
     throw InputError(rec.source + ": the measured angle does not vary (range 0) or no frame could be compared; "
@@ -285,11 +318,12 @@ Comparison compare_recording(const Recording& rec, const std::vector<Series>& mo
   out.rmse_deg = std::sqrt(out.rss_deg2 / static_cast<double>(out.n));
   out.nrmse = out.rmse_deg / out.range_deg;
   out.noise_floor_nrmse = noise_floor_nrmse(rec, opt.hampel);
-  out.profile = all.profile();
-  out.profile_early_trials = early.profile();
-  out.profile_late_trials = late.profile();
-  out.residual_before_mark_deg = before_n > 0 ? before_sum / static_cast<double>(before_n) : kNaN;
-  out.residual_after_mark_deg = after_n > 0 ? after_sum / static_cast<double>(after_n) : kNaN;
+  out.profile = pooled.all.profile();
+  out.profile_early_trials = pooled.early.profile();
+  out.profile_late_trials = pooled.late.profile();
+  out.residual_before_mark_deg =
+      pooled.before_n > 0 ? pooled.before_sum / static_cast<double>(pooled.before_n) : kNaN;
+  out.residual_after_mark_deg = pooled.after_n > 0 ? pooled.after_sum / static_cast<double>(pooled.after_n) : kNaN;
   convention_hints(out);
   return out;
 }

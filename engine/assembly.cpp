@@ -56,47 +56,62 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 }  // namespace
 
 Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry(model.mesh)) {
-  const Mesh& mesh = model.mesh;
-  const int ne = mesh.num_elements(), nn = mesh.num_nodes(), npe = mesh.npe();
-  {
-    std::vector<std::vector<int>> colours = colour_elements(mesh);
-    colour_ptr_.assign(1, 0);
-    kelem_.reserve(ne);
-    for (auto& c : colours) {
-      // Within a colour the order is free (its elements share no node, so every sum sees the same
-      // terms in the same order): group the elements by part, hence by material, so that the
-      // force kernel's batches of one material are full (fabric and silicone interleave otherwise).
-      std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return model.element_part[a] < model.element_part[b]; });
-      kelem_.insert(kelem_.end(), c.begin(), c.end());
-      colour_ptr_.push_back(static_cast<int>(kelem_.size()));
-    }
-    const std::size_t gq = static_cast<std::size_t>(geom_.nqp) * npe * 3;
-    knodes_.resize(static_cast<std::size_t>(ne) * npe);
-    kgrad_.resize(static_cast<std::size_t>(ne) * gq);
-    kw_.resize(static_cast<std::size_t>(ne) * geom_.nqp);
-    kmat_.resize(ne);
-    for (int i = 0; i < ne; ++i) {
-      const int e = kelem_[i];
-      std::copy(mesh.element(e), mesh.element(e) + npe, knodes_.begin() + static_cast<std::ptrdiff_t>(i) * npe);
-      std::copy(geom_.grad(e, 0), geom_.grad(e, 0) + gq, kgrad_.begin() + static_cast<std::ptrdiff_t>(i * gq));
-      for (int q = 0; q < geom_.nqp; ++q) kw_[static_cast<std::size_t>(i) * geom_.nqp + q] = geom_.w(e, q);
-      kmat_[i] = &model.material_of(e);
-    }
-  }
-
+  build_element_loop();
+  const int ne = model.mesh.num_elements();
   state_offset_.assign(ne + 1, 0);
   for (int e = 0; e < ne; ++e)
     state_offset_[e + 1] = state_offset_[e] + static_cast<std::size_t>(geom_.nqp) * model.material_of(e).state_size();
   build_nonlocal();
+  build_solid_mass();
+  build_pattern();
+  build_pressure_faces();
+}
 
-  mass_ = Eigen::VectorXd::Zero(nn);
+void Assembler::build_element_loop() {
+  const Model& model = model_;
+  const Mesh& mesh = model.mesh;
+  const int ne = mesh.num_elements(), npe = mesh.npe();
+  std::vector<std::vector<int>> colours = colour_elements(mesh);
+  colour_ptr_.assign(1, 0);
+  kelem_.reserve(ne);
+  for (auto& c : colours) {
+    // Within a colour the order is free (its elements share no node, so every sum sees the same
+    // terms in the same order): group the elements by part, hence by material, so that the
+    // force kernel's batches of one material are full (fabric and silicone interleave otherwise).
+    std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return model.element_part[a] < model.element_part[b]; });
+    kelem_.insert(kelem_.end(), c.begin(), c.end());
+    colour_ptr_.push_back(static_cast<int>(kelem_.size()));
+  }
+  const std::size_t gq = static_cast<std::size_t>(geom_.nqp) * npe * 3;
+  knodes_.resize(static_cast<std::size_t>(ne) * npe);
+  kgrad_.resize(static_cast<std::size_t>(ne) * gq);
+  kw_.resize(static_cast<std::size_t>(ne) * geom_.nqp);
+  kmat_.resize(ne);
+  for (int i = 0; i < ne; ++i) {
+    const int e = kelem_[i];
+    std::copy(mesh.element(e), mesh.element(e) + npe, knodes_.begin() + static_cast<std::ptrdiff_t>(i) * npe);
+    std::copy(geom_.grad(e, 0), geom_.grad(e, 0) + gq, kgrad_.begin() + static_cast<std::ptrdiff_t>(i * gq));
+    for (int q = 0; q < geom_.nqp; ++q) kw_[static_cast<std::size_t>(i) * geom_.nqp + q] = geom_.w(e, q);
+    kmat_[i] = &model.material_of(e);
+  }
+}
+
+void Assembler::build_solid_mass() {
+  const Mesh& mesh = model_.mesh;
+  const int ne = mesh.num_elements(), npe = mesh.npe();
+  mass_ = Eigen::VectorXd::Zero(mesh.num_nodes());
   const auto frac = lumped_mass_fractions(mesh.type);
   for (int e = 0; e < ne; ++e) {
-    const double m = model.parts[model.element_part[e]].density_kg_m3 * geom_.volume[e];
+    const double m = model_.parts[model_.element_part[e]].density_kg_m3 * geom_.volume[e];
     const int* n = mesh.element(e);
     for (int a = 0; a < npe; ++a) mass_[n[a]] += frac[a] * m;
   }
+}
 
+void Assembler::build_pattern() {
+  const Model& model = model_;
+  const Mesh& mesh = model.mesh;
+  const int ne = mesh.num_elements(), nn = mesh.num_nodes(), npe = mesh.npe();
   // Node adjacency (including self), sorted.
   std::vector<std::vector<int>> adj(nn);
   for (int e = 0; e < ne; ++e) {
@@ -149,12 +164,15 @@ Assembler::Assembler(const Model& model) : model_(model), geom_(compute_geometry
   col_ptr_.assign(3 * nn + 1, 0);
   for (int b = 0; b < nn; ++b)
     for (int k = 0; k < 3; ++k) col_ptr_[3 * b + k + 1] = col_ptr_[3 * b + k] + 3 * (adj_ptr_[b + 1] - adj_ptr_[b]);
+}
 
+void Assembler::build_pressure_faces() {
+  const Mesh& mesh = model_.mesh;
   // Pressure faces in outward order: the Abaqus face order has an inward right-hand normal,
   // so swap the 2nd and 3rd corner (and the mid-edge nodes accordingly).
   const int npf = nodes_per_face(mesh.type);
-  pface_nodes_.reserve(model.pressure_faces.size() * npf);
-  for (const FaceRef& f : model.pressure_faces) {
+  pface_nodes_.reserve(model_.pressure_faces.size() * npf);
+  for (const FaceRef& f : model_.pressure_faces) {
     const int* ln = face_local_nodes(mesh.type, f.local_face);
     const int* n = mesh.element(f.element);
     if (npf == 3) {

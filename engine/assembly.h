@@ -109,7 +109,12 @@ class Assembler {
                        std::span<PointResponse> out) const;
 
  private:
-  void build_nonlocal();  ///< sets nonlocal_ / nl_element_ (constructor)
+  // The constructor's parts, in the order it calls them.
+  void build_element_loop();     ///< colour_ptr_, kelem_ and the per-position knodes_, kgrad_, kw_, kmat_
+  void build_nonlocal();         ///< sets nonlocal_ / nl_element_ (constructor)
+  void build_solid_mass();       ///< mass_: the elements' lumped mass
+  void build_pattern();          ///< adj_ptr_, adj_, pair_slot_, and the membranes' mgeom_, mslot_ and mass
+  void build_pressure_faces();   ///< pface_nodes_
   // internal() for one element type: the coloured element loop, then the membranes. Its kernels
   // (assembly.cpp) share a Pass, the call's inputs and outputs.
   struct Pass;

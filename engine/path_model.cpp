@@ -178,6 +178,12 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
   const Assembler asmb(reference);
   if (asmb.state_size() != 0)
     throw InputError("path model: the reference model must be elastic (materials without history)");
+  take_trace(asmb, trace);
+  choose_points(asmb, trace.u.back());
+  precompute_path(asmb, trace.u);
+}
+
+void PathModel::take_trace(const Assembler& asmb, const ElasticPathTrace& trace) {
   const std::vector<Eigen::VectorXd>& us = trace.u;
   auto bad = [](const std::string& why) {
     return InputError("path model: the elastic path trace " + why +
@@ -186,14 +192,14 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
   if (us.size() != trace.p_Pa.size() || us.size() < 3) throw bad("has fewer than three samples or mismatched sizes");
   const Eigen::VectorXd& mass = asmb.lumped_mass();
   for (std::size_t k = 0; k < us.size(); ++k) {
-    if (us[k].size() != reference.num_dofs())
-      throw bad("has " + std::to_string(us[k].size()) + " dof, the model " + std::to_string(reference.num_dofs()));
+    if (us[k].size() != ref_.num_dofs())
+      throw bad("has " + std::to_string(us[k].size()) + " dof, the model " + std::to_string(ref_.num_dofs()));
     if (!us[k].allFinite() || !std::isfinite(trace.p_Pa[k])) throw bad("holds non-finite values");
     double th = 0.0;
     if (k == 0) {
       if (trace.p_Pa[0] != 0.0 || !us[0].isZero(0.0)) throw bad("does not start unloaded");
     } else {
-      th = unwrap_deg(bending_angle(reference, us[k]).angle_deg, theta_.back());
+      th = unwrap_deg(bending_angle(ref_, us[k]).angle_deg, theta_.back());
       if (!(th > theta_.back() && trace.p_Pa[k] > p_.back()))
         throw bad("is not increasing in pressure and angle at sample " + std::to_string(k));
     }
@@ -202,9 +208,10 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
     V_.push_back(asmb.cavity_volume(us[k]));
     S_.push_back(first_moment(mass, us[k]));
   }
+}
 
-  // 2. Material points.
-  const Mesh& mesh = reference.mesh;
+void PathModel::choose_points(const Assembler& asmb, const Eigen::VectorXd& u_top) {
+  const Mesh& mesh = ref_.mesh;
   const ElementGeometry& geom = asmb.geometry();
   const int ne = mesh.num_elements();
   if (static_cast<long>(ne) * geom.nqp <= opt_.max_points) {
@@ -214,45 +221,50 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
         pt_qp_.push_back(q);
         pt_weight_.push_back(geom.w(e, q));
       }
-  } else {
-    // Importance sample of elements: probability pi_e = (volume share + energy share at the path's
-    // top) / 2; systematic sampling of n positions on the cumulative distribution; each pick keeps
-    // every quadrature point of its element, with the Horvitz-Thompson weight w_eq / (n pi_e), so
-    // sums over picks estimate volume integrals without bias, while the high-energy elements (where
-    // damage lives) are densely covered. Every quadrature point, not the element centroid: the
-    // interior walls bend, and the centroid (the element's mean strain) misses the bending strain
-    // that varies through a wall one or two quadratic elements thick. History driven by it is then
-    // underestimated — by a third of the creep near the default actuator's limit point with
-    // viscoelasticity (2026-11-26: 4.4 deg instead of the FEM's 6.4 deg after a 16 s hold at
-    // 45 kPa; 6.1 deg with every quadrature point), whatever the number of elements sampled.
-    const int n = std::max(1, opt_.max_points / geom.nqp);
-    std::vector<double> energy(ne);
-    double vtot = 0.0, etot = 0.0;
-    for (int e = 0; e < ne; ++e) {
-      const Mat3 F = deformation_gradient(mesh, geom, us.back(), e, -1);
-      PointResponse r;
-      std::vector<double> none;
-      reference.material_of(e).evaluate(std::span<const Mat3>(&F, 1), TimeStep{}, none, none,
-                                        std::span<PointResponse>(&r, 1), false);
-      energy[e] = std::max(0.0, r.psi()) * geom.volume[e];
-      vtot += geom.volume[e];
-      etot += energy[e];
-    }
-    double cum = 0.0;
-    int next = 0;
-    for (int e = 0; e < ne && next < n; ++e) {
-      const double pi = 0.5 * geom.volume[e] / vtot + (etot > 0.0 ? 0.5 * energy[e] / etot : 0.5 * geom.volume[e] / vtot);
-      cum += pi;
-      while (next < n && (next + 0.5) / n < cum) {
-        for (int q = 0; q < geom.nqp; ++q) {
-          pt_element_.push_back(e);
-          pt_qp_.push_back(q);
-          pt_weight_.push_back(geom.w(e, q) / (n * pi));
-        }
-        ++next;
+    return;
+  }
+  // Importance sample of elements: probability pi_e = (volume share + energy share at the path's
+  // top) / 2; systematic sampling of n positions on the cumulative distribution; each pick keeps
+  // every quadrature point of its element, with the Horvitz-Thompson weight w_eq / (n pi_e), so
+  // sums over picks estimate volume integrals without bias, while the high-energy elements (where
+  // damage lives) are densely covered. Every quadrature point, not the element centroid: the
+  // interior walls bend, and the centroid (the element's mean strain) misses the bending strain
+  // that varies through a wall one or two quadratic elements thick. History driven by it is then
+  // underestimated — by a third of the creep near the default actuator's limit point with
+  // viscoelasticity (2026-11-26: 4.4 deg instead of the FEM's 6.4 deg after a 16 s hold at
+  // 45 kPa; 6.1 deg with every quadrature point), whatever the number of elements sampled.
+  const int n = std::max(1, opt_.max_points / geom.nqp);
+  std::vector<double> energy(ne);
+  double vtot = 0.0, etot = 0.0;
+  for (int e = 0; e < ne; ++e) {
+    const Mat3 F = deformation_gradient(mesh, geom, u_top, e, -1);
+    PointResponse r;
+    std::vector<double> none;
+    ref_.material_of(e).evaluate(std::span<const Mat3>(&F, 1), TimeStep{}, none, none, std::span<PointResponse>(&r, 1),
+                                 false);
+    energy[e] = std::max(0.0, r.psi()) * geom.volume[e];
+    vtot += geom.volume[e];
+    etot += energy[e];
+  }
+  double cum = 0.0;
+  int next = 0;
+  for (int e = 0; e < ne && next < n; ++e) {
+    const double pi = 0.5 * geom.volume[e] / vtot + (etot > 0.0 ? 0.5 * energy[e] / etot : 0.5 * geom.volume[e] / vtot);
+    cum += pi;
+    while (next < n && (next + 0.5) / n < cum) {
+      for (int q = 0; q < geom.nqp; ++q) {
+        pt_element_.push_back(e);
+        pt_qp_.push_back(q);
+        pt_weight_.push_back(geom.w(e, q) / (n * pi));
       }
+      ++next;
     }
   }
+}
+
+void PathModel::precompute_path(const Assembler& asmb, const std::vector<Eigen::VectorXd>& us) {
+  const Mesh& mesh = ref_.mesh;
+  const ElementGeometry& geom = asmb.geometry();
   const std::size_t np = pt_element_.size();
   F_.resize(np * theta_.size());
   for (std::size_t k = 0; k < theta_.size(); ++k)
@@ -272,9 +284,9 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
   // diagnose compares at that level. Beyond the ends the residual stays linear (extrapolation).
   dp_dtheta_ = monotone_slopes(theta_, p_);
 
-  // 3. The reference's generalised force on a fine grid of each segment: the difference form
+  // The reference's generalised force on a fine grid of each segment: the difference form
   // needs G_ref at every residual evaluation, and it never changes.
-  const Groups gr = group_points(reference, pt_element_);
+  const Groups gr = group_points(ref_, pt_element_);
   std::vector<Mat3> Fbuf, dFbuf;
   std::vector<PointResponse> rbuf;
   Gref_.resize((theta_.size() - 1) * (kRefSub + 1));
@@ -286,6 +298,215 @@ PathModel::PathModel(const Model& reference, const PathModelOptions& options, co
 
 int PathModel::segment(double theta) const { return path_segment_index(theta_, theta); }
 
+/// One run of `model` along the path: the history of its material points (committed in
+/// state_old_, trial in state_new_), the non-local drivers, the equilibrium residual and the
+/// scalar root finder that places the model on the path at each physical step.
+class PathModel::Run {
+ public:
+  Run(const PathModel& path, const Model& model)
+      : pm_(path), model_(model), np_(path.pt_element_.size()), gm_(group_points(model, path.pt_element_)),
+        gr_(group_points(path.ref_, path.pt_element_)), state_old_(gm_.state_size), state_new_(gm_.state_size),
+        pt_slot_(np_, {-1, 0}) {
+    for (std::size_t k = 0; k < gm_.material.size(); ++k) {
+      const int ss = gm_.material[k]->state_size();
+      for (std::size_t j = 0; j < gm_.points[k].size(); ++j)
+        gm_.material[k]->init_state(std::span<double>(state_new_).subspan(gm_.state_offset[k] + j * ss, ss));
+    }
+    state_old_ = state_new_;
+    build_nonlocal();
+    const double p_scale = std::max(1.0, pm_.p_.back());
+    tol_Pa_ = 1e-7 * p_scale;
+    tol_theta_ = 1e-9 * std::max(1.0, pm_.theta_.back());
+  }
+
+  /// Equilibrium at (t, p) after a physical step dt from the committed state, committed: a
+  /// bracketed secant (Illinois) on the scalar residual.
+  void solve(double t, double dt, double p);
+  double theta() const { return theta_; }
+  const PathRunStats& stats() const { return st_; }
+
+ private:
+  /// Non-local drivers (engine/nonlocal.h) over the reduced model's own quadrature points, with
+  /// their (importance-sampling) weights as volumes; the same protocol as the FEM's
+  /// Assembler::update_nonlocal, after every committed state.
+  void build_nonlocal();
+  void update_nonlocal(double theta);
+  /// Equilibrium residual in pressure units (Pa): p_el + (G_model - G_ref - g.S') / V' - p.
+  double residual(double theta, double p, const TimeStep& ts);
+  /// A trial point leaving the traced path stops at its end first (see solve).
+  double keep_on_path(double from, double to) const {
+    if (from > pm_.theta_.front() && to < pm_.theta_.front()) return pm_.theta_.front();
+    if (from < pm_.theta_.back() && to > pm_.theta_.back()) return pm_.theta_.back();
+    return to;
+  }
+  /// Secant extrapolation from (x0, f0), (x1, f1) until the root is bracketed or the secant has
+  /// converged from one side; throws PhysicsError when it finds none.
+  void bracket_root(double& x0, double& f0, double& x1, double& f1, double slope, double t, double p,
+                    const TimeStep& ts);
+  /// Illinois false position inside the bracket [x0, x1].
+  void illinois(double& x0, double& f0, double& x1, double& f1, double p, const TimeStep& ts);
+
+  const PathModel& pm_;
+  const Model& model_;
+  const std::size_t np_;
+  const Groups gm_;  ///< the model's points by material
+  const Groups gr_;  ///< the reference's, for extrapolation beyond the path
+  std::vector<double> state_old_, state_new_;
+  std::vector<std::pair<int, std::size_t>> pt_slot_;  ///< (group, index within it) per point
+  std::unique_ptr<NonlocalAverage> nonlocal_;
+  std::vector<Mat3> Fbuf_, dFbuf_;
+  std::vector<PointResponse> rbuf_;
+  PathRunStats st_;
+  double tol_Pa_ = 0.0, tol_theta_ = 0.0;
+  double theta_ = 0.0;  ///< the committed angle
+  double ratio_ = 1.0;  ///< the softening ratio seen at the last step (the secant's first slope)
+};
+
+void PathModel::Run::build_nonlocal() {
+  for (std::size_t k = 0; k < gm_.material.size(); ++k)
+    for (std::size_t j = 0; j < gm_.points[k].size(); ++j) pt_slot_[gm_.points[k][j]] = {static_cast<int>(k), j};
+  std::map<std::pair<std::string, double>, int> group_of;
+  std::vector<double> radius;
+  std::vector<NonlocalAverage::Point> pts(np_);
+  const Mesh& mesh = pm_.ref_.mesh;
+  const auto rule = tet_rule(mesh.type);
+  std::array<double, 10> N{};
+  std::array<double, 30> dN{};
+  for (std::size_t i = 0; i < np_; ++i) {
+    const Material::NonlocalSpec spec = gm_.material[pt_slot_[i].first]->nonlocal();
+    if (!(spec.radius_m > 0.0)) continue;
+    const auto [it, added] = group_of.emplace(std::make_pair(spec.kind, spec.radius_m), static_cast<int>(radius.size()));
+    if (added) radius.push_back(spec.radius_m);
+    const int e = pm_.pt_element_[i], npe = mesh.npe();
+    const int q = pm_.pt_qp_[i];
+    tet_shape(mesh.type, rule[q].xi, rule[q].eta, rule[q].zeta, N.data(), dN.data());
+    for (int a = 0; a < npe; ++a) pts[i].X += N[a] * mesh.X[mesh.element(e)[a]];
+    pts[i].volume_m3 = pm_.pt_weight_[i];
+    pts[i].group = it->second;
+  }
+  if (!radius.empty()) nonlocal_ = std::make_unique<NonlocalAverage>(pts, radius);
+}
+
+void PathModel::Run::update_nonlocal(double theta) {
+  if (!nonlocal_) return;
+  const int k = pm_.segment(theta);
+  const double a = (theta - pm_.theta_[k]) / (pm_.theta_[k + 1] - pm_.theta_[k]);
+  const PathSegment seg = path_segment(pm_.F_, pm_.dF_, pm_.theta_, np_, static_cast<std::size_t>(k), a);
+  std::vector<double> X(np_, 0.0), Xbar(np_, 0.0);
+  Mat3 dF;
+  auto point_state = [&](std::size_t i) {
+    const auto [gi, j] = pt_slot_[i];
+    const std::size_t ss = static_cast<std::size_t>(gm_.material[gi]->state_size());
+    return std::span<double>(state_old_).subspan(gm_.state_offset[gi] + j * ss, ss);
+  };
+  for (std::size_t i = 0; i < np_; ++i)
+    X[i] = gm_.material[pt_slot_[i].first]->nonlocal_driver(seg.F(static_cast<int>(i), &dF), point_state(i));
+  nonlocal_->average(X, Xbar);
+  for (std::size_t i = 0; i < np_; ++i)
+    gm_.material[pt_slot_[i].first]->set_nonlocal_driver(point_state(i), X[i], Xbar[i]);
+}
+
+double PathModel::Run::residual(double theta, double p, const TimeStep& ts) {
+  ++st_.evaluations;
+  const std::vector<double>& th = pm_.theta_;
+  const int k = pm_.segment(theta);
+  const double dth = th[k + 1] - th[k], a = (theta - th[k]) / dth;
+  const bool inside = a >= 0.0 && a <= 1.0;
+  const PathSegment seg = path_segment(pm_.F_, pm_.dF_, th, np_, static_cast<std::size_t>(k), a);
+  // p_el with the monotone slopes (beyond the ends the end slopes are the end chords);
+  // V'(theta) and S'(theta) of the same spline as F (a chord slope would jump at the samples
+  // just as F' did); the chord if the cubic's slope is not positive (not seen).
+  double dp = 0.0, dV = 0.0;
+  const double p_el = seg.h(pm_.p_[k], pm_.p_[k + 1], pm_.dp_dtheta_[k], pm_.dp_dtheta_[k + 1], &dp);
+  seg.h(pm_.V_[k], pm_.V_[k + 1], pm_.dV_[k], pm_.dV_[k + 1], &dV);
+  if (!(dV > 0.0)) dV = (pm_.V_[k + 1] - pm_.V_[k]) / dth;
+  Eigen::Vector3d dS;
+  seg.h(pm_.S_[k], pm_.S_[k + 1], pm_.dS_[k], pm_.dS_[k + 1], &dS);
+  const double gS = model_.gravity_m_s2.dot(dS);
+  const double Gm =
+      generalised_force(gm_, seg, pm_.pt_weight_, pm_.pt_element_, ts, &state_old_, &state_new_, Fbuf_, dFbuf_, rbuf_);
+  double Gr = 0.0;
+  if (inside) {  // cached reference force, linear between kRefSub sub-points
+    const double x = a * kRefSub;
+    const int j = std::min(static_cast<int>(x), kRefSub - 1);
+    const double* c = pm_.Gref_.data() + static_cast<std::size_t>(k) * (kRefSub + 1);
+    Gr = c[j] + (x - j) * (c[j + 1] - c[j]);
+  } else {
+    Gr = generalised_force(gr_, seg, pm_.pt_weight_, pm_.pt_element_, TimeStep{}, nullptr, nullptr, Fbuf_, dFbuf_, rbuf_);
+  }
+  const double dG = Gm - Gr;
+  return p_el + (dG - gS) / dV - p;
+}
+
+void PathModel::Run::bracket_root(double& x0, double& f0, double& x1, double& f1, double slope, double t, double p,
+                                  const TimeStep& ts) {
+  int it = 0;
+  const double span = pm_.theta_.back() - pm_.theta_.front();
+  while (f0 * f1 > 0.0 && std::abs(f1) > tol_Pa_) {
+    if (++it > 60 || std::abs(x1) > 20.0 * span + 360.0)
+      throw PhysicsError("reduced model: no equilibrium on the elastic path at t = " + std::to_string(t) +
+                             " s, p = " + std::to_string(p) + " Pa (the softened model may have passed its limit "
+                             "point); use the full FEM (pneufem simulate) to check this case",
+                         -1, t);
+    double s = (f1 - f0) / (x1 - x0);
+    if (!(s > 0.0)) s = slope;
+    double x2 = x1 - f1 / s;
+    const double max_step = 4.0 * std::abs(x1 - x0) + 1.0;
+    x2 = keep_on_path(x1, std::clamp(x2, x1 - max_step, x1 + max_step));
+    x0 = x1, f0 = f1;
+    x1 = x2, f1 = residual(x1, p, ts);
+  }
+}
+
+void PathModel::Run::illinois(double& x0, double& f0, double& x1, double& f1, double p, const TimeStep& ts) {
+  int side = 0;
+  for (int it = 0; it < 100 && std::abs(f1) > tol_Pa_ && std::abs(x1 - x0) > tol_theta_; ++it) {
+    const double x2 = (x0 * f1 - x1 * f0) / (f1 - f0);
+    const double f2 = residual(x2, p, ts);
+    if (f2 * f1 < 0.0) {
+      x0 = x1, f0 = f1;
+      side = 0;
+    } else if (++side >= 2) {
+      f0 *= 0.5;
+    }
+    x1 = x2, f1 = f2;
+  }
+}
+
+void PathModel::Run::solve(double t, double dt, double p) {
+  const TimeStep ts{t, dt};
+  const std::vector<double>& th = pm_.theta_;
+  double x0 = theta_, f0 = residual(x0, p, ts);
+  if (std::abs(f0) > tol_Pa_) {
+    const int k = pm_.segment(x0);
+    // Initial slope: the elastic path's, times the softening ratio seen at the last step.
+    const double slope = ratio_ * (pm_.p_[k + 1] - pm_.p_[k]) / (th[k + 1] - th[k]);
+    // A trial point leaving the traced path stops at its end first (keep_on_path): inside the path
+    // the residual is the model's, outside it an extrapolation, and a secant step that overshoots
+    // (strongly softened or recovering states, a vent from the top level to 0) must not find a
+    // spurious root out there. At theta = 0 the residual is -p (no stress in the undeformed
+    // state), so a drop in pressure is always bracketed inside the path.
+    double x1 = keep_on_path(x0, x0 - f0 / slope), f1 = residual(x1, p, ts);
+    // Extrapolate until the root is bracketed, or the secant has converged from one side (it
+    // often does on a smooth residual; without this exit it would stall and report no root).
+    bracket_root(x0, f0, x1, f1, slope, t, p, ts);
+    illinois(x0, f0, x1, f1, p, ts);
+    if (x1 != x0) {
+      const int kk = pm_.segment(x1);
+      const double s_el = (pm_.p_[kk + 1] - pm_.p_[kk]) / (th[kk + 1] - th[kk]);
+      const double s_now = (f1 - f0) / (x1 - x0);
+      if (s_now > 0.0 && std::isfinite(s_now)) ratio_ = std::clamp(s_now / s_el, 0.05, 20.0);
+    }
+    x0 = x1;
+    residual(x0, p, ts);  // leaves the root's trial state in state_new_
+  }
+  theta_ = x0;
+  if (theta_ > th.back() || theta_ < th.front()) st_.beyond_path = true;
+  state_old_.swap(state_new_);  // commit
+  update_nonlocal(theta_);
+  ++st_.steps;
+}
+
 std::vector<double> PathModel::run(const Model& model, const PathLoad& load, PathRunStats* stats) const {
   if (model.mesh.num_elements() != ref_.mesh.num_elements() || model.mesh.num_nodes() != ref_.mesh.num_nodes())
     throw InputError("path model: the model's mesh differs from the reference mesh the path was traced on");
@@ -294,181 +515,22 @@ std::vector<double> PathModel::run(const Model& model, const PathLoad& load, Pat
   for (std::size_t i = 1; i < load.t_s.size(); ++i)
     if (!(load.t_s[i] > load.t_s[i - 1])) throw InputError("path model: load times must increase strictly");
 
-  const std::size_t np = pt_element_.size();
-  const Groups gm = group_points(model, pt_element_);
-  const Groups gr = group_points(ref_, pt_element_);  // for extrapolation beyond the path
-  std::vector<double> state_old(gm.state_size), state_new(gm.state_size);
-  for (std::size_t k = 0; k < gm.material.size(); ++k) {
-    const int ss = gm.material[k]->state_size();
-    for (std::size_t j = 0; j < gm.points[k].size(); ++j)
-      gm.material[k]->init_state(std::span<double>(state_new).subspan(gm.state_offset[k] + j * ss, ss));
-  }
-  state_old = state_new;
-  PathRunStats st;
-  std::vector<Mat3> Fbuf, dFbuf;
-  std::vector<PointResponse> rbuf;
-
-  // Non-local drivers (engine/nonlocal.h) over the reduced model's own quadrature
-  // points, with their (importance-sampling) weights as volumes; the same protocol as the
-  // FEM's Assembler::update_nonlocal, after every committed state.
-  std::unique_ptr<NonlocalAverage> nonlocal;
-  std::vector<std::pair<int, std::size_t>> pt_slot(np, {-1, 0});  // (group, index within it) per point
-  for (std::size_t k = 0; k < gm.material.size(); ++k)
-    for (std::size_t j = 0; j < gm.points[k].size(); ++j) pt_slot[gm.points[k][j]] = {static_cast<int>(k), j};
-  {
-    std::map<std::pair<std::string, double>, int> group_of;
-    std::vector<double> radius;
-    std::vector<NonlocalAverage::Point> pts(np);
-    const auto rule = tet_rule(ref_.mesh.type);
-    std::array<double, 10> N{};
-    std::array<double, 30> dN{};
-    for (std::size_t i = 0; i < np; ++i) {
-      const Material::NonlocalSpec spec = gm.material[pt_slot[i].first]->nonlocal();
-      if (!(spec.radius_m > 0.0)) continue;
-      const auto [it, added] = group_of.emplace(std::make_pair(spec.kind, spec.radius_m), static_cast<int>(radius.size()));
-      if (added) radius.push_back(spec.radius_m);
-      const int e = pt_element_[i], npe = ref_.mesh.npe();
-      tet_shape(ref_.mesh.type, rule[pt_qp_[i]].xi, rule[pt_qp_[i]].eta, rule[pt_qp_[i]].zeta, N.data(), dN.data());
-      for (int a = 0; a < npe; ++a) pts[i].X += N[a] * ref_.mesh.X[ref_.mesh.element(e)[a]];
-      pts[i].volume_m3 = pt_weight_[i];
-      pts[i].group = it->second;
-    }
-    if (!radius.empty()) nonlocal = std::make_unique<NonlocalAverage>(pts, radius);
-  }
-  auto update_nonlocal = [&](double theta) {
-    if (!nonlocal) return;
-    const int k = segment(theta);
-    const double a = (theta - theta_[k]) / (theta_[k + 1] - theta_[k]);
-    const PathSegment seg = path_segment(F_, dF_, theta_, np, static_cast<std::size_t>(k), a);
-    std::vector<double> X(np, 0.0), Xbar(np, 0.0);
-    Mat3 dF;
-    auto point_state = [&](std::size_t i) {
-      const auto [gi, j] = pt_slot[i];
-      const std::size_t ss = static_cast<std::size_t>(gm.material[gi]->state_size());
-      return std::span<double>(state_old).subspan(gm.state_offset[gi] + j * ss, ss);
-    };
-    for (std::size_t i = 0; i < np; ++i)
-      X[i] = gm.material[pt_slot[i].first]->nonlocal_driver(seg.F(static_cast<int>(i), &dF), point_state(i));
-    nonlocal->average(X, Xbar);
-    for (std::size_t i = 0; i < np; ++i) gm.material[pt_slot[i].first]->set_nonlocal_driver(point_state(i), X[i], Xbar[i]);
-  };
-
-  // Equilibrium residual in pressure units (Pa): p_el + (G_model - G_ref - g.S') / V' - p.
-  auto residual = [&](double theta, double p, const TimeStep& ts) {
-    ++st.evaluations;
-    const int k = segment(theta);
-    const double dth = theta_[k + 1] - theta_[k], a = (theta - theta_[k]) / dth;
-    const bool inside = a >= 0.0 && a <= 1.0;
-    const PathSegment seg = path_segment(F_, dF_, theta_, np, static_cast<std::size_t>(k), a);
-    // p_el with the monotone slopes (beyond the ends the end slopes are the end chords);
-    // V'(theta) and S'(theta) of the same spline as F (a chord slope would jump at the samples
-    // just as F' did); the chord if the cubic's slope is not positive (not seen).
-    double dp = 0.0, dV = 0.0;
-    const double p_el = seg.h(p_[k], p_[k + 1], dp_dtheta_[k], dp_dtheta_[k + 1], &dp);
-    seg.h(V_[k], V_[k + 1], dV_[k], dV_[k + 1], &dV);
-    if (!(dV > 0.0)) dV = (V_[k + 1] - V_[k]) / dth;
-    Eigen::Vector3d dS;
-    seg.h(S_[k], S_[k + 1], dS_[k], dS_[k + 1], &dS);
-    const double gS = model.gravity_m_s2.dot(dS);
-    const double Gm = generalised_force(gm, seg, pt_weight_, pt_element_, ts, &state_old, &state_new, Fbuf, dFbuf, rbuf);
-    double Gr = 0.0;
-    if (inside) {  // cached reference force, linear between kRefSub sub-points
-      const double x = a * kRefSub;
-      const int j = std::min(static_cast<int>(x), kRefSub - 1);
-      const double* c = Gref_.data() + static_cast<std::size_t>(k) * (kRefSub + 1);
-      Gr = c[j] + (x - j) * (c[j + 1] - c[j]);
-    } else {
-      Gr = generalised_force(gr, seg, pt_weight_, pt_element_, TimeStep{}, nullptr, nullptr, Fbuf, dFbuf, rbuf);
-    }
-    const double dG = Gm - Gr;
-    return p_el + (dG - gS) / dV - p;
-  };
-
-  const double p_scale = std::max(1.0, p_.back());
-  const double tol_Pa = 1e-7 * p_scale, tol_theta = 1e-9 * std::max(1.0, theta_.back());
-  double theta = 0.0, ratio = 1.0;
+  Run run(*this, model);
   std::vector<double> out;
   out.reserve(load.t_s.size());
-  // Equilibrium at (t, p) after a physical step dt from the committed state: a bracketed secant
-  // (Illinois) on the scalar residual; leaves the trial state of the root in state_new.
-  auto solve = [&](double t, double dt, double p) {
-    const TimeStep ts{t, dt};
-    double x0 = theta, f0 = residual(x0, p, ts);
-    if (std::abs(f0) > tol_Pa) {
-      const int k = segment(x0);
-      // Initial slope: the elastic path's, times the softening ratio seen at the last step.
-      double slope = ratio * (p_[k + 1] - p_[k]) / (theta_[k + 1] - theta_[k]);
-      // A trial point leaving the traced path stops at its end first: inside the path the residual
-      // is the model's, outside it an extrapolation, and a secant step that overshoots (strongly
-      // softened or recovering states, a vent from the top level to 0) must not find a spurious
-      // root out there. At theta = 0 the residual is -p (no stress in the undeformed state), so a
-      // drop in pressure is always bracketed inside the path.
-      auto keep_on_path = [&](double from, double to) {
-        if (from > theta_.front() && to < theta_.front()) return theta_.front();
-        if (from < theta_.back() && to > theta_.back()) return theta_.back();
-        return to;
-      };
-      double x1 = keep_on_path(x0, x0 - f0 / slope), f1 = residual(x1, p, ts);
-      int it = 0;
-      const double span = theta_.back() - theta_.front();
-      // Extrapolate until the root is bracketed, or the secant has converged from one side (it
-      // often does on a smooth residual; without this exit it would stall and report no root).
-      while (f0 * f1 > 0.0 && std::abs(f1) > tol_Pa) {
-        if (++it > 60 || std::abs(x1) > 20.0 * span + 360.0)
-          throw PhysicsError("reduced model: no equilibrium on the elastic path at t = " + std::to_string(t) +
-                                 " s, p = " + std::to_string(p) + " Pa (the softened model may have passed its limit "
-                                 "point); use the full FEM (pneufem simulate) to check this case",
-                             -1, t);
-        double s = (f1 - f0) / (x1 - x0);
-        if (!(s > 0.0)) s = slope;
-        double x2 = x1 - f1 / s;
-        const double max_step = 4.0 * std::abs(x1 - x0) + 1.0;
-        x2 = keep_on_path(x1, std::clamp(x2, x1 - max_step, x1 + max_step));
-        x0 = x1, f0 = f1;
-        x1 = x2, f1 = residual(x1, p, ts);
-      }
-      // Illinois false position inside [x0, x1].
-      int side = 0;
-      for (it = 0; it < 100 && std::abs(f1) > tol_Pa && std::abs(x1 - x0) > tol_theta; ++it) {
-        const double x2 = (x0 * f1 - x1 * f0) / (f1 - f0);
-        const double f2 = residual(x2, p, ts);
-        if (f2 * f1 < 0.0) {
-          x0 = x1, f0 = f1;
-          side = 0;
-        } else if (++side >= 2) {
-          f0 *= 0.5;
-        }
-        x1 = x2, f1 = f2;
-      }
-      if (x1 != x0) {
-        const int kk = segment(x1);
-        const double s_el = (p_[kk + 1] - p_[kk]) / (theta_[kk + 1] - theta_[kk]);
-        const double s_now = (f1 - f0) / (x1 - x0);
-        if (s_now > 0.0 && std::isfinite(s_now)) ratio = std::clamp(s_now / s_el, 0.05, 20.0);
-      }
-      x0 = x1;
-      residual(x0, p, ts);  // leaves the root's trial state in state_new
-    }
-    theta = x0;
-    if (theta > theta_.back() || theta < theta_.front()) st.beyond_path = true;
-    state_old.swap(state_new);  // commit
-    update_nonlocal(theta);
-    ++st.steps;
-  };
-
-  solve(load.t_s[0], 0.0, load.p_Pa[0]);
-  out.push_back(theta);
+  run.solve(load.t_s[0], 0.0, load.p_Pa[0]);
+  out.push_back(run.theta());
   for (std::size_t i = 1; i < load.t_s.size(); ++i) {
     const double t0 = load.t_s[i - 1], t1 = load.t_s[i];
     const int m = std::max(1, static_cast<int>(std::ceil((t1 - t0) / opt_.max_dt_s - 1e-9)));
     for (int j = 1; j <= m; ++j) {
       const double f = static_cast<double>(j) / m;
       const double t = t0 + f * (t1 - t0);
-      solve(t, (t1 - t0) / m, load.p_Pa[i - 1] + f * (load.p_Pa[i] - load.p_Pa[i - 1]));
+      run.solve(t, (t1 - t0) / m, load.p_Pa[i - 1] + f * (load.p_Pa[i] - load.p_Pa[i - 1]));
     }
-    out.push_back(theta);
+    out.push_back(run.theta());
   }
-  if (stats) *stats = st;
+  if (stats) *stats = run.stats();
   return out;
 }
 

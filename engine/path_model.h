@@ -46,6 +46,8 @@
 
 namespace pneufem {
 
+class Assembler;
+
 struct PathModelOptions {
   double p_top_Pa = 60e3;        ///< trace the elastic path up to this pressure (or the limit point)
   double dp_Pa = 1000.0;         ///< pressure spacing of the path samples
@@ -101,6 +103,16 @@ class PathModel {
 
  private:
   int segment(double theta) const;  ///< path segment holding theta (clamped: linear extrapolation)
+  // The constructor's three steps (path_model.cpp).
+  /// 1. The trace checked against the reference (throws InputError) into theta_, p_, V_, S_.
+  void take_trace(const Assembler& asmb, const ElasticPathTrace& trace);
+  /// 2. The material points (all, or the importance sample above max_points): pt_element_, pt_qp_, pt_weight_.
+  void choose_points(const Assembler& asmb, const Eigen::VectorXd& u_top);
+  /// 3. F_ at the points of every sample, the spline slopes, dp_dtheta_ and the reference force Gref_.
+  void precompute_path(const Assembler& asmb, const std::vector<Eigen::VectorXd>& us);
+  /// One run() of a model through a load: its history, non-local drivers, residual and the scalar
+  /// root finder (path_model.cpp).
+  class Run;
 
   const Model& ref_;
   PathModelOptions opt_;

@@ -285,25 +285,165 @@ void QuasiStaticRun::equilibrium(double p0, double p1, double t0, double t1) {
   ++stats_.states;
 }
 
+void QuasiStaticRun::solve_instant_segment(const Segment& s) {
+  const double span = s.g1 - s.g0;
+  const bool drive_control = opt_.time_control == TimeControl::Drive;
+  const bool solved = span > 0.0 || s.p0 != s.p1;
+  if (solved) equilibrium(s.p0, s.p1, s.g0, s.g1);
+  if (drive_control && !solved) return;  // nothing changed: the control's memory is still valid
+  hist_prev_.clear();  // a jump or an elastic state: the history memory is stale
+  hist_cur_.clear();
+  drive_prev_.clear();
+  drive_cur_.clear();
+  damage_grew_ = false;  // rates start afresh after a jump (a release stops the damage)
+  if (drive_control) unchecked_.assign(unchecked_.size(), 0.0);  // a new trial's budget
+  ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
+}
+
+PhysicsError QuasiStaticRun::stalled(const Segment& s, double t, double last_h, double last_change,
+                                     int last_element) const {
+  std::ostringstream m;
+  m << "physical time stepping stalled: " << opt_.max_segment_steps << " steps in the load segment "
+    << s.g0 << " -> " << s.g1 << " s (global time; pressure " << s.p0 * 1e-3 << " -> " << s.p1 * 1e-3
+    << " kPa) reached only t = " << t << " s; last step " << last_h << " s with a history change of "
+    << last_change << " (time_tol " << opt_.time_tol << ")";
+  if (last_element >= 0) m << ", fastest at " << asm_.model().mesh.element_label(last_element);
+  m << ". Hint: "
+    << "damage or viscous strain there changes faster than time_tol per min_dt_s (a point running away: "
+       "check the damage constants, e.g. a smaller fatigue rate or a saturating law, fatigue.n > 1), or "
+       "raise solver.time_tol / solver.max_segment_steps if the history is meant to change this fast";
+  return PhysicsError(m.str(), last_element, t);
+}
+
+struct QuasiStaticRun::StepMeasure {
+  std::vector<double> hist_new;       ///< the history's scalars after the step
+  std::vector<double> drive_new;      ///< drive control: the linear drives after the step
+  std::vector<double> unchecked_new;  ///< drive control: the points' unchecked budgets after the step
+  double change = 0.0;                ///< the largest change of a point's history
+  double measure = 0.0;               ///< what time_tol bounds: the change or the error estimate
+  double order = 1.0;                 ///< how the measure scales with h
+  int worst_point = -1;               ///< the point of the measure (-1: none)
+  bool estimate = false;              ///< the measure is an error estimate (a previous step is known)
+  double ed_max = 0.0;                ///< drive control: the largest damage error (predicts the next step)
+  std::vector<double> c_kind;         ///< drive control: the largest |D''| per drive kind
+  bool damage_grew = false;           ///< drive control: a point's damage changed
+};
+
+QuasiStaticRun::StepMeasure QuasiStaticRun::measure_step(const std::vector<double>& state_saved, double h,
+                                                         bool hold_start) {
+  // Error control with a previous step at the same load rate bounds the local-error estimate;
+  // otherwise time_tol bounds the change. `order`: how the measure scales with h.
+  StepMeasure sm;
+  sm.hist_new = asm_.history_scalars(state_);
+  if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
+  if (opt_.time_control == TimeControl::Drive) {
+    measure_drive_step(state_saved, h, hold_start, sm);
+    return sm;
+  }
+  const bool error_control = opt_.time_control == TimeControl::Error;
+  sm.estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
+  static const std::vector<double> kNoPrevious;
+  const HistoryStep hs =
+      history_step(sm.estimate ? hist_prev_ : kNoPrevious, hist_cur_, sm.hist_new, sm.estimate ? h / h_prev_ : 0.0);
+  sm.change = hs.change, sm.measure = sm.estimate ? hs.error : hs.change, sm.order = sm.estimate ? 2.0 : 1.0;
+  sm.worst_point = sm.estimate ? hs.error_point : hs.change_point;
+  return sm;
+}
+
+void QuasiStaticRun::measure_drive_step(const std::vector<double>& state_saved, double h, bool hold_start,
+                                        StepMeasure& sm) {
+  const std::vector<double>& hist_new = sm.hist_new;
+  double &change = sm.change, &measure = sm.measure, &ed_max = sm.ed_max;
+  int& worst_point = sm.worst_point;
+  std::vector<double>& c_kind = sm.c_kind;
+  std::vector<double>& drive_new = sm.drive_new;
+  std::vector<double>& unchecked_new = sm.unchecked_new;
+  drive_new = asm_.linear_drives(state_);
+  if (drive_cur_.empty()) drive_cur_ = asm_.linear_drives(state_saved);
+  const bool estimate = sm.estimate = !hist_prev_.empty() && !drive_prev_.empty() && h_prev_ > 0.0;
+  c_kind.assign(drive_kinds_.size(), 0.0);
+  const double r = estimate ? h / h_prev_ : 0.0;
+  // Only the damage's change counts on a hold's first step: the viscous strain's is bounded by
+  // the step's length (first_hold_step).
+  const bool damage_only = hold_start && !estimate;
+  const int n = static_cast<int>(hist_new.size() / 2);
+  if (unchecked_.size() != static_cast<std::size_t>(n)) unchecked_.assign(static_cast<std::size_t>(n), 0.0);
+  unchecked_new = unchecked_;
+  int change_point = -1;
+  sm.damage_grew = false;
+  for (int p = 0; p < n; ++p) {
+    const std::size_t i = 2 * static_cast<std::size_t>(p);
+    const double dd = hist_new[i] - hist_cur_[i];
+    const double c = std::abs(dd) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
+    if (c > change) change = c, change_point = p;
+    if (dd != 0.0) sm.damage_grew = true;
+    double m = 0.0;
+    const int kind = drive_kind_[static_cast<std::size_t>(p)];
+    // The stress (in viscous-strain units) this step's damage change can move: |dd| |S0_undamaged|
+    // / (2 mu_inf) = |dd| max(|D|, |D'|) / (1 - d'), and whether the point's unchecked budget
+    // (engine/quasi_static.h) still covers it.
+    double moved = 0.0;
+    if (dd != 0.0 && kind >= 0) {
+      double n0 = 0.0, n1 = 0.0;
+      for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j)
+        n0 += drive_cur_[j] * drive_cur_[j], n1 += drive_new[j] * drive_new[j];
+      moved = std::abs(dd) * std::sqrt(std::max(n0, n1)) / std::max(1e-12, 1.0 - hist_new[i]);
+    }
+    const bool damaging = dd != 0.0 || (estimate && hist_cur_[i] != hist_prev_[i]);
+    const bool within_budget = kind >= 0 && unchecked_[static_cast<std::size_t>(p)] + moved <= opt_.time_tol;
+    const bool proxy = estimate && damaging && !within_budget;
+    if (estimate && damaging && !proxy) unchecked_new[static_cast<std::size_t>(p)] += moved;
+    if (proxy) {
+      // A damaging point: Milne's estimate on damage and viscous strain, as the error control.
+      for (std::size_t k = i; k < i + 2; ++k)
+        m += std::abs((hist_new[k] - hist_cur_[k]) - r * (hist_cur_[k] - hist_prev_[k]));
+      m *= r / (1.0 + r);
+      ed_max = std::max(ed_max, m);
+    } else if (estimate) {
+      const int k = kind;
+      if (k >= 0) {
+        double c2 = 0.0;
+        for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j) {
+          const double d2 = 2.0 * ((drive_new[j] - drive_cur_[j]) / h - (drive_cur_[j] - drive_prev_[j]) / h_prev_) / (h + h_prev_);
+          c2 += d2 * d2;
+        }
+        const double curvature = std::sqrt(c2);
+        c_kind[static_cast<std::size_t>(k)] = std::max(c_kind[static_cast<std::size_t>(k)], curvature);
+        m += linear_drive_error(drive_kinds_[static_cast<std::size_t>(k)], curvature, h);
+      }
+    } else {
+      m = damage_only ? std::abs(dd) : c;
+    }
+    if (m > measure) measure = m, worst_point = p;
+  }
+  if (!estimate && worst_point < 0) worst_point = change_point;
+}
+
+double QuasiStaticRun::next_step(double h, const StepMeasure& sm, bool rejected) const {
+  const bool drive_estimate = opt_.time_control == TimeControl::Drive && sm.estimate;
+  if (rejected) {
+    if (drive_estimate)
+      return std::max(opt_.min_dt_s, drive_step(h, sm.ed_max, sm.c_kind, 0.9 * opt_.time_tol, 0.2 * h, h));
+    return std::max(opt_.min_dt_s, h * std::max(0.2, std::pow(0.9 * opt_.time_tol / sm.measure, 1.0 / sm.order)));
+  }
+  if (drive_estimate)
+    return std::clamp(drive_step(h, sm.ed_max, sm.c_kind, 0.9 * opt_.time_tol, 0.5 * h, 2.0 * h), opt_.min_dt_s,
+                      opt_.max_dt_s);
+  const double grow =
+      sm.measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / sm.measure, 1.0 / sm.order), 0.5, 2.0) : 2.0;
+  return std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
+}
+
+// One loop of ~100 lines, on purpose: a step's save of u_, state_ and the Newton path, its solve, its
+// measure and its rejection (restore) or acceptance share that saved state; the parts with a name of
+// their own (the instant segment, the measures, the next step, the stall message) are functions.
 void QuasiStaticRun::solve_segment(const Segment& s) {
   // A segment starts from what a checkpoint holds, and the factorisation is not in it: forgetting
   // it here makes a resumed run continue bit for bit from any segment boundary (engine/quasi_static.h).
   newton_.forget_factor();
   const double span = s.g1 - s.g0;
   const bool drive_control = opt_.time_control == TimeControl::Drive;
-  if (!rate_dependent_ || span <= 0.0) {
-    const bool solved = span > 0.0 || s.p0 != s.p1;
-    if (solved) equilibrium(s.p0, s.p1, s.g0, s.g1);
-    if (drive_control && !solved) return;  // nothing changed: the control's memory is still valid
-    hist_prev_.clear();  // a jump or an elastic state: the history memory is stale
-    hist_cur_.clear();
-    drive_prev_.clear();
-    drive_cur_.clear();
-    damage_grew_ = false;  // rates start afresh after a jump (a release stops the damage)
-    if (drive_control) unchecked_.assign(unchecked_.size(), 0.0);  // a new trial's budget
-    ramp_start_dp_[0] = ramp_start_dp_[1] = 0.0;  // a release: the next ramps start a new climb
-    return;
-  }
+  if (!rate_dependent_ || span <= 0.0) return solve_instant_segment(s);
   auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
   if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
   const bool error_control = opt_.time_control == TimeControl::Error;
@@ -334,19 +474,7 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   double last_change = 0.0, last_h = 0.0;
   int last_element = -1;
   while (t < s.g1 - 1e-12 * (1.0 + std::abs(s.g1))) {
-    if (++steps > opt_.max_segment_steps) {
-      std::ostringstream m;
-      m << "physical time stepping stalled: " << opt_.max_segment_steps << " steps in the load segment "
-        << s.g0 << " -> " << s.g1 << " s (global time; pressure " << s.p0 * 1e-3 << " -> " << s.p1 * 1e-3
-        << " kPa) reached only t = " << t << " s; last step " << last_h << " s with a history change of "
-        << last_change << " (time_tol " << opt_.time_tol << ")";
-      if (last_element >= 0) m << ", fastest at " << asm_.model().mesh.element_label(last_element);
-      m << ". Hint: "
-        << "damage or viscous strain there changes faster than time_tol per min_dt_s (a point running away: "
-           "check the damage constants, e.g. a smaller fatigue rate or a saturating law, fatigue.n > 1), or "
-           "raise solver.time_tol / solver.max_segment_steps if the history is meant to change this fast";
-      throw PhysicsError(m.str(), last_element, t);
-    }
+    if (++steps > opt_.max_segment_steps) throw stalled(s, t, last_h, last_change, last_element);
     // A step is "minimal" when the control already asks for min_dt_s: it is then accepted whatever
     // the history change (or the run stops if its equilibrium fails). Testing h instead would loop
     // forever when the sliver rule below stretches a minimal step just above min_dt_s: rejected,
@@ -373,109 +501,22 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       ++stats_.rejected_steps;
       continue;
     }
-    // Error control with a previous step at the same load rate bounds the local-error estimate;
-    // otherwise time_tol bounds the change. `order`: how the measure scales with h.
-    std::vector<double> hist_new = asm_.history_scalars(state_);
-    if (hist_cur_.empty()) hist_cur_ = asm_.history_scalars(state_saved);
-    std::vector<double> drive_new, unchecked_new;
-    double change = 0.0, measure = 0.0, order = 1.0;
-    int worst_point = -1;
-    bool estimate = false;
-    // Drive control's prediction of the next step: the largest damage error and |D''| per kind.
-    double ed_max = 0.0;
-    std::vector<double> c_kind;
-    bool step_damage_grew = false;
-    if (!drive_control) {
-      estimate = error_control && !hist_prev_.empty() && h_prev_ > 0.0;
-      static const std::vector<double> kNoPrevious;
-      const HistoryStep hs = history_step(estimate ? hist_prev_ : kNoPrevious, hist_cur_, hist_new, estimate ? h / h_prev_ : 0.0);
-      change = hs.change, measure = estimate ? hs.error : hs.change, order = estimate ? 2.0 : 1.0;
-      worst_point = estimate ? hs.error_point : hs.change_point;
-    } else {
-      drive_new = asm_.linear_drives(state_);
-      if (drive_cur_.empty()) drive_cur_ = asm_.linear_drives(state_saved);
-      estimate = !hist_prev_.empty() && !drive_prev_.empty() && h_prev_ > 0.0;
-      c_kind.assign(drive_kinds_.size(), 0.0);
-      const double r = estimate ? h / h_prev_ : 0.0;
-      // Only the damage's change counts on a hold's first step: the viscous strain's is bounded by
-      // the step's length (first_hold_step).
-      const bool damage_only = hold_start && !estimate;
-      const int n = static_cast<int>(hist_new.size() / 2);
-      if (unchecked_.size() != static_cast<std::size_t>(n)) unchecked_.assign(static_cast<std::size_t>(n), 0.0);
-      unchecked_new = unchecked_;
-      int change_point = -1;
-      step_damage_grew = false;
-      for (int p = 0; p < n; ++p) {
-        const std::size_t i = 2 * static_cast<std::size_t>(p);
-        const double dd = hist_new[i] - hist_cur_[i];
-        const double c = std::abs(dd) + std::abs(hist_new[i + 1] - hist_cur_[i + 1]);
-        if (c > change) change = c, change_point = p;
-        if (dd != 0.0) step_damage_grew = true;
-        double m = 0.0;
-        const int kind = drive_kind_[static_cast<std::size_t>(p)];
-        // The stress (in viscous-strain units) this step's damage change can move: |dd| |S0_undamaged|
-        // / (2 mu_inf) = |dd| max(|D|, |D'|) / (1 - d'), and whether the point's unchecked budget
-        // (engine/quasi_static.h) still covers it.
-        double moved = 0.0;
-        if (dd != 0.0 && kind >= 0) {
-          double n0 = 0.0, n1 = 0.0;
-          for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j)
-            n0 += drive_cur_[j] * drive_cur_[j], n1 += drive_new[j] * drive_new[j];
-          moved = std::abs(dd) * std::sqrt(std::max(n0, n1)) / std::max(1e-12, 1.0 - hist_new[i]);
-        }
-        const bool damaging = dd != 0.0 || (estimate && hist_cur_[i] != hist_prev_[i]);
-        const bool within_budget = kind >= 0 && unchecked_[static_cast<std::size_t>(p)] + moved <= opt_.time_tol;
-        const bool proxy = estimate && damaging && !within_budget;
-        if (estimate && damaging && !proxy) unchecked_new[static_cast<std::size_t>(p)] += moved;
-        if (proxy) {
-          // A damaging point: Milne's estimate on damage and viscous strain, as the error control.
-          for (std::size_t k = i; k < i + 2; ++k)
-            m += std::abs((hist_new[k] - hist_cur_[k]) - r * (hist_cur_[k] - hist_prev_[k]));
-          m *= r / (1.0 + r);
-          ed_max = std::max(ed_max, m);
-        } else if (estimate) {
-          const int k = kind;
-          if (k >= 0) {
-            double c2 = 0.0;
-            for (std::size_t j = 6 * static_cast<std::size_t>(p); j < 6 * static_cast<std::size_t>(p) + 6; ++j) {
-              const double d2 = 2.0 * ((drive_new[j] - drive_cur_[j]) / h - (drive_cur_[j] - drive_prev_[j]) / h_prev_) / (h + h_prev_);
-              c2 += d2 * d2;
-            }
-            const double curvature = std::sqrt(c2);
-            c_kind[static_cast<std::size_t>(k)] = std::max(c_kind[static_cast<std::size_t>(k)], curvature);
-            m += linear_drive_error(drive_kinds_[static_cast<std::size_t>(k)], curvature, h);
-          }
-        } else {
-          m = damage_only ? std::abs(dd) : c;
-        }
-        if (m > measure) measure = m, worst_point = p;
-      }
-      if (!estimate && worst_point < 0) worst_point = change_point;
-    }
-    last_element = worst_point >= 0 ? asm_.element_of_point(worst_point) : -1;
-    last_change = change;
+    StepMeasure sm = measure_step(state_saved, h, hold_start);
+    last_element = sm.worst_point >= 0 ? asm_.element_of_point(sm.worst_point) : -1;
+    last_change = sm.change;
     last_h = h;
-    const bool reject = measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
+    const bool reject = sm.measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
     if (opt_.newton.verbose)
       std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history %s %.3g (tol %.3g) at %s%s\n",
-                   t + h, h, p_at(t + h) * 1e-3, estimate ? "error estimate" : "change", measure, opt_.time_tol,
+                   t + h, h, p_at(t + h) * 1e-3, sm.estimate ? "error estimate" : "change", sm.measure, opt_.time_tol,
                    last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-", reject ? " (rejected)" : "");
+    dt_suggest_ = next_step(h, sm, reject);
     if (reject) {
       u_ = u_saved;
       state_ = state_saved;
       newton_.set_path(path_saved);
-      if (drive_control && estimate)
-        dt_suggest_ = std::max(opt_.min_dt_s, drive_step(h, ed_max, c_kind, 0.9 * opt_.time_tol, 0.2 * h, h));
-      else
-        dt_suggest_ = std::max(opt_.min_dt_s, h * std::max(0.2, std::pow(0.9 * opt_.time_tol / measure, 1.0 / order)));
       ++stats_.rejected_steps;
       continue;
-    }
-    if (drive_control && estimate) {
-      dt_suggest_ = std::clamp(drive_step(h, ed_max, c_kind, 0.9 * opt_.time_tol, 0.5 * h, 2.0 * h), opt_.min_dt_s, opt_.max_dt_s);
-    } else {
-      const double grow = measure > 0.0 ? std::clamp(std::pow(0.9 * opt_.time_tol / measure, 1.0 / order), 0.5, 2.0) : 2.0;
-      dt_suggest_ = std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
     }
     // The ramp's first step, when the control (not the segment's end) set its length: the step
     // the control would now take, as a pressure increment, starts the next ramp.
@@ -487,11 +528,11 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     }
     if (drive_control) {
       drive_prev_ = std::move(drive_cur_);
-      drive_cur_ = std::move(drive_new);
-      unchecked_ = std::move(unchecked_new);
-      damage_grew_ = step_damage_grew;
+      drive_cur_ = std::move(sm.drive_new);
+      unchecked_ = std::move(sm.unchecked_new);
+      damage_grew_ = sm.damage_grew;
     }
-    hist_cur_ = std::move(hist_new);
+    hist_cur_ = std::move(sm.hist_new);
     rate_prev_ = rate;
     t += h;
   }
@@ -599,6 +640,69 @@ std::string QuasiStaticRun::failure_note() const {
   return m.str();
 }
 
+void QuasiStaticRun::restore(const QuasiStaticCheckpoint& c) {
+  dt_suggest_ = c.dt_suggest_s;
+  last_angle_ = c.last_angle_deg;
+  u_ = c.u;
+  state_ = c.state;
+  newton_.set_path({c.path_p, c.path_u});
+  stats_ = c.stats;
+  hist_prev_ = c.hist_prev;
+  hist_cur_ = c.hist_cur;
+  h_prev_ = c.h_prev_s;
+  rate_prev_ = c.rate_prev_Pa_s;
+  ramp_start_dp_[0] = c.ramp_start_dp_Pa[0];
+  ramp_start_dp_[1] = c.ramp_start_dp_Pa[1];
+  drive_prev_ = c.drive_prev;
+  drive_cur_ = c.drive_cur;
+  damage_grew_ = c.damage_grew;
+  unchecked_ = c.unchecked_damage;
+  cycle_ends_ = c.cycle_ends;
+  cycle_reports_ = c.cycle_reports;
+  trial_reports_ = c.trial_reports;
+}
+
+QuasiStaticCheckpoint QuasiStaticRun::checkpoint(std::size_t next_segment) const {
+  QuasiStaticCheckpoint c;
+  c.next_segment = next_segment;
+  c.dt_suggest_s = dt_suggest_;
+  c.last_angle_deg = last_angle_;
+  c.u = u_;
+  c.state = state_;
+  const StaticSolver::Path path = newton_.path();
+  c.path_p = path.p;
+  c.path_u = path.u;
+  c.stats = stats_;
+  c.hist_prev = hist_prev_;
+  c.hist_cur = hist_cur_;
+  c.h_prev_s = h_prev_;
+  c.rate_prev_Pa_s = rate_prev_;
+  c.ramp_start_dp_Pa[0] = ramp_start_dp_[0];
+  c.ramp_start_dp_Pa[1] = ramp_start_dp_[1];
+  c.drive_prev = drive_prev_;
+  c.drive_cur = drive_cur_;
+  c.damage_grew = damage_grew_;
+  c.unchecked_damage = unchecked_;
+  c.cycle_ends = cycle_ends_;
+  c.cycle_reports = cycle_reports_;
+  c.trial_reports = trial_reports_;
+  return c;
+}
+
+StateRecord QuasiStaticRun::report(const Segment& s) {
+  StateRecord rec;
+  rec.trial = s.trial + 1;
+  rec.time_s = s.t1;
+  rec.global_time_s = s.g1;
+  rec.pressure_Pa = s.p1;
+  const AngleResult a = bending_angle(asm_.model(), u_);
+  rec.angle_deg = unwrap_deg(a.angle_deg, last_angle_);
+  last_angle_ = rec.angle_deg;
+  rec.plane_rms_m = a.plane_rms_m;
+  rec.cavity_volume_m3 = asm_.cavity_volume(u_);
+  return rec;
+}
+
 void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, const CheckpointSink& sink,
                          const QuasiStaticCheckpoint* resume) {
   const auto wall0 = std::chrono::steady_clock::now();
@@ -612,25 +716,7 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
   double wall_before = 0.0;
   if (resume) {
     first = resume->next_segment;
-    dt_suggest_ = resume->dt_suggest_s;
-    last_angle_ = resume->last_angle_deg;
-    u_ = resume->u;
-    state_ = resume->state;
-    newton_.set_path({resume->path_p, resume->path_u});
-    stats_ = resume->stats;
-    hist_prev_ = resume->hist_prev;
-    hist_cur_ = resume->hist_cur;
-    h_prev_ = resume->h_prev_s;
-    rate_prev_ = resume->rate_prev_Pa_s;
-    ramp_start_dp_[0] = resume->ramp_start_dp_Pa[0];
-    ramp_start_dp_[1] = resume->ramp_start_dp_Pa[1];
-    drive_prev_ = resume->drive_prev;
-    drive_cur_ = resume->drive_cur;
-    damage_grew_ = resume->damage_grew;
-    unchecked_ = resume->unchecked_damage;
-    cycle_ends_ = resume->cycle_ends;
-    cycle_reports_ = resume->cycle_reports;
-    trial_reports_ = resume->trial_reports;
+    restore(*resume);
     wall_before = stats_.wall_s;
   }
   // The run starts from u = 0, which is an equilibrium only without load. When the load history
@@ -658,47 +744,13 @@ void QuasiStaticRun::run(const LoadHistory& load, const Observer& observer, cons
       throw PhysicsError(msg, e.element(), e.time_s());
     }
     if (s.report) {
-      StateRecord rec;
-      rec.trial = s.trial + 1;
-      rec.time_s = s.t1;
-      rec.global_time_s = s.g1;
-      rec.pressure_Pa = s.p1;
-      const AngleResult a = bending_angle(asm_.model(), u_);
-      rec.angle_deg = unwrap_deg(a.angle_deg, last_angle_);
-      last_angle_ = rec.angle_deg;
-      rec.plane_rms_m = a.plane_rms_m;
-      rec.cavity_volume_m3 = asm_.cavity_volume(u_);
+      const StateRecord rec = report(s);
       if (observer) observer(rec, u_, state_);
       if (jumping) trial_reports_.push_back(rec);
     }
     if (jumping && (i + 1 == segs.size() || segs[i + 1].trial != s.trial)) i = end_of_trial(segs, i, observer);
     stats_.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    if (sink) {
-      QuasiStaticCheckpoint c;
-      c.next_segment = i + 1;
-      c.dt_suggest_s = dt_suggest_;
-      c.last_angle_deg = last_angle_;
-      c.u = u_;
-      c.state = state_;
-      const StaticSolver::Path path = newton_.path();
-      c.path_p = path.p;
-      c.path_u = path.u;
-      c.stats = stats_;
-      c.hist_prev = hist_prev_;
-      c.hist_cur = hist_cur_;
-      c.h_prev_s = h_prev_;
-      c.rate_prev_Pa_s = rate_prev_;
-      c.ramp_start_dp_Pa[0] = ramp_start_dp_[0];
-      c.ramp_start_dp_Pa[1] = ramp_start_dp_[1];
-      c.drive_prev = drive_prev_;
-      c.drive_cur = drive_cur_;
-      c.damage_grew = damage_grew_;
-      c.unchecked_damage = unchecked_;
-      c.cycle_ends = cycle_ends_;
-      c.cycle_reports = cycle_reports_;
-      c.trial_reports = trial_reports_;
-      sink(c);
-    }
+    if (sink) sink(checkpoint(i + 1));
   }
   stats_.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }

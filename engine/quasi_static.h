@@ -87,6 +87,7 @@
 
 #include <Eigen/Core>
 
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/cycle_jump.h"
 #include "engine/load_history.h"
@@ -206,7 +207,33 @@ class QuasiStaticRun {
   /// the N skipped trials as extrapolated and returns the index of the last skipped segment (else i).
   std::size_t end_of_trial(const std::vector<Segment>& segs, std::size_t i, const Observer& observer);
   std::string failure_note() const;  ///< where damage laws report failed points ("" = none)
+  /// The run's state from a checkpoint (run's resume), and the checkpoint of the state after the
+  /// segments before `next_segment`: the same fields, one way and the other.
+  void restore(const QuasiStaticCheckpoint& c);
+  QuasiStaticCheckpoint checkpoint(std::size_t next_segment) const;
+  /// The state at the end of reported segment s (its angle unwrapped from the last report's).
+  StateRecord report(const Segment& s);
+  /// The segment's physical time in steps whose length the history control chooses (time_tol,
+  /// time_control), rejecting and retrying a step whose history moved too far or whose
+  /// equilibrium failed.
   void solve_segment(const Segment& s);
+  /// A segment of no physical time, or of a model without history: one equilibrium (when the load
+  /// changes), and the step control's memory reset (a jump or an elastic state makes it stale).
+  void solve_instant_segment(const Segment& s);
+  /// The PhysicsError of a segment that took more than max_segment_steps steps.
+  PhysicsError stalled(const Segment& s, double t, double last_h, double last_change, int last_element) const;
+  /// How a physical step moved the history, as the step control measures it (quasi_static.cpp).
+  struct StepMeasure;
+  /// The step control's measure of the step of length h just solved (from state_saved to state_);
+  /// hold_start: drive control's first step of a hold, where only the damage's change counts.
+  StepMeasure measure_step(const std::vector<double>& state_saved, double h, bool hold_start);
+  /// measure_step under time_control = "drive": per point, Milne's estimate where damage moves
+  /// beyond its unchecked budget, else the drives' curvature error.
+  void measure_drive_step(const std::vector<double>& state_saved, double h, bool hold_start, StepMeasure& sm);
+  /// The step the control suggests after a step of length h that `sm` measured: after a rejection
+  /// at most h (at least 0.2 h), else within [0.5 h, 2 h]; always within [min_dt_s, max_dt_s] (a
+  /// rejection: at least min_dt_s).
+  double next_step(double h, const StepMeasure& sm, bool rejected) const;
   void equilibrium(double p0, double p1, double t0, double t1);
   /// Drive control: the first step of a hold or rest, from the current viscous strains (see above).
   double first_hold_step() const;

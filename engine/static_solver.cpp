@@ -208,92 +208,104 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
     stats_.factor_s += seconds_since(t0);
     if (!ok) return rep;
 
-    // Line search on s(alpha) = du . R(u + alpha du) (works for the non-potential follower load).
-    // With a stiff layer, R is taken at the state relaxed in the layer (stiff-layer elimination):
-    // s(alpha) is then the slope of the energy with the layer in equilibrium, so the step is not cut
-    // for the layer's spurious stretch. With a potential, the step must first lower it (Armijo,
-    // sufficient-decrease constant 1e-4, the usual choice); not in the last iterations (within 100x
-    // the tolerance), where Pi changes by less than its round-off.
-    const double s0 = du.dot(R);
-    if (opt_.verbose) std::fprintf(stderr, "      |du|=%.3e max|du|=%.3e decrement du.R=%.3e\n", du.norm(), du.lpNorm<Eigen::Infinity>(), s0);
-    const bool armijo = energy_search && s0 < 0.0 && rep.residual_N > 100.0 * tol;
-    const double Pi0 = armijo ? potential_from(W0, p, u) : 0.0;
-    double alpha = 1.0;
-    Eigen::VectorXd u_try;
-    for (int ls = 0; ls < 8; ++ls) {
-      u_try = u + alpha * du;
-      Eigen::VectorXd R1;
-      double Pi1 = 0.0;
-      try {
-        R1 = residual(p, ts, s_old, s_new, u_try, armijo ? &Pi1 : nullptr);
-      } catch (const PhysicsError&) {
-        alpha *= 0.5;
-        ++rep.line_search_cuts;
-        continue;
-      }
-      if (!stiff_dofs_.empty()) relax_stiff_layer(p, ts, s_old, s_new, u_try, R1, armijo ? &Pi1 : nullptr);
-      const double s1 = du.dot(R1);
-      if (!std::isfinite(s1)) {
-        alpha *= 0.5;
-        ++rep.line_search_cuts;
-        continue;
-      }
-      if (armijo && !(Pi1 <= Pi0 + 1e-4 * alpha * s0)) {
-        // The energy rose: go to the minimum of the parabola through Pi0, slope s0 and Pi1, kept
-        // within [0.1, 0.5] of alpha (a rise means the minimum lies well inside the step).
-        const double c = (Pi1 - Pi0 - s0 * alpha) / (alpha * alpha);
-        const double a_min = c > 0.0 ? -s0 / (2.0 * c) : 0.5 * alpha;
-        if (opt_.verbose)
-          std::fprintf(stderr, "      alpha=%.3g: potential %+.3e J (Armijo bound %+.3e J), |R| %.3e\n", alpha, Pi1 - Pi0,
-                       1e-4 * alpha * s0, R1.norm());
-        alpha = std::clamp(a_min, 0.1 * alpha, 0.5 * alpha);
-        ++rep.line_search_cuts;
-        ++stats_.energy_cuts;
-        continue;
-      }
-      if (s0 >= 0.0 || std::abs(s1) <= 0.8 * std::abs(s0) || s1 < 0.0) break;
-      // Root of the secant through (0, s0) and (alpha, s1), kept in [0.1, 1] of the current alpha.
-      const double a_new = alpha * std::clamp(s0 / (s0 - s1), 0.1, 1.0);
-      if (a_new >= alpha * 0.999) break;
-      alpha = a_new;
-      ++rep.line_search_cuts;
-    }
+    const Eigen::VectorXd u_try = line_search(p, ts, s_old, s_new, u, du, R, W0, tol, rep);
     u = u_try;
-
-    // Chord steps with the factor just computed (Shamanskii's method). A stiff inextensible layer
-    // makes every Newton step that bends the structure stretch the layer to second order in the
-    // rotation increment, which shows as a large but "stiff" residual; one back-substitution with
-    // the same factor removes it at a fraction of a new factorisation's cost. Steps continue while
-    // they at least halve the residual.
-    if (linear_->has_factor()) {
-      Eigen::VectorXd Rc;
-      try {
-        Rc = residual(p, ts, s_old, s_new, u);
-      } catch (const PhysicsError&) {
-        continue;
-      }
-      for (int c = 0; c < opt_.chord_steps; ++c) {
-        const double r0 = Rc.norm();
-        if (r0 <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) break;
-        const Eigen::VectorXd dc = -linear_->solve(Rc);
-        Eigen::VectorXd R2;
-        try {
-          R2 = residual(p, ts, s_old, s_new, u + dc);
-        } catch (const PhysicsError&) {
-          break;
-        }
-        if (!(R2.norm() <= 0.5 * r0)) break;
-        u += dc;
-        Rc.swap(R2);
-        ++stats_.chord_steps;
-      }
-    }
+    chord_steps(p, ts, s_old, s_new, u, rep);
   }
   std::ostringstream s;
   s << "no convergence in " << opt_.max_iterations << " iterations (residual " << rep.residual_N << " N, reference "
     << rep.reference_N << " N)";
   rep.failure = s.str();
   return rep;
+}
+
+Eigen::VectorXd StaticSolver::line_search(double p, const TimeStep& ts, std::span<const double> s_old,
+                                          std::span<double> s_new, const Eigen::VectorXd& u, const Eigen::VectorXd& du,
+                                          const Eigen::VectorXd& R, double W0, double tol, NewtonReport& rep) {
+  const bool energy_search = has_potential_ && opt_.energy_line_search;
+  // Line search on s(alpha) = du . R(u + alpha du) (works for the non-potential follower load).
+  // With a stiff layer, R is taken at the state relaxed in the layer (stiff-layer elimination):
+  // s(alpha) is then the slope of the energy with the layer in equilibrium, so the step is not cut
+  // for the layer's spurious stretch. With a potential, the step must first lower it (Armijo,
+  // sufficient-decrease constant 1e-4, the usual choice); not in the last iterations (within 100x
+  // the tolerance), where Pi changes by less than its round-off.
+  const double s0 = du.dot(R);
+  if (opt_.verbose) std::fprintf(stderr, "      |du|=%.3e max|du|=%.3e decrement du.R=%.3e\n", du.norm(), du.lpNorm<Eigen::Infinity>(), s0);
+  const bool armijo = energy_search && s0 < 0.0 && rep.residual_N > 100.0 * tol;
+  const double Pi0 = armijo ? potential_from(W0, p, u) : 0.0;
+  double alpha = 1.0;
+  Eigen::VectorXd u_try;
+  for (int ls = 0; ls < 8; ++ls) {
+    u_try = u + alpha * du;
+    Eigen::VectorXd R1;
+    double Pi1 = 0.0;
+    try {
+      R1 = residual(p, ts, s_old, s_new, u_try, armijo ? &Pi1 : nullptr);
+    } catch (const PhysicsError&) {
+      alpha *= 0.5;
+      ++rep.line_search_cuts;
+      continue;
+    }
+    if (!stiff_dofs_.empty()) relax_stiff_layer(p, ts, s_old, s_new, u_try, R1, armijo ? &Pi1 : nullptr);
+    const double s1 = du.dot(R1);
+    if (!std::isfinite(s1)) {
+      alpha *= 0.5;
+      ++rep.line_search_cuts;
+      continue;
+    }
+    if (armijo && !(Pi1 <= Pi0 + 1e-4 * alpha * s0)) {
+      // The energy rose: go to the minimum of the parabola through Pi0, slope s0 and Pi1, kept
+      // within [0.1, 0.5] of alpha (a rise means the minimum lies well inside the step).
+      const double c = (Pi1 - Pi0 - s0 * alpha) / (alpha * alpha);
+      const double a_min = c > 0.0 ? -s0 / (2.0 * c) : 0.5 * alpha;
+      if (opt_.verbose)
+        std::fprintf(stderr, "      alpha=%.3g: potential %+.3e J (Armijo bound %+.3e J), |R| %.3e\n", alpha, Pi1 - Pi0,
+                     1e-4 * alpha * s0, R1.norm());
+      alpha = std::clamp(a_min, 0.1 * alpha, 0.5 * alpha);
+      ++rep.line_search_cuts;
+      ++stats_.energy_cuts;
+      continue;
+    }
+    if (s0 >= 0.0 || std::abs(s1) <= 0.8 * std::abs(s0) || s1 < 0.0) break;
+    // Root of the secant through (0, s0) and (alpha, s1), kept in [0.1, 1] of the current alpha.
+    const double a_new = alpha * std::clamp(s0 / (s0 - s1), 0.1, 1.0);
+    if (a_new >= alpha * 0.999) break;
+    alpha = a_new;
+    ++rep.line_search_cuts;
+  }
+  return u_try;
+}
+
+void StaticSolver::chord_steps(double p, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,
+                               Eigen::VectorXd& u, const NewtonReport& rep) {
+  // Chord steps with the factor just computed (Shamanskii's method). A stiff inextensible layer
+  // makes every Newton step that bends the structure stretch the layer to second order in the
+  // rotation increment, which shows as a large but "stiff" residual; one back-substitution with
+  // the same factor removes it at a fraction of a new factorisation's cost. Steps continue while
+  // they at least halve the residual.
+  if (linear_->has_factor()) {
+    Eigen::VectorXd Rc;
+    try {
+      Rc = residual(p, ts, s_old, s_new, u);
+    } catch (const PhysicsError&) {
+      return;  // the next Newton iteration starts from u
+    }
+    for (int c = 0; c < opt_.chord_steps; ++c) {
+      const double r0 = Rc.norm();
+      if (r0 <= opt_.rel_tol * rep.reference_N + opt_.abs_tol_N) break;
+      const Eigen::VectorXd dc = -linear_->solve(Rc);
+      Eigen::VectorXd R2;
+      try {
+        R2 = residual(p, ts, s_old, s_new, u + dc);
+      } catch (const PhysicsError&) {
+        break;
+      }
+      if (!(R2.norm() <= 0.5 * r0)) break;
+      u += dc;
+      Rc.swap(R2);
+      ++stats_.chord_steps;
+    }
+  }
 }
 
 bool StaticSolver::factorize_current(NewtonReport& rep) {
@@ -426,28 +438,85 @@ bool StaticSolver::release_from_reference(double p0, double t, std::vector<doubl
   return true;
 }
 
+void StaticSolver::advance_in_time(double p1, double t0, double t1, std::vector<double>& state,
+                                   std::vector<double>& trial, Eigen::VectorXd& u) {
+  // Pure time increment at constant pressure (rate laws evolve): the tangent changes little
+  // from one time step to the next, so the last factorisation preconditions CG well.
+  TimeStep ts{t1, t1 - t0};
+  krylov_allowed_ = true;
+  NewtonReport r = solve_first_with_weight(p1, ts, state, trial, u);
+  krylov_allowed_ = false;
+  ++stats_.increments;
+  if (!r.converged) {
+    std::ostringstream s;
+    s << "static solve failed at p = " << p1 * 1e-3 << " kPa, t = " << t1 << " s: " << r.failure;
+    throw PhysicsError(s.str(), -1, t1);
+  }
+  has_equilibrium_ = true;
+  state.swap(trial);
+  asm_.update_nonlocal(u, state);
+}
+
+Eigen::VectorXd StaticSolver::predictor(double pa, double pb, double ta, double tb, std::span<const double> state,
+                                        std::span<double> trial, const Eigen::VectorXd& u) {
+  // Start from the polynomial extrapolation of the last equilibria (quadratic through three,
+  // else linear through two) when it balances the new load better than the previous
+  // equilibrium does. Quadratic extrapolation follows the arc of a bending actuator, so the
+  // stiff fabric is not stretched by a tangent-line predictor.
+  Eigen::VectorXd u_try = u;
+  const std::size_t m = path_p_.size();
+  if (m >= 2 && path_p_.back() == pa) {
+    Eigen::VectorXd u_pred;
+    if (m >= 3) {
+      const double x0 = path_p_[m - 3], x1 = path_p_[m - 2], x2 = path_p_[m - 1];
+      const double l0 = (pb - x1) * (pb - x2) / ((x0 - x1) * (x0 - x2));
+      const double l1 = (pb - x0) * (pb - x2) / ((x1 - x0) * (x1 - x2));
+      const double l2 = (pb - x0) * (pb - x1) / ((x2 - x0) * (x2 - x1));
+      u_pred = l0 * path_u_[m - 3] + l1 * path_u_[m - 2] + l2 * path_u_[m - 1];
+    } else {
+      const double x0 = path_p_[0], x1 = path_p_[1];
+      u_pred = path_u_[1] + (path_u_[1] - path_u_[0]) * ((pb - x1) / (x1 - x0));
+    }
+    const TimeStep ts{tb, tb - ta};
+    try {
+      if (residual(pb, ts, state, trial, u_pred).norm() < residual(pb, ts, state, trial, u).norm()) u_try = u_pred;
+    } catch (const PhysicsError&) {
+      // the extrapolated state inverts an element: keep the warm start
+    }
+  }
+  return u_try;
+}
+
+PhysicsError StaticSolver::stalled_continuation(double pa, double ta, const NewtonReport& r) const {
+  // The hint depends on what Newton saw: a tangent that had to be regularised (not positive
+  // definite) means the structure is at or past a limit point; a positive-definite tangent
+  // with a residual still falling means Newton merely ran out of iterations.
+  std::ostringstream s;
+  s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure;
+  if (r.regularised > 0)
+    // Only what works: past a limit point under a pressure load there is no nearby
+    // equilibrium (the wall balloons or the softened part gives way), so explicit dynamics,
+    // which this hint once suggested, runs away into an inverted element (issue 30 item 6).
+    s << ". Hint: the tangent stiffness is not positive definite there, so the actuator is at a limit "
+         "point (ballooning, or a softened part giving way): above about "
+      << pa * 1e-3
+      << " kPa it has no equilibrium near this one, and no solver follows it (explicit dynamics "
+         "runs away into an inverted element). Keep the pressure below it (load.max_kPa, or the recording's "
+         "peak), or make the actuator stiffer: thicker walls (geometry.*) or a stiffer silicone.";
+  else
+    s << ". Hint: the tangent stayed positive definite (no limit point detected) and Newton did not converge "
+         "within solver.max_iterations = "
+      << opt_.max_iterations
+      << "; strongly nonlinear states (a membrane fabric, softened damage) can need 30-40 iterations: raise "
+         "solver.max_iterations, or reduce solver.max_increment_kPa.";
+  return PhysicsError(s.str(), -1, ta);
+}
+
 void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vector<double>& state,
                            Eigen::VectorXd& u) {
   const double span = p1 - p0;
   std::vector<double> trial(state.size());
-  if (std::abs(span) < 1e-12) {
-    // Pure time increment at constant pressure (rate laws evolve): the tangent changes little
-    // from one time step to the next, so the last factorisation preconditions CG well.
-    TimeStep ts{t1, t1 - t0};
-    krylov_allowed_ = true;
-    NewtonReport r = solve_first_with_weight(p1, ts, state, trial, u);
-    krylov_allowed_ = false;
-    ++stats_.increments;
-    if (!r.converged) {
-      std::ostringstream s;
-      s << "static solve failed at p = " << p1 * 1e-3 << " kPa, t = " << t1 << " s: " << r.failure;
-      throw PhysicsError(s.str(), -1, t1);
-    }
-    has_equilibrium_ = true;
-    state.swap(trial);
-    asm_.update_nonlocal(u, state);
-    return;
-  }
+  if (std::abs(span) < 1e-12) return advance_in_time(p1, t0, t1, state, trial, u);
   if (p1 == 0.0 && t1 == t0 && release_from_reference(p0, t1, state, trial, u)) return;
   double s_done = 0.0;  // fraction of the increment completed
   double ds = std::min(1.0, opt_.max_increment_Pa / std::abs(span));
@@ -455,59 +524,12 @@ void StaticSolver::advance(double p0, double p1, double t0, double t1, std::vect
     ds = std::min(ds, 1.0 - s_done);
     const double pa = p0 + s_done * span, pb = p0 + (s_done + ds) * span;
     const double ta = t0 + s_done * (t1 - t0), tb = t0 + (s_done + ds) * (t1 - t0);
-    // Start from the polynomial extrapolation of the last equilibria (quadratic through three,
-    // else linear through two) when it balances the new load better than the previous
-    // equilibrium does. Quadratic extrapolation follows the arc of a bending actuator, so the
-    // stiff fabric is not stretched by a tangent-line predictor.
-    Eigen::VectorXd u_try = u;
-    const std::size_t m = path_p_.size();
-    if (m >= 2 && path_p_.back() == pa) {
-      Eigen::VectorXd u_pred;
-      if (m >= 3) {
-        const double x0 = path_p_[m - 3], x1 = path_p_[m - 2], x2 = path_p_[m - 1];
-        const double l0 = (pb - x1) * (pb - x2) / ((x0 - x1) * (x0 - x2));
-        const double l1 = (pb - x0) * (pb - x2) / ((x1 - x0) * (x1 - x2));
-        const double l2 = (pb - x0) * (pb - x1) / ((x2 - x0) * (x2 - x1));
-        u_pred = l0 * path_u_[m - 3] + l1 * path_u_[m - 2] + l2 * path_u_[m - 1];
-      } else {
-        const double x0 = path_p_[0], x1 = path_p_[1];
-        u_pred = path_u_[1] + (path_u_[1] - path_u_[0]) * ((pb - x1) / (x1 - x0));
-      }
-      const TimeStep ts{tb, tb - ta};
-      try {
-        if (residual(pb, ts, state, trial, u_pred).norm() < residual(pb, ts, state, trial, u).norm()) u_try = u_pred;
-      } catch (const PhysicsError&) {
-        // the extrapolated state inverts an element: keep the warm start
-      }
-    }
+    Eigen::VectorXd u_try = predictor(pa, pb, ta, tb, state, trial, u);
     NewtonReport r = solve(pb, TimeStep{tb, tb - ta}, state, trial, u_try);
     if (!r.converged) {
       ++stats_.cutbacks;
       ds *= 0.5;
-      if (ds * std::abs(span) < opt_.min_increment_Pa) {
-        // The hint depends on what Newton saw: a tangent that had to be regularised (not positive
-        // definite) means the structure is at or past a limit point; a positive-definite tangent
-        // with a residual still falling means Newton merely ran out of iterations.
-        std::ostringstream s;
-        s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure;
-        if (r.regularised > 0)
-          // Only what works: past a limit point under a pressure load there is no nearby
-          // equilibrium (the wall balloons or the softened part gives way), so explicit dynamics,
-          // which this hint once suggested, runs away into an inverted element (issue 30 item 6).
-          s << ". Hint: the tangent stiffness is not positive definite there, so the actuator is at a limit "
-               "point (ballooning, or a softened part giving way): above about "
-            << pa * 1e-3
-            << " kPa it has no equilibrium near this one, and no solver follows it (explicit dynamics "
-               "runs away into an inverted element). Keep the pressure below it (load.max_kPa, or the recording's "
-               "peak), or make the actuator stiffer: thicker walls (geometry.*) or a stiffer silicone.";
-        else
-          s << ". Hint: the tangent stayed positive definite (no limit point detected) and Newton did not converge "
-               "within solver.max_iterations = "
-            << opt_.max_iterations
-            << "; strongly nonlinear states (a membrane fabric, softened damage) can need 30-40 iterations: raise "
-               "solver.max_iterations, or reduce solver.max_increment_kPa.";
-        throw PhysicsError(s.str(), -1, ta);
-      }
+      if (ds * std::abs(span) < opt_.min_increment_Pa) throw stalled_continuation(pa, ta, r);
       continue;
     }
     ++stats_.increments;

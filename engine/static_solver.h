@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "core/errors.h"
 #include "engine/assembly.h"
 #include "engine/linear_solver.h"
 
@@ -149,6 +150,24 @@ class StaticSolver {
   /// Solves K du = -R (Newton-Krylov with the stored factor, else a fresh factorisation).
   bool linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, NewtonReport& rep);
   bool factorize_current(NewtonReport& rep);
+  /// solve()'s line search along du from u, where R = R(u), W0 the stored energy at u and tol the
+  /// iteration's tolerance: returns u + alpha du (see static_solver.cpp).
+  Eigen::VectorXd line_search(double p, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,
+                              const Eigen::VectorXd& u, const Eigen::VectorXd& du, const Eigen::VectorXd& R,
+                              double W0, double tol, NewtonReport& rep);
+  /// solve()'s chord steps with the factor just computed (Shamanskii), updating u in place.
+  void chord_steps(double p, const TimeStep& ts, std::span<const double> s_old, std::span<double> s_new,
+                   Eigen::VectorXd& u, const NewtonReport& rep);
+  /// advance() at constant pressure p1 over [t0, t1] (rate laws evolve): one solve, Krylov allowed.
+  void advance_in_time(double p1, double t0, double t1, std::vector<double>& state, std::vector<double>& trial,
+                       Eigen::VectorXd& u);
+  /// advance()'s start for the increment pa -> pb: the polynomial extrapolation of the last
+  /// equilibria when it balances the load at pb better than u does, else u.
+  Eigen::VectorXd predictor(double pa, double pb, double ta, double tb, std::span<const double> state,
+                            std::span<double> trial, const Eigen::VectorXd& u);
+  /// The PhysicsError of a continuation whose increment fell below min_increment_Pa at pa, with
+  /// the hint that what Newton saw supports (a limit point, or too few iterations).
+  PhysicsError stalled_continuation(double pa, double ta, const NewtonReport& r) const;
   /// advance() from p0 to zero pressure in zero time: one Newton solve from the reference
   /// configuration; false (u and the state unchanged) when it does not converge. See static_solver.cpp.
   bool release_from_reference(double p0, double t, std::vector<double>& state, std::vector<double>& trial,

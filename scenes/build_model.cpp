@@ -54,13 +54,6 @@ const std::pair<const std::string, std::vector<FaceRef>>* find_surface(const Mes
   return it == mesh.surfaces.end() ? nullptr : &*it;
 }
 
-/// mesh.fabric_model: "solid" (elements of set FABRIC) or "membrane".
-bool fabric_is_membrane(const Scene& s) {
-  const std::string v = s.string("mesh.fabric_model");
-  if (v != "solid" && v != "membrane") s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + v + "\"");
-  return v == "membrane";
-}
-
 /// The membrane fabric: the faces of surface mesh.fabric_surface (the mesher's FABRIC_MEMBRANE on
 /// the layer's mid-plane, or a deck's surface: an embedded sheet of M3D3/M3D6/M3D4/M3D8 elements, a
 /// *SURFACE), thickness geometry.fabric_thickness_mm, plane-stress St Venant-Kirchhoff with E and
@@ -102,46 +95,6 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
 
 // ---- end fabric membrane -------------------------------------------------------------------------
 
-PneuNetParams pneunet_params(const Scene& s) {
-  PneuNetParams p;
-  p.width = s.number("geometry.width_mm") * kmm;
-  p.base_thickness = s.number("geometry.base_thickness_mm") * kmm;
-  p.body_height = s.number("geometry.body_height_mm") * kmm;
-  p.chambers = s.integer("geometry.chambers");
-  p.chamber_length = s.number("geometry.chamber_length_mm") * kmm;
-  p.interior_wall = s.number("geometry.interior_wall_mm") * kmm;
-  p.side_wall = s.number("geometry.side_wall_mm") * kmm;
-  p.roof = s.number("geometry.roof_mm") * kmm;
-  p.end_cap = s.number("geometry.end_cap_mm") * kmm;
-  p.channel_width = s.number("geometry.channel_width_mm") * kmm;
-  p.channel_height = s.number("geometry.channel_height_mm") * kmm;
-  p.fabric_z0 = s.number("geometry.fabric_z0_mm") * kmm;
-  p.fabric_thickness = s.number("geometry.fabric_thickness_mm") * kmm;
-  p.h = s.number("mesh.h_mm") * kmm;
-  p.h_z = s.number("mesh.h_z_mm") * kmm;
-  if (p.h_z < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
-  p.fabric_layers = s.integer("mesh.fabric_layers");
-  p.wall_layers = s.integer("mesh.wall_layers");
-  if (p.wall_layers < 0) s.fail("mesh.wall_layers", "must be >= 0 (0 = from mesh.h_mm)");
-  p.half = s.boolean("mesh.half");
-  const std::string el = s.string("mesh.element");
-  if (el == "tet10")
-    p.element = ElementType::Tet10;
-  else if (el == "tet4")
-    p.element = ElementType::Tet4;
-  else
-    s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
-  p.fabric_model = fabric_is_membrane(s) ? FabricModel::Membrane : FabricModel::Solid;
-  return p;
-}
-
-double length_unit(const Scene& s) {
-  const std::string u = s.string("mesh.length_unit");
-  if (u == "mm") return 1e-3;
-  if (u == "m") return 1.0;
-  s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
-}
-
 const std::vector<int>* find_elset(const Mesh& m, const std::string& name) {
   std::string upper = name;
   std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
@@ -175,7 +128,7 @@ std::map<std::string, double> region_scales(const Scene& s, const Mesh& mesh) {
 
 /// The built-in pneu-net of the scene's [geometry] and [mesh] keys.
 Mesh built_in_mesh(const Scene& s) {
-  PneuNetParams p = pneunet_params(s);
+  PneuNetParams p = pneunet_settings(s);
   p.validate();
   return build_pneunet(p);
 }
@@ -184,7 +137,7 @@ Mesh built_in_mesh(const Scene& s) {
 InpDeck scene_deck(const Scene& s) {
   const std::string file = s.string("mesh.file");
   if (file.empty()) s.fail("mesh.file", "mesh.source = \"inp\" needs the deck's path in mesh.file");
-  return read_inp(s.resolve_path(file), length_unit(s));
+  return read_inp(s.resolve_path(file), mesh_settings(s).length_unit_m);
 }
 
 /// The mesh of mesh.source (`source`): the built-in pneu-net, or a deck, which is kept in `deck`
@@ -383,8 +336,9 @@ LoadHistory chamber_load(const Scene& s) {
   // First order, or second (load.pressure_lag2_s > 0) with the same tolerance.
   const PressureLag lag = scene_pressure_lag(s);
   if (lag.on()) {
-    const bool staircase = load_settings(s).protocol == LoadSettings::Protocol::Staircase;
-    load = apply_pressure_lag(load, lag, staircase ? 0.005 * s.number("load.step_kPa") * kkPa : 0.05 * kkPa);
+    const LoadSettings settings = load_settings(s);
+    const bool staircase = settings.protocol == LoadSettings::Protocol::Staircase;
+    load = apply_pressure_lag(load, lag, staircase ? 0.005 * settings.step_Pa : 0.05 * kkPa);
   }
   return load;
 }
@@ -404,9 +358,9 @@ LoadHistory inlet_load(const Scene& s) {
   LoadHistory load;
   const LoadSettings settings = load_settings(s);
   if (settings.protocol == LoadSettings::Protocol::Staircase) {
-    const double p_max = s.number("load.max_kPa") * kkPa, dp = s.number("load.step_kPa") * kkPa;
-    const double hold_s = s.number("load.hold_s"), every_s = s.number("load.output_every_s");
-    const int trials = s.integer("load.trials");
+    const double p_max = settings.max_Pa, dp = settings.step_Pa;
+    const double hold_s = settings.hold_s, every_s = settings.output_every_s;
+    const int trials = settings.trials;
     // The size first, so that the key and where it was set are named (staircase() checks it too).
     const StaircaseSize size = staircase_size(p_max, dp, hold_s, trials, every_s);
     if (size.levels > kMaxStaircaseLevels)
@@ -421,7 +375,7 @@ LoadHistory inlet_load(const Scene& s) {
                  "; report less often (load.output_every_s) or run fewer trials");
     // The keys that must agree with each other, with where they were set (staircase() checks them
     // too, but knows no scene).
-    const double ramp_s = s.number("load.ramp_s"), mark_s = s.number("load.mark_s");
+    const double ramp_s = settings.ramp_s, mark_s = settings.mark_s;
     if (!(ramp_s < hold_s))
       s.fail("load.ramp_s", "got " + short_num(ramp_s) + "; it must be shorter than load.hold_s = " + short_num(hold_s));
     if (!(mark_s >= ramp_s && mark_s <= hold_s))
@@ -429,10 +383,10 @@ LoadHistory inlet_load(const Scene& s) {
                                 "load.ramp_s = " + short_num(ramp_s) + " to load.hold_s = " + short_num(hold_s) + " s");
     load = staircase(p_max, dp, hold_s, ramp_s, trials, mark_s, settings.rest_s, every_s);
   } else {  // LoadSettings::Protocol::Csv
-    const std::string csv = s.string("load.csv");
+    const std::string& csv = settings.csv;
     if (csv.empty()) s.fail("load.csv", "protocol = \"csv\" needs the pressure file in load.csv");
     try {
-      load = pressure_history_from_csv(s.resolve_path(csv), 0.25, s.number("load.output_every_s"));
+      load = pressure_history_from_csv(s.resolve_path(csv), 0.25, settings.output_every_s);
     } catch (const InputError& e) {
       if (std::string(e.what()).find("load.output_every_s") == std::string::npos) throw;
       s.fail("load.output_every_s", e.what());
@@ -451,7 +405,7 @@ std::unique_ptr<BuiltModel> build_model(const Scene& s) {
   out->warnings.insert(out->warnings.end(), s.notes().begin(), s.notes().end());  // a deck's materials
   Mesh& mesh = model.mesh;
   mesh.ensure_ids();
-  const bool membrane_fabric = fabric_is_membrane(s);
+  const bool membrane_fabric = mesh_settings(s).membrane_fabric;
   assign_parts(with_deck_moduli(s, deck, out->warnings), model, membrane_fabric);  // s itself without MODULI=
 
   // Boundary conditions.

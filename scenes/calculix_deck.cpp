@@ -9,6 +9,8 @@
 #include "damage/registry.h"
 #include "scenes/inp/deck.h"
 #include "scenes/inp/materials.h"
+#include "scenes/scene_keys.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
 
@@ -183,7 +185,8 @@ std::string calculix_deck(const Scene& s, const BuiltModel& bm, std::vector<std:
     for (int n = 0; n < mesh.num_nodes() && !any; ++n) any = m.fixed[3 * n + d];
     if (any) os << "PNEUFEM_FIX" << d + 1 << ", " << d + 1 << ", " << d + 1 << ", 0.\n";
   }
-  const double pmax = s.number("load.max_kPa"), dp = s.number("load.step_kPa");
+  const LoadSettings load = load_settings(s);
+  const double pmax = load.max_Pa / detail::kkPa, dp = load.step_Pa / detail::kkPa;  // in kPa, as the amplitude
   os << "*AMPLITUDE, NAME=PRAMP\n0., 0., " << g10(pmax) << ", " << g10(pmax) << "\n";
   os << "*TIME POINTS, NAME=TP\n";
   std::vector<std::string> points;

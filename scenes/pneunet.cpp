@@ -347,6 +347,79 @@ const std::array<CellSplit, 2>& cell_splits() {
   return splits;
 }
 
+/// The plan's grid: nx x ny x nz cells between its grid lines, cells and nodes numbered y
+/// outermost, then z, then x.
+struct CellGrid {
+  const std::vector<double>& gx;
+  const std::vector<double>& gy;
+  const std::vector<double>& gz;
+  int nx, ny, nz;
+  explicit CellGrid(const Plan& plan)
+      : gx(plan.lines[0]), gy(plan.lines[1]), gz(plan.lines[2]), nx(static_cast<int>(gx.size()) - 1),
+        ny(static_cast<int>(gy.size()) - 1), nz(static_cast<int>(gz.size()) - 1) {}
+  std::size_t cell(int i, int j, int k) const { return (static_cast<std::size_t>(j) * nz + k) * nx + i; }
+  int node(int i, int j, int k) const { return (j * (nz + 1) + k) * (nx + 1) + i; }
+};
+
+/// Per cell of the grid: 1 where its centre is inside the OpenVDB solid of the plan.
+std::vector<char> solid_cells(const Plan& plan, const CellGrid& g) {
+  std::vector<char> solid(static_cast<std::size_t>(g.nx) * g.ny * g.nz, 0);
+  const auto grid = make_solid(plan);
+  const auto acc = grid->getConstAccessor();
+  const auto& xform = grid->transform();
+  for (int j = 0; j < g.ny; ++j)
+    for (int k = 0; k < g.nz; ++k)
+      for (int i = 0; i < g.nx; ++i) {
+        const openvdb::Vec3d c(0.5 * (g.gx[i] + g.gx[i + 1]), 0.5 * (g.gy[j] + g.gy[j + 1]), 0.5 * (g.gz[k] + g.gz[k + 1]));
+        solid[g.cell(i, j, k)] = acc.isValueOn(openvdb::Coord::round(xform.worldToIndex(c)));
+      }
+  return solid;
+}
+
+/// The region of a solid cell from its centre: fabric (when solid), base, end cap, roof, side
+/// wall, else interior wall. Cell centres are at least half a cell from every feature plane, so
+/// strict comparisons are safe.
+struct RegionOfCell {
+  std::uint16_t base, fabric, cap, side, roof, wall;
+  bool solid_fabric;
+  double hb, L, z_roof, x_side, z_fab0, z_fab1, end_cap;
+  RegionOfCell(Mesh& m, const PneuNetParams& p)
+      // Fixed region order, independent of which regions a parameter set produces first.
+      : base(m.region_id(regions::kBase)), fabric(m.region_id(regions::kFabric)), cap(m.region_id(regions::kEndCap)),
+        side(m.region_id(regions::kSideWall)), roof(m.region_id(regions::kRoof)),
+        wall(m.region_id(regions::kInteriorWall)), solid_fabric(p.fabric_model == FabricModel::Solid),
+        hb(p.base_thickness), L(p.length()), z_roof(hb + p.body_height - p.roof), x_side(0.5 * p.width - p.side_wall),
+        z_fab0(p.fabric_z0), z_fab1(p.fabric_z0 + p.fabric_thickness), end_cap(p.end_cap) {}
+  std::uint16_t operator()(double x, double y, double z) const {
+    if (solid_fabric && z > z_fab0 && z < z_fab1) return fabric;
+    if (z < hb) return base;
+    if (y < end_cap || y > L - end_cap) return cap;
+    if (z > z_roof) return roof;
+    if (std::abs(x) > x_side) return side;
+    return wall;
+  }
+};
+
+/// Element sets FABRIC (exists, empty for a membrane fabric) and SILICONE, node sets FIXED (y = 0),
+/// TIP (the last y line) and, for a half model, SYMMETRY (x = 0), from the grid indices (exact).
+void add_pneunet_sets(Mesh& m, const CellGrid& g, bool half, std::uint16_t r_fabric) {
+  m.element_sets["FABRIC"];
+  for (int e = 0; e < m.num_elements(); ++e) m.element_sets[m.region[e] == r_fabric ? "FABRIC" : "SILICONE"].push_back(e);
+  auto& fixed = m.node_sets["FIXED"];
+  auto& tip = m.node_sets["TIP"];
+  for (int k = 0; k <= g.nz; ++k)
+    for (int i = 0; i <= g.nx; ++i) {
+      fixed.push_back(g.node(i, 0, k));
+      tip.push_back(g.node(i, g.ny, k));
+    }
+  if (half) {
+    auto& sym = m.node_sets["SYMMETRY"];
+    for (int j = 0; j <= g.ny; ++j)
+      for (int k = 0; k <= g.nz; ++k) sym.push_back(g.node(0, j, k));
+  }
+  for (auto& [name, nodes] : m.node_sets) std::sort(nodes.begin(), nodes.end());
+}
+
 }  // namespace
 
 void PneuNetParams::validate() const {
@@ -357,52 +430,23 @@ void PneuNetParams::validate() const {
 Mesh build_pneunet(const PneuNetParams& p) {
   check_params(p);
   const Plan plan = make_plan(p);
-  const auto& gx = plan.lines[0];
-  const auto& gy = plan.lines[1];
-  const auto& gz = plan.lines[2];
-  const int nx = static_cast<int>(gx.size()) - 1, ny = static_cast<int>(gy.size()) - 1,
-            nz = static_cast<int>(gz.size()) - 1;
-
+  const CellGrid g(plan);
+  const auto& gx = g.gx;
+  const auto& gy = g.gy;
+  const auto& gz = g.gz;
+  const int nx = g.nx, ny = g.ny, nz = g.nz;
   // Classify cells (y outermost, then z, then x) by the OpenVDB solid.
-  auto cell = [&](int i, int j, int k) { return (static_cast<std::size_t>(j) * nz + k) * nx + i; };
-  std::vector<char> solid(static_cast<std::size_t>(nx) * ny * nz, 0);
-  {
-    const auto grid = make_solid(plan);
-    const auto acc = grid->getConstAccessor();
-    const auto& xform = grid->transform();
-    for (int j = 0; j < ny; ++j)
-      for (int k = 0; k < nz; ++k)
-        for (int i = 0; i < nx; ++i) {
-          const openvdb::Vec3d c(0.5 * (gx[i] + gx[i + 1]), 0.5 * (gy[j] + gy[j + 1]), 0.5 * (gz[k] + gz[k + 1]));
-          solid[cell(i, j, k)] = acc.isValueOn(openvdb::Coord::round(xform.worldToIndex(c)));
-        }
-  }
+  const std::vector<char> solid = solid_cells(plan, g);
 
   Mesh m;
   m.type = ElementType::Tet4;
-  // Fixed region order, independent of which regions a parameter set produces first.
-  const std::uint16_t r_base = m.region_id(regions::kBase), r_fabric = m.region_id(regions::kFabric),
-                      r_cap = m.region_id(regions::kEndCap), r_side = m.region_id(regions::kSideWall),
-                      r_roof = m.region_id(regions::kRoof), r_wall = m.region_id(regions::kInteriorWall);
-  const double hb = p.base_thickness, L = p.length(), z_roof = hb + p.body_height - p.roof;
-  const double x_side = 0.5 * p.width - p.side_wall, z_fab0 = p.fabric_z0, z_fab1 = p.fabric_z0 + p.fabric_thickness;
-  // Cell centres are at least half a cell from every feature plane: strict comparisons are safe.
-  const bool solid_fabric = p.fabric_model == FabricModel::Solid;
-  auto region_of = [&](double x, double y, double z) {
-    if (solid_fabric && z > z_fab0 && z < z_fab1) return r_fabric;
-    if (z < hb) return r_base;
-    if (y < p.end_cap || y > L - p.end_cap) return r_cap;
-    if (z > z_roof) return r_roof;
-    if (std::abs(x) > x_side) return r_side;
-    return r_wall;
-  };
+  const RegionOfCell region_of(m, p);
+  const bool solid_fabric = region_of.solid_fabric;
 
-  const int NX = nx + 1, NZ = nz + 1;
-  auto node = [&](int i, int j, int k) { return (j * NZ + k) * NX + i; };
-  m.X.resize(static_cast<std::size_t>(NX) * (ny + 1) * NZ);
+  m.X.resize(static_cast<std::size_t>(nx + 1) * (ny + 1) * (nz + 1));
   for (int j = 0; j <= ny; ++j)
     for (int k = 0; k <= nz; ++k)
-      for (int i = 0; i <= nx; ++i) m.X[node(i, j, k)] = Eigen::Vector3d(gx[i], gy[j], gz[k]);
+      for (int i = 0; i <= nx; ++i) m.X[g.node(i, j, k)] = Eigen::Vector3d(gx[i], gy[j], gz[k]);
 
   const auto& splits = cell_splits();
   std::vector<FaceRef> cavity, membrane;
@@ -417,12 +461,12 @@ Mesh build_pneunet(const PneuNetParams& p) {
   for (int j = 0; j < ny; ++j)
     for (int k = 0; k < nz; ++k)
       for (int i = 0; i < nx; ++i) {
-        if (!solid[cell(i, j, k)]) continue;
+        if (!solid[g.cell(i, j, k)]) continue;
         const std::uint16_t r = region_of(0.5 * (gx[i] + gx[i + 1]), 0.5 * (gy[j] + gy[j + 1]), 0.5 * (gz[k] + gz[k + 1]));
         const CellSplit& s = splits[(i + j + k) % 2];
         for (int t = 0; t < 5; ++t) {
           const int e = m.num_elements();
-          for (int c : s.tet[t]) m.conn.push_back(node(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
+          for (int c : s.tet[t]) m.conn.push_back(g.node(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
           m.region.push_back(r);
           for (int f = 0; f < 4; ++f) {
             const int d = s.face_dir[t][f];
@@ -432,29 +476,13 @@ Mesh build_pneunet(const PneuNetParams& p) {
             // Every void cell of the grid is cavity: the grid spans the actuator's bounding box
             // (or its x >= 0 half), and the cavity is enclosed by end caps, side walls, roof and base.
             if (ii < 0 || ii >= nx || jj < 0 || jj >= ny || kk < 0 || kk >= nz) continue;
-            if (!solid[cell(ii, jj, kk)]) cavity.push_back({e, f});
+            if (!solid[g.cell(ii, jj, kk)]) cavity.push_back({e, f});
           }
         }
       }
   m.surfaces["CAVITY"] = std::move(cavity);
   if (!solid_fabric) m.surfaces["FABRIC_MEMBRANE"] = std::move(membrane);
-
-  // Element sets and node sets (grid indices, exact). FABRIC exists (empty for a membrane fabric).
-  m.element_sets["FABRIC"];
-  for (int e = 0; e < m.num_elements(); ++e) m.element_sets[m.region[e] == r_fabric ? "FABRIC" : "SILICONE"].push_back(e);
-  auto& fixed = m.node_sets["FIXED"];
-  auto& tip = m.node_sets["TIP"];
-  for (int k = 0; k <= nz; ++k)
-    for (int i = 0; i <= nx; ++i) {
-      fixed.push_back(node(i, 0, k));
-      tip.push_back(node(i, ny, k));
-    }
-  if (p.half) {
-    auto& sym = m.node_sets["SYMMETRY"];
-    for (int j = 0; j <= ny; ++j)
-      for (int k = 0; k <= nz; ++k) sym.push_back(node(0, j, k));
-  }
-  for (auto& [name, nodes] : m.node_sets) std::sort(nodes.begin(), nodes.end());
+  add_pneunet_sets(m, g, p.half, region_of.fabric);
 
   // promote_to_tet10 adds a mid-edge node to a node set when both corners are in it, which is
   // exact here because the sets are planes.

@@ -7,6 +7,7 @@ namespace pneufem {
 
 using detail::choice;
 using detail::kkPa;
+using detail::kmm;
 using detail::positive;
 
 MeshSettings mesh_settings(const Scene& s) {
@@ -15,8 +16,61 @@ MeshSettings mesh_settings(const Scene& s) {
                                                              {"inp", MeshSettings::Source::Inp},
                                                              {"stl", MeshSettings::Source::Stl}});
   m.file = s.string("mesh.file");
-  if (m.source == MeshSettings::Source::PneuNet) m.h_mm = s.number("mesh.h_mm");
+  const bool pneunet = m.source == MeshSettings::Source::PneuNet, stl = m.source == MeshSettings::Source::Stl;
+  if (pneunet) {
+    m.h_mm = s.number("mesh.h_mm");
+    m.h_m = m.h_mm * kmm;
+  }
+  if (stl) m.h_m = positive(s, "mesh.h_mm") * kmm;
+  if (pneunet || stl) {
+    m.h_z_m = s.number("mesh.h_z_mm") * kmm;
+    if (m.h_z_m < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
+    m.half = s.boolean("mesh.half");
+    m.fabric_layers = s.integer("mesh.fabric_layers");
+    const std::string el = s.string("mesh.element");
+    if (el != "tet10" && el != "tet4") s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
+    m.element = el == "tet10" ? ElementType::Tet10 : ElementType::Tet4;
+  }
+  if (!stl) {
+    const std::string v = s.string("mesh.fabric_model");
+    if (v != "solid" && v != "membrane") s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + v + "\"");
+    m.membrane_fabric = v == "membrane";
+  }
+  if (!pneunet) {
+    const std::string u = s.string("mesh.length_unit");
+    if (u != "mm" && u != "m") s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
+    m.length_unit_m = u == "mm" ? 1e-3 : 1.0;
+  }
   return m;
+}
+
+PneuNetParams pneunet_settings(const Scene& s) {
+  PneuNetParams p;
+  p.width = s.number("geometry.width_mm") * kmm;
+  p.base_thickness = s.number("geometry.base_thickness_mm") * kmm;
+  p.body_height = s.number("geometry.body_height_mm") * kmm;
+  p.chambers = s.integer("geometry.chambers");
+  p.chamber_length = s.number("geometry.chamber_length_mm") * kmm;
+  p.interior_wall = s.number("geometry.interior_wall_mm") * kmm;
+  p.side_wall = s.number("geometry.side_wall_mm") * kmm;
+  p.roof = s.number("geometry.roof_mm") * kmm;
+  p.end_cap = s.number("geometry.end_cap_mm") * kmm;
+  p.channel_width = s.number("geometry.channel_width_mm") * kmm;
+  p.channel_height = s.number("geometry.channel_height_mm") * kmm;
+  p.fabric_z0 = s.number("geometry.fabric_z0_mm") * kmm;
+  p.fabric_thickness = s.number("geometry.fabric_thickness_mm") * kmm;
+  const MeshSettings m = mesh_settings(s);
+  if (m.source != MeshSettings::Source::PneuNet)
+    s.fail("mesh.source", "the built-in pneu-net's geometry needs mesh.source = \"pneunet\"");
+  p.h = m.h_m;
+  p.h_z = m.h_z_m;
+  p.fabric_layers = m.fabric_layers;
+  p.wall_layers = s.integer("mesh.wall_layers");
+  if (p.wall_layers < 0) s.fail("mesh.wall_layers", "must be >= 0 (0 = from mesh.h_mm)");
+  p.half = m.half;
+  p.element = m.element;
+  p.fabric_model = m.membrane_fabric ? FabricModel::Membrane : FabricModel::Solid;
+  return p;
 }
 
 LoadSettings load_settings(const Scene& s) {
@@ -24,6 +78,14 @@ LoadSettings load_settings(const Scene& s) {
   l.protocol = choice<LoadSettings::Protocol>(s, "load.protocol", {{"staircase", LoadSettings::Protocol::Staircase},
                                                                    {"csv", LoadSettings::Protocol::Csv}});
   l.rest_s = s.number("load.rest_s");
+  l.output_every_s = s.number("load.output_every_s");
+  l.max_Pa = s.number("load.max_kPa") * kkPa;
+  l.step_Pa = s.number("load.step_kPa") * kkPa;
+  l.hold_s = s.number("load.hold_s");
+  l.ramp_s = s.number("load.ramp_s");
+  l.mark_s = s.number("load.mark_s");
+  l.trials = s.integer("load.trials");
+  l.csv = s.string("load.csv");
   return l;
 }
 

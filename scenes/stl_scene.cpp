@@ -2,19 +2,13 @@
 
 #include "core/errors.h"
 #include "scenes/scene_keys.h"
+#include "scenes/scene_settings.h"
 
 namespace pneufem {
 
 namespace {
 
 using detail::kmm;
-
-double length_unit_of(const Scene& s) {
-  const std::string u = s.string("mesh.length_unit");
-  if (u == "mm") return 1e-3;
-  if (u == "m") return 1.0;
-  s.fail("mesh.length_unit", "must be \"mm\" or \"m\", got \"" + u + "\"");
-}
 
 /// The surface of `key` (mesh.file or mesh.cavity_file), read and checked; an error of the file
 /// is prefixed with the key and where it was set.
@@ -32,10 +26,10 @@ TriSurface surface_of(const Scene& s, const std::string& key, double unit) {
 StlMeshSpec stl_spec(const Scene& s) {
   StlMeshSpec spec;
   StuffingOptions& o = spec.stuffing;
-  o.h = detail::positive(s, "mesh.h_mm") * kmm;
-  o.h_z = s.number("mesh.h_z_mm") * kmm;
-  if (o.h_z < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
-  o.half = s.boolean("mesh.half");
+  const MeshSettings m = mesh_settings(s);
+  o.h = m.h_m;
+  o.h_z = m.h_z_m;
+  o.half = m.half;
   o.feature_planes = s.boolean("mesh.feature_planes");
   const std::vector<double> slab = s.numbers("mesh.fabric_slab_mm");
   if (!slab.empty()) {
@@ -44,11 +38,9 @@ StlMeshSpec stl_spec(const Scene& s) {
     o.has_slab = true;
     o.slab_z0 = slab[0] * kmm;
     o.slab_z1 = slab[1] * kmm;
-    o.slab_cells = s.integer("mesh.fabric_layers");
+    o.slab_cells = m.fabric_layers;
   }
-  const std::string el = s.string("mesh.element");
-  if (el != "tet10" && el != "tet4") s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
-  spec.element = el == "tet10" ? ElementType::Tet10 : ElementType::Tet4;
+  spec.element = m.element;
   const std::vector<double> inlet = s.numbers("mesh.cavity_inlet_mm");
   if (inlet.size() == 3)
     spec.cavity_inlet = Eigen::Vector3d(inlet[0], inlet[1], inlet[2]) * kmm;
@@ -69,7 +61,7 @@ StlMeshSpec stl_spec(const Scene& s) {
 Mesh stl_scene_mesh(const Scene& s, std::vector<std::string>* warnings, StlMeshReport* report) {
   const std::string file = s.string("mesh.file");
   if (file.empty()) s.fail("mesh.file", "mesh.source = \"stl\" needs the path of the actuator's .stl or .obj in mesh.file");
-  const double unit = length_unit_of(s);
+  const double unit = mesh_settings(s).length_unit_m;
   StlMeshSpec spec = stl_spec(s);
   TriSurface surface = surface_of(s, "mesh.file", unit);
   if (!s.string("mesh.cavity_file").empty()) {

@@ -52,14 +52,12 @@ std::string profile_json(const Comparison& c, double bin_s) {
   return o.str(2);
 }
 
-std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, const CompareRunResult& r,
-                              const std::string& label, const std::string& hash) {
-  const Comparison& c = r.comparison;
+/// metrics.json "trials": one object per trial with its NRMSE, RMSE, range, noise and the
+/// per-step arrays (levels, marks, spreads, slopes, steadiness, mean residual).
+std::string trials_json(const Comparison& c) {
   std::string trials = "[";
-  std::vector<double> trial_nrmse;
   for (std::size_t k = 0; k < c.trials.size(); ++k) {
     const TrialComparison& t = c.trials[k];
-    trial_nrmse.push_back(t.nrmse);
     json::Object o;
     o.add("trial", t.trial)
         .add("nrmse_mark", t.nrmse_mark)
@@ -84,25 +82,29 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
         .add("mean_residual_deg", numbers(t.steps, &StepComparison::mean_residual_deg));
     trials += (k ? ", " : "") + o.str(4);
   }
-  trials += "]";
-  std::string map = "[";
-  for (std::size_t k = 0; k < c.residual_map_deg.size(); ++k) map += (k ? ", " : "") + json::array(c.residual_map_deg[k]);
-  map += "]";
-  std::string regions = "null";
-  if (opt.regions) {
-    regions = "[";
-    for (std::size_t i = 0; i < r.regions.size(); ++i) {
-      const RegionSensitivity& g = r.regions[i];
-      json::Object o;
-      o.add_str("region", g.region)
-          .add("elements", static_cast<double>(g.elements))
-          .add("best_scale", g.best_scale)
-          .add("variance_fraction", g.variance_fraction)
-          .add("nrmse", g.nrmse);
-      regions += (i ? ", " : "") + o.str(4);
-    }
-    regions += "]";
+  return trials + "]";
+}
+
+/// metrics.json "regions": each region's sensitivity (best stiffness scale, share of the residual
+/// variance it explains, NRMSE), or null when --regions was not asked.
+std::string regions_json(const CompareRunOptions& opt, const CompareRunResult& r) {
+  if (!opt.regions) return "null";
+  std::string regions = "[";
+  for (std::size_t i = 0; i < r.regions.size(); ++i) {
+    const RegionSensitivity& g = r.regions[i];
+    json::Object o;
+    o.add_str("region", g.region)
+        .add("elements", static_cast<double>(g.elements))
+        .add("best_scale", g.best_scale)
+        .add("variance_fraction", g.variance_fraction)
+        .add("nrmse", g.nrmse);
+    regions += (i ? ", " : "") + o.str(4);
   }
+  return regions + "]";
+}
+
+/// metrics.json "worst_states": the states written as VTU, their files relative to --out.
+std::string worst_states_json(const CompareRunOptions& opt, const CompareRunResult& r) {
   std::string worst = "[";
   for (std::size_t i = 0; i < r.drive.worst.size(); ++i) {
     const WorstState& w = r.drive.worst[i];
@@ -114,7 +116,11 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
         .add_str("file", fs::path(w.file).lexically_relative(opt.out_dir).string());
     worst += (i ? ", " : "") + o.str(4);
   }
-  worst += "]";
+  return worst + "]";
+}
+
+/// metrics.json "mesh": node and element counts, element type, volume, elements per region.
+std::string mesh_json(const CompareRunResult& r) {
   json::Object mesh_regions;
   for (const auto& [name, n] : r.drive.mesh.elements_per_region) mesh_regions.add(name, static_cast<double>(n));
   json::Object mesh;
@@ -123,6 +129,12 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
       .add_str("element_type", r.drive.mesh.element_type)
       .add("volume_m3", r.drive.mesh.volume_m3)
       .add("elements_per_region", mesh_regions.str(4));
+  return mesh.str(2);
+}
+
+/// metrics.json "simulation": how the model ran (status, states, model and, when the reduced
+/// model ran, its offline cost, basis source, worst check and enrichments).
+std::string simulation_json(const CompareRunResult& r) {
   json::Object sim;
   sim.add_str("status", r.drive.failure.empty() ? "complete" : "incomplete")
       .add_str("failure", r.drive.failure)
@@ -136,6 +148,17 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
         .add("reduced_worst_check_deg", r.drive.reduced_worst_check_deg)
         .add("reduced_enrichments", static_cast<double>(r.drive.reduced_enrichments));
   }
+  return sim.str(2);
+}
+
+std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, const CompareRunResult& r,
+                              const std::string& label, const std::string& hash) {
+  const Comparison& c = r.comparison;
+  std::vector<double> trial_nrmse;
+  for (const TrialComparison& t : c.trials) trial_nrmse.push_back(t.nrmse);
+  std::string map = "[";
+  for (std::size_t k = 0; k < c.residual_map_deg.size(); ++k) map += (k ? ", " : "") + json::array(c.residual_map_deg[k]);
+  map += "]";
   json::Object o;
   o.add_str("pneufem_version", version_string())
       .add_str("command_line", opt.command_line)
@@ -149,15 +172,15 @@ std::string metrics_json_text(const Scene& scene, const CompareRunOptions& opt, 
       .add("n", static_cast<double>(c.n))
       .add("noise_floor_nrmse", c.noise_floor_nrmse)
       .add("trial_nrmse", json::array(trial_nrmse))
-      .add("trials", trials)
+      .add("trials", trials_json(c))
       .add("residual_map_deg", map)
       .add("residual_profile", profile_json(c, opt.compare.bin_s))
-      .add("regions", regions)
-      .add("worst_states", worst)
-      .add("simulation", sim.str(2))
+      .add("regions", regions_json(opt, r))
+      .add("worst_states", worst_states_json(opt, r))
+      .add("simulation", simulation_json(r))
       .add("wall_s", r.wall_s)
       .add("warnings", strings(r.warnings))
-      .add("mesh", mesh.str(2))
+      .add("mesh", mesh_json(r))
       .add("scene", scene.to_json());
   return o.str() + "\n";
 }

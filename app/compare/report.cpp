@@ -394,31 +394,22 @@ std::vector<ReportFigure> compare_figures(const Recording& rec, const CompareRun
   return out;
 }
 
-std::string compare_report_html(const Recording& rec, const CompareRunResult& r, const std::vector<ReportFigure>& figs,
-                                const std::vector<HistoryEntry>& history, const std::string& label,
-                                const std::string& data_file) {
+namespace {
+
+/// The report's figures of one section (figure, inline SVG, caption).
+std::string section_figures(const std::vector<ReportFigure>& figs, const std::string& section) {
+  std::string s;
+  for (const ReportFigure& f : figs)
+    if (f.section == section)
+      s += "<figure id=\"" + escape(f.name) + "\">\n" + inline_svg(f.svg) + "<figcaption><b>" + escape(f.title) +
+           ".</b> " + escape(f.caption) + "</figcaption>\n</figure>\n";
+  return s;
+}
+
+/// "Summary": the pooled metrics, one row per trial, and the warnings (folded).
+std::string summary_section(const CompareRunResult& r) {
   const Comparison& c = r.comparison;
-  std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>pneufem compare: " +
-                  escape(label) + "</title>\n<style>\n"
-                  "body{font-family:Helvetica,Arial,sans-serif;max-width:1000px;margin:2em auto;color:#222}\n"
-                  "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;"
-                  "text-align:right}th{background:#f3f3f3}figure{margin:1em 0}figcaption{color:#555;font-size:0.9em}\n"
-                  "</style>\n</head>\n<body>\n";
-  h += "<h1>Model vs measurement: " + escape(label) + "</h1>\n";
-  h += "<p>Data: <code>" + escape(data_file) + "</code> (" + std::to_string(rec.trials.size()) +
-       " trials). The model was driven by the measured pressure of every trial (" + std::to_string(r.drive.states) +
-       " solved states, pressure tolerance " + fmt("%.3g", r.drive.tolerance_kPa) + " kPa).</p>\n";
-
-  auto figures = [&](const std::string& section) {
-    std::string s;
-    for (const ReportFigure& f : figs)
-      if (f.section == section)
-        s += "<figure id=\"" + escape(f.name) + "\">\n" + inline_svg(f.svg) + "<figcaption><b>" + escape(f.title) +
-             ".</b> " + escape(f.caption) + "</figcaption>\n</figure>\n";
-    return s;
-  };
-
-  h += "<h2>Summary</h2>\n<table>\n<tr><th>pooled NRMSE</th><th>noise floor NRMSE</th><th>RMSE (deg)</th>"
+  std::string h = "<h2>Summary</h2>\n<table>\n<tr><th>pooled NRMSE</th><th>noise floor NRMSE</th><th>RMSE (deg)</th>"
        "<th>measured range (deg)</th><th>frames n</th><th>RSS (deg&#178;)</th></tr>\n<tr><td>" +
        fmt("%.4f", c.nrmse) + "</td><td>" + fmt("%.4f", c.noise_floor_nrmse) + "</td><td>" + fmt("%.3f", c.rmse_deg) +
        "</td><td>" + fmt("%.2f", c.range_deg) + "</td><td>" + std::to_string(c.n) + "</td><td>" + fmt("%.4g", c.rss_deg2) +
@@ -436,11 +427,14 @@ std::string compare_report_html(const Recording& rec, const CompareRunResult& r,
     for (const std::string& w : r.warnings) h += "<li>" + escape(w) + "</li>\n";
     h += "</ul></details>\n";
   }
+  return h;
+}
 
-  h += "<h2>Figures</h2>\n" + figures("figures");
-
-  // Where it fails: worst steps by |mean residual|, worst trial, structure of the residual.
-  h += "<h2>Where it fails</h2>\n";
+/// "Where it fails": the five worst steps by |mean residual|, the worst trial, the residual before
+/// and after the mark, the section's figures and the VTU files of the worst states.
+std::string where_it_fails_section(const CompareRunResult& r, const std::vector<ReportFigure>& figs) {
+  const Comparison& c = r.comparison;
+  std::string h = "<h2>Where it fails</h2>\n";
   struct Cell {
     double abs_mean;
     std::size_t trial, step;
@@ -471,7 +465,7 @@ std::string compare_report_html(const Recording& rec, const CompareRunResult& r,
   }
   h += "<p>Mean residual before the 2.5 s mark (transient): " + fmt("%.3f", c.residual_before_mark_deg) +
        " deg; after it (settled): " + fmt("%.3f", c.residual_after_mark_deg) + " deg.</p>\n";
-  h += figures("fails");
+  h += section_figures(figs, "fails");
   if (!r.drive.worst.empty()) {
     h += "<p>Fields at the worst states (ParaView: Warp By Vector with displacement_m):</p>\n<ul>\n";
     for (const WorstState& w : r.drive.worst)
@@ -480,8 +474,13 @@ std::string compare_report_html(const Recording& rec, const CompareRunResult& r,
            " deg vs measured " + fmt("%.2f", w.measured_deg) + " deg</li>\n";
     h += "</ul>\n";
   }
+  return h;
+}
 
-  h += "<h2>Region sensitivity</h2>\n";
+/// "Region sensitivity": per region the best stiffness scale and the residual it removes (or how
+/// to compute it).
+std::string regions_section(const CompareRunResult& r, const std::vector<ReportFigure>& figs) {
+  std::string h = "<h2>Region sensitivity</h2>\n";
   if (r.regions.empty()) {
     h += "<p>Not computed (run with <code>--regions</code>: one extra simulation per region).</p>\n";
   } else {
@@ -491,17 +490,44 @@ std::string compare_report_html(const Recording& rec, const CompareRunResult& r,
       h += "<tr><td>" + escape(s.region) + "</td><td>" + std::to_string(s.elements) + "</td><td>" +
            fmt("%.3f", s.best_scale) + "</td><td>" + fmt("%.3f", s.variance_fraction) + "</td><td>" +
            fmt("%.4f", s.nrmse) + "</td></tr>\n";
-    h += "</table>\n" + figures("regions");
+    h += "</table>\n" + section_figures(figs, "regions");
   }
+  return h;
+}
 
-  h += "<h2>History</h2>\n" + figures("history");
+/// "History": the figure and one row per earlier comparison in this --out.
+std::string history_section(const std::vector<HistoryEntry>& history, const std::vector<ReportFigure>& figs) {
+  std::string h = "<h2>History</h2>\n" + section_figures(figs, "history");
   h += "<table>\n<tr><th>#</th><th>time (UTC)</th><th>label</th><th>scene hash</th><th>source</th><th>pooled "
        "NRMSE</th></tr>\n";
   for (std::size_t i = 0; i < history.size(); ++i)
     h += "<tr><td>" + std::to_string(i + 1) + "</td><td>" + escape(history[i].time_utc) + "</td><td>" +
          escape(history[i].label) + "</td><td><code>" + escape(history[i].scene_hash) + "</code></td><td>" +
          escape(history[i].source) + "</td><td>" + fmt("%.4f", history[i].nrmse) + "</td></tr>\n";
-  h += "</table>\n</body>\n</html>\n";
+  return h + "</table>\n";
+}
+
+}  // namespace
+
+std::string compare_report_html(const Recording& rec, const CompareRunResult& r, const std::vector<ReportFigure>& figs,
+                                const std::vector<HistoryEntry>& history, const std::string& label,
+                                const std::string& data_file) {
+  std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>pneufem compare: " +
+                  escape(label) + "</title>\n<style>\n"
+                  "body{font-family:Helvetica,Arial,sans-serif;max-width:1000px;margin:2em auto;color:#222}\n"
+                  "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;"
+                  "text-align:right}th{background:#f3f3f3}figure{margin:1em 0}figcaption{color:#555;font-size:0.9em}\n"
+                  "</style>\n</head>\n<body>\n";
+  h += "<h1>Model vs measurement: " + escape(label) + "</h1>\n";
+  h += "<p>Data: <code>" + escape(data_file) + "</code> (" + std::to_string(rec.trials.size()) +
+       " trials). The model was driven by the measured pressure of every trial (" + std::to_string(r.drive.states) +
+       " solved states, pressure tolerance " + fmt("%.3g", r.drive.tolerance_kPa) + " kPa).</p>\n";
+  h += summary_section(r);
+  h += "<h2>Figures</h2>\n" + section_figures(figs, "figures");
+  h += where_it_fails_section(r, figs);
+  h += regions_section(r, figs);
+  h += history_section(history, figs);
+  h += "</body>\n</html>\n";
   return h;
 }
 

@@ -503,18 +503,19 @@ void full_fem_stats(const QuasiStaticRun& run, const BuiltModel& bm, const RunOp
 constexpr double kAddedMassWarnFraction = 0.05;
 constexpr double kAddedMassForceShare = 0.02;
 
-void run_explicit(const Assembler& asmb, BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
-                  json::Object& solver_stats) {
-  if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
-  const QuasiStaticRun::Observer observe = rec.observer();
-  const int ntrials = static_cast<int>(bm.load.trials.size());
-  ExplicitIntegrator ex(asmb, bm.solver.explicit_dynamics);
-  const double ts = bm.solver.time_scale;
-  const double target_dt = bm.solver.explicit_dynamics.target_dt_s;
-  double max_share = 0.0, max_share_t = 0.0;
-  bool warned = false;
-  // The added mass so far: a warning (console and summary.json) the first time it passes the limit.
-  auto report_mass = [&](const char* when, bool print) {
+/// The added mass of selective mass scaling through an explicit run: reported (console, and a
+/// warning into the summary the first time it passes kAddedMassWarnFraction of the model's mass),
+/// its largest share of the loads at a report tracked, and the run refused where that share
+/// passes kAddedMassForceShare (unless solver.force_mass_scaling).
+struct AddedMassMonitor {
+  double target_dt = 0.0;       ///< solver.target_dt_s (0: no scaling, nothing reported)
+  bool warned = false;          ///< the warning was given
+  double max_share = 0.0;       ///< largest share of the loads taken by the added mass at a report
+  double max_share_t = 0.0;     ///< its protocol time
+
+  /// The added mass so far ("adds", "has added", "added"), printed when `print`; the warning the
+  /// first time it passes the limit.
+  void report(const ExplicitIntegrator& ex, const char* when, bool print, std::vector<std::string>& warnings) {
     const double added = ex.stats().added_mass_kg, phys = ex.stats().physical_mass_kg;
     if (target_dt <= 0.0 || phys <= 0.0) return;
     char line[400];
@@ -533,32 +534,68 @@ void run_explicit(const Assembler& asmb, BuiltModel& bm, RunRecorder& rec, const
                             " % of the loads (it would change the answer) unless solver.force_mass_scaling = true; "
                             "a smaller solver.target_dt_s adds less";
       std::fprintf(stderr, "warning: %s\n", w.c_str());
-      bm.warnings.push_back(w);
+      warnings.push_back(w);
     }
-  };
-  auto add_stats = [&] {
-    solver_stats.add_str("mode", "explicit")
-        .add("steps", static_cast<double>(ex.stats().steps))
-        .add("dt_s", ex.stats().dt_s)
-        .add("dt_min_s", ex.stats().dt_min_s)
-        .add("time_scale", ts)
-        .add("physical_mass_kg", ex.stats().physical_mass_kg)
-        .add("added_mass_kg", ex.stats().added_mass_kg)
-        .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
-        .add("added_mass_max_force_share", max_share)
-        .add("added_mass_max_force_share_time_s", max_share_t)
-        .add("mass_scaling_forced", bm.solver.force_mass_scaling ? "true" : "false")
-        .add("stability_estimates", static_cast<double>(ex.stats().stability_estimates))
-        .add("energy_kinetic_J", ex.energy().kinetic_J)
-        .add("energy_internal_J", ex.energy().internal_J)
-        .add("energy_external_work_J", ex.energy().external_work_J)
-        .add("energy_damping_J", ex.energy().damping_J)
-        .add("energy_balance_relative_error", ex.energy().relative_error());
-  };
+  }
+
+  /// At report `r`: the added mass's share of the loads, tracked, and an InputError above the limit.
+  void check(const ExplicitIntegrator& ex, const StateRecord& r, bool force_mass_scaling) {
+    const double share = ex.added_mass_force_share();
+    if (share > max_share) {
+      max_share = share;
+      max_share_t = r.global_time_s;
+    }
+    if (share > kAddedMassForceShare && !force_mass_scaling) {
+      char m[900];
+      std::snprintf(m, sizeof m,
+                    "solver.target_dt_s = %g: selective mass scaling added %.4g kg to the model's %.4g kg (%.4g times "
+                    "it), and at trial %d, t = %g s (%.4g kPa) that mass takes %.3g %% of the loads (limit %.3g %%): "
+                    "the angles would be those of a heavier actuator, not of this one. Lower solver.target_dt_s (0 = "
+                    "no scaling), or set solver.time_scale lower so the load is slower, or use solver.mode = "
+                    "\"quasi_static\"; solver.force_mass_scaling = true runs it anyway",
+                    target_dt, ex.stats().added_mass_kg, ex.stats().physical_mass_kg,
+                    ex.stats().added_mass_kg / ex.stats().physical_mass_kg, r.trial, r.time_s, r.pressure_Pa * 1e-3,
+                    100.0 * share, 100.0 * kAddedMassForceShare);
+      throw InputError(m);
+    }
+  }
+};
+
+/// The statistics of an explicit run (finished or failed) into `solver_stats`.
+void explicit_stats(const ExplicitIntegrator& ex, const BuiltModel& bm, const AddedMassMonitor& mass,
+                    json::Object& solver_stats) {
+  solver_stats.add_str("mode", "explicit")
+      .add("steps", static_cast<double>(ex.stats().steps))
+      .add("dt_s", ex.stats().dt_s)
+      .add("dt_min_s", ex.stats().dt_min_s)
+      .add("time_scale", bm.solver.time_scale)
+      .add("physical_mass_kg", ex.stats().physical_mass_kg)
+      .add("added_mass_kg", ex.stats().added_mass_kg)
+      .add("added_mass_fraction", ex.stats().added_mass_kg / ex.stats().physical_mass_kg)
+      .add("added_mass_max_force_share", mass.max_share)
+      .add("added_mass_max_force_share_time_s", mass.max_share_t)
+      .add("mass_scaling_forced", bm.solver.force_mass_scaling ? "true" : "false")
+      .add("stability_estimates", static_cast<double>(ex.stats().stability_estimates))
+      .add("energy_kinetic_J", ex.energy().kinetic_J)
+      .add("energy_internal_J", ex.energy().internal_J)
+      .add("energy_external_work_J", ex.energy().external_work_J)
+      .add("energy_damping_J", ex.energy().damping_J)
+      .add("energy_balance_relative_error", ex.energy().relative_error());
+}
+
+void run_explicit(const Assembler& asmb, BuiltModel& bm, RunRecorder& rec, const RunOptions& opt,
+                  json::Object& solver_stats) {
+  if (opt.resume) throw InputError("--resume: explicit-mode runs have no checkpoints; start the run again");
+  const QuasiStaticRun::Observer observe = rec.observer();
+  const int ntrials = static_cast<int>(bm.load.trials.size());
+  ExplicitIntegrator ex(asmb, bm.solver.explicit_dynamics);
+  const double ts = bm.solver.time_scale;
+  AddedMassMonitor mass;
+  mass.target_dt = bm.solver.explicit_dynamics.target_dt_s;
   try {
-    if (target_dt > 0.0) {
+    if (mass.target_dt > 0.0) {
       (void)ex.estimate_stable_dt();  // the mass added at the start, reported before the work
-      report_mass("adds", true);
+      mass.report(ex, "adds", true, bm.warnings);
     }
     double t0_protocol = 0.0, last_angle = 0.0;
     for (int k = 0; k < ntrials; ++k) {
@@ -577,35 +614,18 @@ void run_explicit(const Assembler& asmb, BuiltModel& bm, RunRecorder& rec, const
         last_angle = r.angle_deg;
         r.plane_rms_m = a.plane_rms_m;
         r.cavity_volume_m3 = asmb.cavity_volume(ex.u());
-        if (!warned) report_mass("has added", false);
-        const double share = ex.added_mass_force_share();
-        if (share > max_share) {
-          max_share = share;
-          max_share_t = r.global_time_s;
-        }
-        if (share > kAddedMassForceShare && !bm.solver.force_mass_scaling) {
-          char m[900];
-          std::snprintf(m, sizeof m,
-                        "solver.target_dt_s = %g: selective mass scaling added %.4g kg to the model's %.4g kg (%.4g times "
-                        "it), and at trial %d, t = %g s (%.4g kPa) that mass takes %.3g %% of the loads (limit %.3g %%): "
-                        "the angles would be those of a heavier actuator, not of this one. Lower solver.target_dt_s (0 = "
-                        "no scaling), or set solver.time_scale lower so the load is slower, or use solver.mode = "
-                        "\"quasi_static\"; solver.force_mass_scaling = true runs it anyway",
-                        target_dt, ex.stats().added_mass_kg, ex.stats().physical_mass_kg,
-                        ex.stats().added_mass_kg / ex.stats().physical_mass_kg, r.trial, r.time_s, r.pressure_Pa * 1e-3,
-                        100.0 * share, 100.0 * kAddedMassForceShare);
-          throw InputError(m);
-        }
+        if (!mass.warned) mass.report(ex, "has added", false, bm.warnings);
+        mass.check(ex, r, bm.solver.force_mass_scaling);
         observe(r, ex.u(), ex.state());
       }
       t0_protocol += tl.duration() + bm.load.rest_between_trials_s;
     }
   } catch (...) {
-    add_stats();
+    explicit_stats(ex, bm, mass, solver_stats);
     throw;
   }
-  report_mass("added", true);
-  add_stats();
+  mass.report(ex, "added", true, bm.warnings);
+  explicit_stats(ex, bm, mass, solver_stats);
 }
 
 /// metrics.json (the paper's metrics of every trial against the ideal model); its summary.json

@@ -332,22 +332,17 @@ double elastic_reference_peak_Pa(double scene_peak_Pa, double recorded_peak_Pa) 
   return step * std::ceil(p / step);
 }
 
-DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
-  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+namespace {
 
-  std::unique_ptr<BuiltModel> bm = build_model(scene);
-  const Assembler asmb(bm->model);
-  const bool rate_dependent = asmb.state_size() > 0;
-  std::vector<double> offset;
-  DriveResult result;
+/// The load that drives the model through a recording: its measured pressure (measured_load),
+/// through the scene's chamber-pressure lag (load.pressure_lag_s, first or with load.pressure_lag2_s
+/// second order) exactly as the scene's own load is (same 0.05 kPa breakpoint tolerance as
+/// build_model uses for a CSV inlet), then opt.chamber_pressure. The lag's breakpoints become
+/// reported states too, so the lagged rise after each step is resolved at the frames rather than
+/// bridged by one straight line. `offset` receives each trial's start time in the recording.
+LoadHistory recording_load(const Scene& scene, const Recording& rec, const DriveOptions& opt, bool rate_dependent,
+                           std::vector<double>& offset, DriveResult& result) {
   LoadHistory load = measured_load(rec, opt, load_settings(scene).rest_s, rate_dependent, offset, &result.tolerance_kPa);
-  // The scene's chamber-pressure lag (load.pressure_lag_s, first or with load.pressure_lag2_s
-  // second order) acts on the measured inlet exactly as on the scene's own load (same 0.05 kPa
-  // breakpoint tolerance as build_model uses for a CSV inlet). Its breakpoints become reported
-  // states too, so the lagged rise after each step is resolved at the frames rather than bridged
-  // by one straight line.
   const PressureLag lag = scene_pressure_lag(scene);
   if (lag.on()) {
     LoadHistory lagged = apply_pressure_lag(load, lag, 0.05e3);
@@ -362,6 +357,96 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
   if (opt.chamber_pressure)
     for (TrialLoad& tl : load.trials)
       for (double& p : tl.pressure_Pa) p = opt.chamber_pressure(p);
+  return load;
+}
+
+/// Runs `load` through the reduced model (when the scene asks for it and it stands) or the full
+/// quasi-static FEM, each report to `observe`. A PhysicsError with opt.partial_on_failure is kept in
+/// result.failure and result.failure_time_s; returns the index of the trial that stopped early
+/// (the trial count when none did).
+std::size_t drive_load(const Scene& scene, BuiltModel& bm, const Assembler& asmb, const LoadHistory& load,
+                       std::size_t trials, const DriveOptions& opt, const StateObserver& observe,
+                       const std::function<void()>& clear_traces, ProgressMeter& progress, DriveResult& result) {
+  try {
+    const bool reduced =
+        bm.solver.mode == SolverSettings::Mode::QuasiStatic && bm.solver.model == SolverSettings::Model::Reduced;
+    const std::string fallback = reduced ? drive_reduced(scene, bm, load, opt, observe, clear_traces, result) : std::string();
+    if (!fallback.empty()) {
+      clear_traces();
+      result.model = "full (fallback: " + fallback + ")";
+      progress.message("  " + result.model);
+    }
+    if (!reduced || !fallback.empty()) {
+      // A recording is compared frame by frame and its measured trials differ: every trial is solved.
+      QuasiStaticOptions qs = bm.solver.quasi_static;
+      qs.cycle_jump.on = false;
+      QuasiStaticRun run(asmb, qs);
+      try {
+        run.run(load, observe);
+      } catch (...) {
+        result.states = run.stats().states;
+        throw;
+      }
+      result.states = run.stats().states;
+    }
+  } catch (const PhysicsError& e) {
+    if (!opt.partial_on_failure) throw;
+    result.failure = e.what();
+    std::size_t failed_trial = 0;
+    while (failed_trial + 1 < trials && !result.trials[failed_trial + 1].states_angle_deg.t_s.empty()) ++failed_trial;
+    const Series& solved = result.trials[failed_trial].states_angle_deg;
+    result.failure_time_s = solved.t_s.empty() ? 0.0 : solved.t_s.back();
+    return failed_trial;
+  }
+  return trials;
+}
+
+/// The model's angle at every frame of the recording, interpolated between the solved states.
+/// After an early stop, frames past the last solved state of the failed trial (and all frames of
+/// later trials) have no model value (NaN).
+void model_at_frames(const Recording& rec, std::size_t failed_trial, DriveResult& result) {
+  for (std::size_t k = 0; k < rec.trials.size(); ++k) {
+    TrialTrace& tt = result.trials[k];
+    const Series& frames = rec.trials[k].angle_deg;
+    tt.angle_deg.t_s = frames.t_s;
+    tt.angle_deg.value.reserve(frames.t_s.size());
+    const Series& solved = tt.states_angle_deg;
+    const double t_end = k < failed_trial    ? INFINITY
+                         : k == failed_trial ? (solved.t_s.empty() ? -INFINITY : solved.t_s.back())
+                                             : -INFINITY;
+    for (double t : frames.t_s)
+      tt.angle_deg.value.push_back(t <= t_end && !solved.t_s.empty() ? interp_clamped(solved.t_s, solved.value, t) : NAN);
+  }
+}
+
+/// The worst states (largest |model - measured|) as worst_N.vtu in opt.vtu_dir, listed in result.worst.
+void write_worst_states(std::vector<Candidate>& worst, const BuiltModel& bm, const Assembler& asmb,
+                        const DriveOptions& opt, DriveResult& result) {
+  std::filesystem::create_directories(opt.vtu_dir);
+  for (std::size_t i = 0; i < worst.size(); ++i) {
+    Candidate& c = worst[i];
+    c.info.file = (std::filesystem::path(opt.vtu_dir) / ("worst_" + std::to_string(i + 1) + ".vtu")).string();
+    const TrialTrace& tt = *std::find_if(result.trials.begin(), result.trials.end(),
+                                         [&](const TrialTrace& x) { return x.trial == c.info.trial; });
+    write_vtu(c.info.file, bm.model, compute_fields(asmb, c.u, c.state), c.info.time_s, c.info.trial,
+              interp_clamped(tt.states_pressure_kPa.t_s, tt.states_pressure_kPa.value, c.info.time_s), c.info.model_deg);
+    result.worst.push_back(c.info);
+  }
+}
+
+}  // namespace
+
+DriveResult simulate_recording(const Scene& scene, const Recording& rec, const DriveOptions& opt) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const int threads = opt.threads > 0 ? opt.threads : tbb::info::default_concurrency();
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+
+  std::unique_ptr<BuiltModel> bm = build_model(scene);
+  const Assembler asmb(bm->model);
+  const bool rate_dependent = asmb.state_size() > 0;
+  std::vector<double> offset;
+  DriveResult result;
+  const LoadHistory load = recording_load(scene, rec, opt, rate_dependent, offset, result);
 
   // Measured angles without outlier frames, only to pick the worst states for VTU output.
   const bool want_vtu = !opt.vtu_dir.empty() && opt.vtu_worst > 0;
@@ -379,6 +464,8 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
                          opt.progress_log_every_s);
   std::vector<double> before(load.trials.size() + 1, 0.0);  // the recording's time before each trial
   for (std::size_t k = 0; k < load.trials.size(); ++k) before[k + 1] = before[k] + load.trials[k].duration();
+  // Each reported state: into the trial's traces, the progress line, and (with VTU output) the
+  // list of the opt.vtu_worst states farthest from the measured angle, largest first.
   auto observe = [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>& state) {
     const std::size_t k = static_cast<std::size_t>(r.trial - 1);
     TrialTrace& tt = result.trials[k];
@@ -408,67 +495,13 @@ DriveResult simulate_recording(const Scene& scene, const Recording& rec, const D
     for (TrialTrace& tt : result.trials) tt.states_angle_deg = tt.states_pressure_kPa = Series();
     worst.clear();
   };
-  std::size_t failed_trial = rec.trials.size();  // index of the trial that stopped early
-  try {
-    const bool reduced =
-        bm->solver.mode == SolverSettings::Mode::QuasiStatic && bm->solver.model == SolverSettings::Model::Reduced;
-    const std::string fallback = reduced ? drive_reduced(scene, *bm, load, opt, observe, clear_traces, result) : std::string();
-    if (!fallback.empty()) {
-      clear_traces();
-      result.model = "full (fallback: " + fallback + ")";
-      progress.message("  " + result.model);
-    }
-    if (!reduced || !fallback.empty()) {
-      // A recording is compared frame by frame and its measured trials differ: every trial is solved.
-      QuasiStaticOptions qs = bm->solver.quasi_static;
-      qs.cycle_jump.on = false;
-      QuasiStaticRun run(asmb, qs);
-      try {
-        run.run(load, observe);
-      } catch (...) {
-        result.states = run.stats().states;
-        throw;
-      }
-      result.states = run.stats().states;
-    }
-  } catch (const PhysicsError& e) {
-    if (!opt.partial_on_failure) throw;
-    result.failure = e.what();
-    failed_trial = 0;
-    while (failed_trial + 1 < rec.trials.size() && !result.trials[failed_trial + 1].states_angle_deg.t_s.empty())
-      ++failed_trial;
-    const Series& solved = result.trials[failed_trial].states_angle_deg;
-    result.failure_time_s = solved.t_s.empty() ? 0.0 : solved.t_s.back();
-  }
+  const std::size_t failed_trial =
+      drive_load(scene, *bm, asmb, load, rec.trials.size(), opt, observe, clear_traces, progress, result);
   progress.done();
   result.mesh = bm->stats;
 
-  for (std::size_t k = 0; k < rec.trials.size(); ++k) {
-    TrialTrace& tt = result.trials[k];
-    const Series& frames = rec.trials[k].angle_deg;
-    tt.angle_deg.t_s = frames.t_s;
-    tt.angle_deg.value.reserve(frames.t_s.size());
-    const Series& solved = tt.states_angle_deg;
-    // After an early stop, frames past the last solved state of the failed trial (and all frames
-    // of later trials) have no model value.
-    const double t_end = k < failed_trial    ? INFINITY
-                         : k == failed_trial ? (solved.t_s.empty() ? -INFINITY : solved.t_s.back())
-                                             : -INFINITY;
-    for (double t : frames.t_s)
-      tt.angle_deg.value.push_back(t <= t_end && !solved.t_s.empty() ? interp_clamped(solved.t_s, solved.value, t) : NAN);
-  }
-  if (want_vtu && !worst.empty()) {
-    std::filesystem::create_directories(opt.vtu_dir);
-    for (std::size_t i = 0; i < worst.size(); ++i) {
-      Candidate& c = worst[i];
-      c.info.file = (std::filesystem::path(opt.vtu_dir) / ("worst_" + std::to_string(i + 1) + ".vtu")).string();
-      const TrialTrace& tt = *std::find_if(result.trials.begin(), result.trials.end(),
-                                           [&](const TrialTrace& x) { return x.trial == c.info.trial; });
-      write_vtu(c.info.file, bm->model, compute_fields(asmb, c.u, c.state), c.info.time_s, c.info.trial,
-                interp_clamped(tt.states_pressure_kPa.t_s, tt.states_pressure_kPa.value, c.info.time_s), c.info.model_deg);
-      result.worst.push_back(c.info);
-    }
-  }
+  model_at_frames(rec, failed_trial, result);
+  if (want_vtu && !worst.empty()) write_worst_states(worst, *bm, asmb, opt, result);
   result.scene_text = "# [load] is replaced by the " + load.description + "; rest between trials = load.rest_s\n" +
                       scene.to_toml();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -3,6 +3,7 @@
 #include "scenes/scene_settings.h"
 
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -27,6 +28,45 @@ TEST(SceneSettings, MeshSourceOfTheDefaultSceneAndOfADeck) {
   EXPECT_EQ(deck.file, "actuator.inp");
   EXPECT_EQ(deck.h_mm, 0.0);  // a deck is its own mesh
   EXPECT_EQ(mesh_settings(base.with({"mesh.source=\"stl\""})).source, MeshSettings::Source::Stl);
+}
+
+// The meshers' keys in SI units, read for the sources that use them; each bad value names its key.
+TEST(SceneSettings, MesherKeysAndTheGeometry) {
+  const Scene base = Scene::load("", {"mesh.h_mm=4", "mesh.h_z_mm=2.5", "mesh.half=false", "mesh.element=\"tet4\"",
+                                      "mesh.fabric_layers=2", "mesh.fabric_model=\"membrane\""});
+  const MeshSettings m = mesh_settings(base);
+  EXPECT_EQ(m.h_m, 4e-3);
+  EXPECT_EQ(m.h_z_m, 2.5e-3);
+  EXPECT_FALSE(m.half);
+  EXPECT_EQ(m.element, ElementType::Tet4);
+  EXPECT_EQ(m.fabric_layers, 2);
+  EXPECT_TRUE(m.membrane_fabric);
+  const PneuNetParams p = pneunet_settings(base.with({"geometry.chambers=7", "geometry.width_mm=20"}));
+  EXPECT_EQ(p.chambers, 7);
+  EXPECT_EQ(p.width, 20e-3);
+  EXPECT_EQ(p.h, 4e-3);
+  EXPECT_EQ(p.h_z, 2.5e-3);
+  EXPECT_EQ(p.element, ElementType::Tet4);
+  EXPECT_EQ(p.fabric_model, FabricModel::Membrane);
+  EXPECT_FALSE(p.half);
+  // A deck's unit; the mesher's keys keep their defaults.
+  const MeshSettings deck = mesh_settings(base.with({"mesh.source=\"inp\"", "mesh.length_unit=\"m\""}));
+  EXPECT_EQ(deck.length_unit_m, 1.0);
+  EXPECT_EQ(deck.h_m, 0.0);
+  EXPECT_EQ(mesh_settings(Scene::load("")).length_unit_m, 1e-3);
+  const Scene d = Scene::load("");
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.element=\"hex8\""})); })
+                .find("key 'mesh.element': must be \"tet10\" or \"tet4\", got \"hex8\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.h_z_mm=-1"})); }).find("mesh.h_z_mm"), std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.fabric_model=\"cloth\""})); })
+                .find("must be \"solid\" or \"membrane\", got \"cloth\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.source=\"inp\"", "mesh.length_unit=\"in\""})); })
+                .find("must be \"mm\" or \"m\", got \"in\""),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { mesh_settings(d.with({"mesh.source=\"stl\"", "mesh.h_mm=0"})); }).find("mesh.h_mm"),
+            std::string::npos);
 }
 
 // The message build_model gave before the settings were typed: the key, where it was set, the values.
@@ -83,6 +123,26 @@ TEST(SceneSettings, LoadProtocolAndRest) {
   const std::string msg = error_of([&] { load_settings(base.with({"load.protocol=\"ramp\""})); });
   EXPECT_NE(msg.find("load.protocol"), std::string::npos) << msg;
   EXPECT_NE(msg.find("must be \"staircase\" or \"csv\", got \"ramp\""), std::string::npos) << msg;
+}
+
+// The staircase's numbers, read once in SI units; inlet_load builds the protocol from them.
+TEST(SceneSettings, StaircaseNumbersInSI) {
+  const Scene s = Scene::load("", {"load.max_kPa=30", "load.step_kPa=7.5", "load.hold_s=4", "load.ramp_s=0.25",
+                                   "load.mark_s=2", "load.trials=3", "load.output_every_s=1", "load.csv=\"p.csv\""});
+  const LoadSettings l = load_settings(s);
+  EXPECT_EQ(l.max_Pa, 30e3);
+  EXPECT_EQ(l.step_Pa, 7.5e3);
+  EXPECT_EQ(l.hold_s, 4.0);
+  EXPECT_EQ(l.ramp_s, 0.25);
+  EXPECT_EQ(l.mark_s, 2.0);
+  EXPECT_EQ(l.trials, 3);
+  EXPECT_EQ(l.output_every_s, 1.0);
+  EXPECT_EQ(l.csv, "p.csv");
+  const LoadHistory h = inlet_load(s);
+  ASSERT_EQ(h.trials.size(), 3u);
+  EXPECT_EQ(h.trials[0].step_level_Pa, (std::vector<double>{0.0, 7.5e3, 15e3, 22.5e3, 30e3}));
+  EXPECT_EQ(h.trials[0].mark_s, 2.0);
+  EXPECT_EQ(h.trials[0].time_s[2], 4.25);  // the first ramp ends ramp_s after the hold
 }
 
 TEST(SceneSettings, SolverAndOutput) {
