@@ -37,6 +37,7 @@ StlMeshSpec stl_spec(const Scene& s) {
   if (o.h_z < 0) s.fail("mesh.h_z_mm", "must be >= 0 (0 = same as mesh.h_mm)");
   o.half = s.boolean("mesh.half");
   o.feature_planes = s.boolean("mesh.feature_planes");
+  spec.wall_cells = s.integer("mesh.wall_cells");
   const std::vector<double> slab = s.numbers("mesh.fabric_slab_mm");
   if (!slab.empty()) {
     if (slab.size() != 2 || !(slab[0] < slab[1]))
@@ -99,7 +100,7 @@ Mesh stl_scene_mesh(const Scene& s, std::vector<std::string>* warnings, StlMeshR
   } catch (const InputError& e) {
     const std::string what = e.what();
     // The mesher names the key it refuses; others are the file's.
-    for (const char* key : {"mesh.cavity_inlet_mm", "mesh.fixed_face", "mesh.fabric_slab_mm", "mesh.half", "mesh.h_mm"})
+    for (const char* key : {"mesh.cavity_inlet_mm", "mesh.fixed_face", "mesh.fabric_slab_mm", "mesh.half", "mesh.wall_cells", "mesh.h_mm"})
       if (what.find(key) != std::string::npos)
         s.fail(key, what.rfind(std::string(key) + ": ", 0) == 0 ? what.substr(std::string(key).size() + 2) : what);
     s.fail("mesh.file", what);

@@ -15,6 +15,7 @@
 #include "core/number_text.h"
 #include "engine/tet_element.h"
 #include "scenes/stl/distance.h"
+#include "scenes/stl/thin_walls.h"
 
 namespace pneufem {
 
@@ -203,17 +204,22 @@ namespace {
 
 /// The OpenVDB band must hold every background edge that can cross the surface: the longest cell
 /// diagonal of the grid, plus a margin of voxels. Voxels of h/3.
-std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const StuffingOptions& opt, StlMeshReport& rep) {
+/// The thin-wall rays (scenes/stl/thin_walls.h) need half the thickest wall they refine,
+/// wall_cells * h / 2; refinement only shortens the cells, so the band of the uniform grid holds
+/// the graded one's.
+std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const StuffingOptions& opt, int wall_cells,
+                                              StlMeshReport& rep) {
   const auto lines = stuffing_grid(surface, opt);
   double diag2 = 0.0;
   for (int d = 0; d < 3; ++d) {
     double longest = 0.0;
     for (std::size_t i = 0; i + 1 < lines[d].size(); ++i) longest = std::max(longest, lines[d][i + 1] - lines[d][i]);
     diag2 += longest * longest;
-    rep.grid_lines[d] = static_cast<int>(lines[d].size());
   }
+  const double h_max = std::max(opt.h, opt.h_z > 0.0 ? opt.h_z : opt.h);
   rep.voxel_m = std::min(opt.h, opt.h_z > 0.0 ? opt.h_z : opt.h) / 3.0;
-  auto dist = std::make_unique<SurfaceDistance>(surface, rep.voxel_m, std::sqrt(diag2) + 3.0 * rep.voxel_m);
+  const double band = std::max(std::sqrt(diag2), 0.5 * wall_cells * h_max) + 3.0 * rep.voxel_m;
+  auto dist = std::make_unique<SurfaceDistance>(surface, rep.voxel_m, band);
   rep.band_voxels = dist->voxels();
   return dist;
 }
@@ -327,9 +333,20 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   if (!(opt.h > 0.0 && std::isfinite(opt.h))) throw InputError("mesh.h_mm must be a positive element size");
   const std::vector<char> cavity = cavity_shells(surface, spec);
   const auto [fixed_plane, tip_plane] = end_planes(surface, spec);
-  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, opt, rep);
+  if (spec.wall_cells < 0) throw InputError("mesh.wall_cells must be >= 0 (0 = no refinement across thin walls)");
+  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, opt, spec.wall_cells, rep);
+  StuffingOptions graded = opt;
+  {
+    ThinWalls thin = measure_thin_walls(surface, *dist, opt, spec.wall_cells);
+    graded.sizes = std::move(thin.sizes);
+    rep.thin_rays = thin.samples;
+    rep.thin_found = thin.thin;
+    rep.thinnest_m = thin.thinnest;
+    rep.notes.insert(rep.notes.end(), thin.notes.begin(), thin.notes.end());
+  }
 
-  const StuffedTets st = stuff_surface(surface, *dist, opt);
+  const StuffedTets st = stuff_surface(surface, *dist, graded);
+  for (int d = 0; d < 3; ++d) rep.grid_lines[d] = static_cast<int>(st.lines[d].size());
   rep.warped = st.warped;
   rep.creased = st.creased;
   rep.on_sharp_edges = st.on_sharp_edges;
@@ -357,12 +374,12 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
 }
 
 std::string describe(const StlMeshReport& r) {
-  char buf[512];
+  char buf[640];
   std::snprintf(buf, sizeof buf,
-                "background grid %d x %d x %d lines; OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
+                "background grid %d x %d x %d lines (%d of %d thin-wall rays refined it, thinnest %.3g mm); OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
                 "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
                 "min radius ratio %.3f; volume %+.2f %% of the surface's; %d mid-nodes on the surface, %d kept straight; %.2f s\n",
-                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
+                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.thin_found, r.thin_rays, r.thinnest_m * 1e3, r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
                 r.flat_dropped, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
                 100.0 * r.volume_error, r.midnodes_on_surface, r.midnodes_kept_straight, r.seconds);
   std::string s = buf;

@@ -5,6 +5,8 @@
 // roof, side_wall, interior_wall, by the built-in mesher's rules against the cavity's bounding box,
 // when the actuator lies along y; else fabric and body).
 //
+//  * Grid: graded so that at least wall_cells cells lie across every wall and gap the grid cuts
+//    (scenes/stl/thin_walls.h).
 //  * Tetrahedra: isosurface stuffing of the solid (scenes/stl/stuffing.h), promoted to Tet10 with
 //    the mid-nodes of boundary edges moved onto the surface (closest point); a mid-node whose move
 //    would leave an element's scaled Jacobian (engine/tet_element.h) below 0.5 stays straight.
@@ -38,10 +40,15 @@ struct StlMeshSpec {
   std::string fixed_face = "y-";
   Eigen::Vector3d fixed_point = Eigen::Vector3d::Zero();   ///< m
   Eigen::Vector3d fixed_normal = Eigen::Vector3d(0, -1, 0);
+  /// Fewest background cells across every wall and gap the grid cuts (scenes/stl/thin_walls.h);
+  /// walls between two grid planes are meshed exactly and keep ceil(t / h) cells. 0 = uniform h.
+  int wall_cells = 2;
 };
 
 struct StlMeshReport {
   int grid_lines[3] = {0, 0, 0};
+  int thin_rays = 0, thin_found = 0;    ///< rays cast for thin walls and gaps; those that refined the grid
+  double thinnest_m = 0.0;              ///< the thinnest wall or gap refined (0 = none)
   long band_voxels = 0;
   double voxel_m = 0.0;
   int warped = 0, creased = 0, on_sharp_edges = 0, cut_points = 0, flat_dropped = 0;

@@ -40,7 +40,7 @@ std::array<std::map<double, double>, 3> facet_planes(const TriSurface& s) {
 
 }  // namespace
 
-std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const StuffingOptions& o) {
+std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& s, const StuffingOptions& o) {
   Eigen::Vector3d lo = s.V.front(), hi = s.V.front();
   for (const auto& p : s.V) {
     lo = lo.cwiseMin(p);
@@ -55,7 +55,7 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
     lo.x() = 0.0;
   }
   const auto facets = facet_planes(s);
-  std::array<std::vector<double>, 3> lines;
+  std::array<std::vector<double>, 3> ends;
   for (int d = 0; d < 3; ++d) {
     const double h = axis_h(o, d);
     constexpr double kForced = std::numeric_limits<double>::infinity();
@@ -90,12 +90,63 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
     if (!(d == 0 && o.half)) at.push_back(!planes.empty() && planes.front().at <= lo[d] ? planes.front().at - h : lo[d] - 0.5 * h);
     for (const Plane& p : planes) at.push_back(p.at);
     at.push_back(!planes.empty() && planes.back().at >= hi[d] ? planes.back().at + h : hi[d] + 0.5 * h);
+    ends[d] = std::move(at);
+  }
+  return ends;
+}
+
+std::vector<double> subdivide_interval(double a, double b, double h, const std::vector<AxisSize>& sizes, double grading) {
+  auto size_at = [&](double x) {
+    double s = h;
+    for (const AxisSize& z : sizes) s = std::min(s, z.spacing + grading * std::max({0.0, z.lo - x, x - z.hi}));
+    return s;
+  };
+  double s_min = h;
+  for (const AxisSize& z : sizes) s_min = std::min(s_min, z.spacing + grading * std::max({0.0, z.lo - b, a - z.hi}));
+  std::vector<double> L;
+  if (!(s_min < h)) {  // nothing finer in reach: equal cells, as the built-in mesher
+    const int n = static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
+    for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+    L.push_back(b);
+    return L;
+  }
+  // Cumulative integral of 1/s on a fine uniform sampling (trapezoid rule; 16 samples per
+  // smallest cell keep the cells' sizes within a few per cent of s), then inverted linearly.
+  const int m = static_cast<int>(std::clamp(std::ceil(16.0 * (b - a) / s_min), 16.0, 4e6));
+  std::vector<double> cum(m + 1, 0.0);
+  double f0 = 1.0 / size_at(a);
+  for (int i = 1; i <= m; ++i) {
+    const double f1 = 1.0 / size_at(a + (b - a) * i / m);
+    cum[i] = cum[i - 1] + 0.5 * (f0 + f1) * (b - a) / m;
+    f0 = f1;
+  }
+  const int n = static_cast<int>(std::max(1.0, std::ceil(cum[m] * (1.0 - 1e-12))));
+  L.push_back(a);
+  for (int k = 1, i = 1; k < n; ++k) {
+    const double target = cum[m] * k / n;
+    while (cum[i] < target) ++i;
+    const double t = (target - cum[i - 1]) / (cum[i] - cum[i - 1]);
+    L.push_back(a + (b - a) * (i - 1 + t) / m);
+  }
+  L.push_back(b);
+  return L;
+}
+
+std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const StuffingOptions& o) {
+  const auto ends = stuffing_planes(s, o);
+  std::array<std::vector<double>, 3> lines;
+  for (int d = 0; d < 3; ++d) {
+    const auto& at = ends[d];
     auto& L = lines[d];
     for (std::size_t m = 0; m + 1 < at.size(); ++m) {
       const double a = at[m], b = at[m + 1];
       const bool slab = d == 2 && o.has_slab && a == o.slab_z0 && b == o.slab_z1;
-      const int n = slab ? o.slab_cells : static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
-      for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+      if (slab) {
+        for (int k = 0; k < o.slab_cells; ++k) L.push_back(a + (b - a) * k / o.slab_cells);
+        continue;
+      }
+      std::vector<double> sub = subdivide_interval(a, b, axis_h(o, d), o.sizes[d], o.grading);
+      L.insert(L.end(), sub.begin(), sub.end() - 1);
     }
     L.push_back(at.back());
   }

@@ -44,6 +44,12 @@
 
 namespace pneufem {
 
+/// Cells along one axis no longer than `spacing` within [lo, hi] (m): a thin wall's requirement
+/// (scenes/stl/thin_walls.h). Away from [lo, hi] the bound grows by `grading` per unit distance.
+struct AxisSize {
+  double lo = 0.0, hi = 0.0, spacing = 0.0;
+};
+
 struct StuffingOptions {
   double h = 2e-3;                   ///< target cell size in x and y (m)
   double h_z = 0.0;                  ///< along z (m); 0 = h
@@ -53,6 +59,12 @@ struct StuffingOptions {
   double slab_z0 = 0.0, slab_z1 = 0.0;
   int slab_cells = 1;                ///< grid cells through the slab
   double alpha = 0.25;               ///< warping threshold, a fraction of the edge length
+  /// Graded refinement per axis (empty: every interval between planes gets ceil(length / h)
+  /// cells). Within an interval the cell size follows s(x) = min(h, min_k spacing_k + grading *
+  /// dist(x, [lo_k, hi_k])), and the lines equidistribute the integral of 1/s (de Boor's
+  /// equidistribution; the interval gets ceil of that integral cells, each no longer than s).
+  std::array<std::vector<AxisSize>, 3> sizes;
+  double grading = 0.4;              ///< growth of the cell size per unit distance (neighbours differ by <= ~1.4x)
 };
 
 struct StuffedTets {
@@ -73,5 +85,14 @@ StuffedTets stuff_surface(const TriSurface& surface, const SurfaceDistance& dist
 
 /// The grid lines of step 1 (for the band the distance needs: the longest cell diagonal).
 std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& surface, const StuffingOptions& opt);
+
+/// The planes of step 1 before subdivision, per axis and increasing: the two ends (padding
+/// beyond the surface), the forced planes and the feature planes. stuffing_grid subdivides
+/// every interval between them.
+std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& surface, const StuffingOptions& opt);
+
+/// Lines from a to b (both included) with cells no longer than the graded size of `sizes` (and h);
+/// without a size below h in reach, ceil((b - a) / h) equal cells.
+std::vector<double> subdivide_interval(double a, double b, double h, const std::vector<AxisSize>& sizes, double grading);
 
 }  // namespace pneufem
