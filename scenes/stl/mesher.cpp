@@ -352,6 +352,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   rep.on_sharp_edges = st.on_sharp_edges;
   rep.cut_points = st.cut_points;
   rep.flat_dropped = st.flat_dropped;
+  rep.smoothed = st.smoothed;
 
   Mesh m = tagged_tet4(st, surface, cavity, spec, rep);
   check_volume(surface, m, opt, rep);
@@ -377,10 +378,10 @@ std::string describe(const StlMeshReport& r) {
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "background grid %d x %d x %d lines (%d of %d thin-wall rays refined it, thinnest %.3g mm); OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
-                "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
+                "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped, %d smoothing moves\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
                 "min radius ratio %.3f; volume %+.2f %% of the surface's; %d mid-nodes on the surface, %d kept straight; %.2f s\n",
                 r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.thin_found, r.thin_rays, r.thinnest_m * 1e3, r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
-                r.flat_dropped, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
+                r.flat_dropped, r.smoothed, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
                 100.0 * r.volume_error, r.midnodes_on_surface, r.midnodes_kept_straight, r.seconds);
   std::string s = buf;
   s += "min dihedral angle per element (10-degree bins from 0):";

@@ -51,7 +51,7 @@ struct StlMeshReport {
   double thinnest_m = 0.0;              ///< the thinnest wall or gap refined (0 = none)
   long band_voxels = 0;
   double voxel_m = 0.0;
-  int warped = 0, creased = 0, on_sharp_edges = 0, cut_points = 0, flat_dropped = 0;
+  int warped = 0, creased = 0, on_sharp_edges = 0, cut_points = 0, flat_dropped = 0, smoothed = 0;
   int tets = 0, nodes = 0;
   double min_dihedral_deg = 0.0, max_dihedral_deg = 0.0;
   std::vector<int> dihedral_histogram;  ///< counts per 10 degrees, 0-10 ... 170-180 (corner tetrahedra)

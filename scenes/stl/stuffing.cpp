@@ -12,6 +12,7 @@
 
 #include "core/errors.h"
 #include "core/number_text.h"
+#include "scenes/stl/smoothing.h"
 
 namespace pneufem {
 
@@ -252,23 +253,6 @@ int snap_to_creases(std::vector<Eigen::Vector3d>& X, const std::vector<double>& 
   return moved;
 }
 
-/// Smallest dihedral angle (degrees) of tetrahedron (a, b, c, d); 0 when it is flat or inverted.
-double min_dihedral_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                        const Eigen::Vector3d& d) {
-  if ((b - a).cross(c - a).dot(d - a) <= 0.0) return 0.0;
-  const Eigen::Vector3d p[4] = {a, b, c, d};
-  static constexpr int kPairs[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
-  double lo = 180.0;
-  for (const auto& q : kPairs) {
-    const Eigen::Vector3d e = (p[q[1]] - p[q[0]]).normalized();
-    Eigen::Vector3d u = p[q[2]] - p[q[0]], w = p[q[3]] - p[q[0]];
-    u -= u.dot(e) * e;
-    w -= w.dot(e) * e;
-    lo = std::min(lo, std::acos(std::clamp(u.normalized().dot(w.normalized()), -1.0, 1.0)) * 180.0 / 3.141592653589793);
-  }
-  return lo;
-}
-
 /// Step 6: sharp edges. Stencils cut a sharp edge of the surface (two facets meeting at more than
 /// 30 degrees: a box's edge, a chamber's) with a chamfer about a cell wide. Each surface node within
 /// `reach` of a sharp edge and on a boundary face that leaves the surface (a chamfer: its centroid
@@ -334,13 +318,13 @@ int snap_to_sharp_edges(StuffedTets& out, const TriSurface& s, const SurfaceDist
     std::vector<double> before;
     for (int t : tets_of[v]) {
       const auto& q = out.tets[t];
-      before.push_back(min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]));
+      before.push_back(tet_min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]));
     }
     out.X[v] = target[v];
     bool ok = true;
     for (std::size_t i = 0; i < tets_of[v].size() && ok; ++i) {
       const auto& q = out.tets[tets_of[v][i]];
-      ok = min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]) >= std::min(5.0, before[i]);
+      ok = tet_min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]) >= std::min(5.0, before[i]);
     }
     if (ok)
       ++moved;
@@ -367,6 +351,7 @@ class Stuffing {
     for (int j = 0; j < n_[1]; ++j)
       for (int k = 0; k < n_[2]; ++k)
         for (int i = 0; i < n_[0]; ++i) X_[vid(i, j, k)] = Eigen::Vector3d(out_.lines[0][i], out_.lines[1][j], out_.lines[2][k]);
+    grid_X_ = X_;
     h_min_ = std::min(opt.h, axis_h(opt, 2));
     zero_tol_ = 1e-9 * h_min_;  // round-off of a distance to a facet the vertex lies on
   }
@@ -385,6 +370,15 @@ class Stuffing {
     out_.creased = snap_to_creases(X_, phi_, nbr_, forced_, dist_, opt_.alpha, zero_tol_);
     compact(stencils());
     out_.on_sharp_edges = snap_to_sharp_edges(out_, s_, dist_, 0.9 * h_min_);
+    if (opt_.smooth_target_deg > 0.0) {
+      SmoothingOptions so;
+      so.target_deg = opt_.smooth_target_deg;
+      so.has_slab = opt_.has_slab;
+      so.slab_z0 = opt_.slab_z0;
+      so.slab_z1 = opt_.slab_z1;
+      so.zero_tol = zero_tol_;
+      out_.smoothed = smooth_cut_elements(out_, out_.from_cut, dist_, so);
+    }
     return std::move(out_);
   }
 
@@ -611,6 +605,7 @@ class Stuffing {
           out_.X.push_back(pos_of(v));
           out_.on_surface.push_back(v >= nv_ || phi_[v] == 0.0 ? 1 : 0);
           out_.on_symmetry.push_back(opt_.half && out_.X.back().x() == 0.0 ? 1 : 0);
+          out_.from_cut.push_back(v >= nv_ || X_[v] != grid_X_[v] ? 1 : 0);
         }
         v = new_id[v];
       }
@@ -627,7 +622,7 @@ class Stuffing {
   int n_[3] = {0, 0, 0};
   int nv_ = 0;
   double h_min_ = 0.0, zero_tol_ = 0.0;
-  std::vector<Eigen::Vector3d> X_;
+  std::vector<Eigen::Vector3d> X_, grid_X_;  // current and original positions of the grid vertices
   std::vector<double> phi_;
   std::vector<std::array<int, 4>> bg_;
   std::unordered_map<std::uint64_t, int, EdgeHash> cut_of_;  // edge -> index into cut_pos_

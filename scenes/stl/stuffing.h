@@ -28,6 +28,10 @@
 //    tetrahedron around them with a dihedral angle below 5 degrees. Stencils alone cut such edges
 //    with a chamfer about a cell wide.
 //
+// 7. Smoothing (an addition): the tetrahedra steps 3-6 made with a dihedral angle below
+//    smooth_target_deg have their vertices moved to raise it (scenes/stl/smoothing.h); the grid's
+//    own tetrahedra, where nothing was cut, are left as they are.
+//
 // What is simplified (and so not proven): L&S's grid is the body-centred cubic lattice, with
 // alpha_long = 0.24999 and alpha_short = 0.41189 and a parity rule for the prisms' diagonals, which
 // together bound every dihedral angle to [10.7, 164.8] degrees. Here the grid is rectilinear (to
@@ -65,6 +69,9 @@ struct StuffingOptions {
   /// equidistribution; the interval gets ceil of that integral cells, each no longer than s).
   std::array<std::vector<AxisSize>, 3> sizes;
   double grading = 0.4;              ///< growth of the cell size per unit distance (neighbours differ by <= ~1.4x)
+  /// Step 7: tetrahedra the cut made with a dihedral angle below this are improved by vertex
+  /// smoothing (scenes/stl/smoothing.h); 0 = none.
+  double smooth_target_deg = 15.0;
 };
 
 struct StuffedTets {
@@ -72,12 +79,14 @@ struct StuffedTets {
   std::vector<std::array<int, 4>> tets;      ///< positive volume
   std::vector<char> on_surface;              ///< per node: phi = 0 (a cut point or a warped vertex)
   std::vector<char> on_symmetry;             ///< per node: on the plane x = 0 (half)
+  std::vector<char> from_cut;                ///< per node: a cut point, or a grid vertex the cut moved
   std::array<std::vector<double>, 3> lines;  ///< the grid lines
   int warped = 0;                            ///< vertices moved onto the surface
   int cut_points = 0;
   int on_sharp_edges = 0;                    ///< surface nodes moved onto a sharp edge (step 6)
   int creased = 0;                           ///< surface vertices moved onto a crease (step 4b)
   int flat_dropped = 0;                      ///< stencil tetrahedra of no volume, left out
+  int smoothed = 0;                          ///< vertex moves of step 7
 };
 
 /// Steps 1-5 above. `dist` must answer within a band of at least max_cell_diagonal(opt, surface).

@@ -93,7 +93,9 @@ TEST(StlMesher, UniformLatticeCutsTheBoxesToTheSurface) {
   // Warped vertices lie on the surface; corner tets of the stencils only cut the box corners, so
   // the volume is within 2 % (a cut corner at h = 1 mm loses at most h^3/6 per corner).
   EXPECT_NEAR(mesh_volume(m), mesh_volume(built_in), 0.02 * mesh_volume(built_in));
-  EXPECT_GT(rep.min_dihedral_deg, 1.0);
+  // The cut's worst tetrahedra are smoothed (scenes/stl/smoothing.h): measured 15.1 deg, 8.0
+  // without smoothing.
+  EXPECT_GT(rep.min_dihedral_deg, 12.0);
   for (int e = 0; e < m.num_elements(); ++e) ASSERT_GT(tet10_distortion(m, e).min_scaled_jacobian, 0.1) << e;
 }
 
