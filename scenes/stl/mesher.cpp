@@ -224,12 +224,26 @@ std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const S
   return dist;
 }
 
+/// The axis (0 = x, 1 = y) along which the actuator lies when its fixed face is normal to x or y
+/// ("x-", "x+", "y-", "y+", or a "plane" whose normal is within 1 degree of one of them); -1 else.
+int horizontal_length_axis(const StlMeshSpec& spec) {
+  const std::string& f = spec.fixed_face;
+  if (f == "x-" || f == "x+") return 0;
+  if (f == "y-" || f == "y+") return 1;
+  if (f == "plane" && spec.fixed_normal.norm() > 0.0) {
+    const Eigen::Vector3d n = spec.fixed_normal.normalized();
+    for (int d = 0; d < 2; ++d)
+      if (std::abs(n[d]) > std::cos(std::numbers::pi / 180.0)) return d;
+  }
+  return -1;
+}
+
 /// The Tet4 mesh of the stuffed tetrahedra with region tags, element sets SILICONE and FABRIC,
 /// and its dihedral angles in the report. Tags, by the element's centroid against the bounding
 /// box of the cavity (the built-in pneu-net's rules, scenes/pneunet.cpp, when the actuator lies
-/// as it does: along y, fixed face "y-" or "y+"): fabric (in the slab), base (below the cavity),
-/// end_cap (beyond it along y), roof (above it), side_wall (beside it in x), interior_wall (the
-/// walls between chambers); another frame tags all but the fabric "body".
+/// along y as it does, or along x; z up): fabric (in the slab), base (below the cavity), end_cap
+/// (beyond it along the length), roof (above it), side_wall (beside it across the width),
+/// interior_wall (the walls between chambers); another frame tags all but the fabric "body".
 Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::vector<char>& cavity, const StlMeshSpec& spec,
                  StlMeshReport& rep) {
   const StuffingOptions& opt = spec.stuffing;
@@ -240,7 +254,9 @@ Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::ve
   for (int f = 0; f < static_cast<int>(surface.F.size()); ++f)
     if (cavity[surface.face_shell[f]])
       for (int v : surface.F[f]) clo = clo.cwiseMin(surface.V[v]), chi = chi.cwiseMax(surface.V[v]);
-  const bool along_y = spec.fixed_face == "y-" || spec.fixed_face == "y+";
+  const int length_axis = horizontal_length_axis(spec);
+  const bool along_y = length_axis >= 0;  // an actuator lying along x or y, z up
+  const int width_axis = 1 - std::max(length_axis, 0);
   const std::uint16_t r_base = m.region_id(regions::kBase), r_fabric = m.region_id(regions::kFabric);
   std::uint16_t r_cap = 0, r_side = 0, r_roof = 0, r_wall = 0, r_body = 0;
   if (along_y) {
@@ -253,9 +269,9 @@ Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::ve
     if (opt.has_slab && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
     if (!along_y) return r_body;
     if (c.z() < clo.z()) return r_base;
-    if (c.y() < clo.y() || c.y() > chi.y()) return r_cap;
+    if (c[length_axis] < clo[length_axis] || c[length_axis] > chi[length_axis]) return r_cap;
     if (c.z() > chi.z()) return r_roof;
-    if (c.x() < clo.x() || c.x() > chi.x()) return r_side;
+    if (c[width_axis] < clo[width_axis] || c[width_axis] > chi[width_axis]) return r_side;
     return r_wall;
   };
   for (const auto& t : st.tets) {

@@ -3,7 +3,7 @@
 // pneu-net mesher gives (scenes/pneunet.h): element sets SILICONE and FABRIC, node sets FIXED, TIP
 // and, for a half model, SYMMETRY, the surface CAVITY, and region tags (fabric, base, end_cap,
 // roof, side_wall, interior_wall, by the built-in mesher's rules against the cavity's bounding box,
-// when the actuator lies along y; else fabric and body).
+// when the actuator lies along y or x with z up, by its fixed face; else fabric and body).
 //
 //  * Grid: graded so that at least wall_cells cells lie across every wall and gap the grid cuts
 //    (scenes/stl/thin_walls.h).

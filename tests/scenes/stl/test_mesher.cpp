@@ -120,6 +120,44 @@ TEST(StlMesher, CurvedTubeIsMeshedWithMidNodesOnTheSurface) {
   EXPECT_FALSE(m.node_sets.at("TIP").empty());
 }
 
+TEST(StlMesher, AnActuatorAlongXGetsTheRegionsOfOneAlongY) {
+  // The 2-chamber actuator turned 90 degrees about z, (x, y, z) -> (y, -x, z) (exact in floating
+  // point), clamped at its lowest x: the same cells (the grid's axes swap), so every region holds
+  // the same number of elements and the same volume as the actuator along y clamped at y-.
+  PneuNetParams p;
+  p.chambers = 2;
+  p.h = 2e-3;
+  StlMeshSpec spec = default_spec(p);
+  spec.stuffing.half = false;  // the half model's symmetry plane is x = 0
+  const Mesh along_y = mesh_closed_surface(closed(test::pneunet_surface(p)), spec);
+  TriSurface turned = test::pneunet_surface(p);
+  for (auto& v : turned.V) v = Eigen::Vector3d(v.y(), -v.x(), v.z());
+  spec.fixed_face = "x-";
+  const Mesh along_x = mesh_closed_surface(closed(std::move(turned)), spec);
+  ASSERT_EQ(along_x.region_names.size(), along_y.region_names.size());
+  for (std::size_t r = 0; r < along_y.region_names.size(); ++r) {
+    const std::string& name = along_y.region_names[r];
+    const auto it = std::find(along_x.region_names.begin(), along_x.region_names.end(), name);
+    ASSERT_NE(it, along_x.region_names.end()) << name;
+    const auto rx = static_cast<std::uint16_t>(it - along_x.region_names.begin());
+    double vy = 0.0, vx = 0.0;
+    int ny = 0, nx = 0;
+    for (int e = 0; e < along_y.num_elements(); ++e)
+      if (along_y.region[e] == r) vy += corner_volume(along_y, e), ++ny;
+    for (int e = 0; e < along_x.num_elements(); ++e)
+      if (along_x.region[e] == rx) vx += corner_volume(along_x, e), ++nx;
+    EXPECT_EQ(nx, ny) << name;
+    EXPECT_GT(ny, 0) << name;
+    EXPECT_NEAR(vx, vy, 1e-12 * vy) << name;
+  }
+  EXPECT_EQ(along_x.node_sets.at("FIXED").size(), along_y.node_sets.at("FIXED").size());
+  // Clamped on a face normal to z, the frame has no length axis across z up: body and fabric.
+  spec.fixed_face = "z-";
+  const Mesh upright = mesh_closed_surface(closed(test::pneunet_surface(p)), spec);
+  std::set<std::string> names(upright.region_names.begin(), upright.region_names.end());
+  EXPECT_TRUE(names.count("body") == 1 && names.count("roof") == 0);
+}
+
 TEST(StlMesher, BadInputsAreClearErrors) {
   PneuNetParams p;
   p.chambers = 2;
