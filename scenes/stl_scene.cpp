@@ -59,9 +59,13 @@ StlMeshSpec stl_spec(const Scene& s) {
   spec.fixed_face = s.string("mesh.fixed_face");
   spec.fixed_point = s.vec3("mesh.fixed_point_mm") * kmm;
   spec.fixed_normal = s.vec3("mesh.fixed_normal");
-  if (s.string("mesh.fabric_model") != "solid")
-    s.fail("mesh.fabric_model", "must be \"solid\" with mesh.source = \"stl\" (the fabric is the slab "
-                                "mesh.fabric_slab_mm; a membrane needs a surface the STL mesher does not make)");
+  const std::string fabric = s.string("mesh.fabric_model");
+  if (fabric != "solid" && fabric != "membrane")
+    s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + fabric + "\"");
+  if (fabric == "membrane" && !o.has_slab)
+    s.fail("mesh.fabric_model", "\"membrane\" with mesh.source = \"stl\" puts the membrane on the mid-plane of "
+                                "mesh.fabric_slab_mm: give the fabric layer's z range there");
+  o.slab_mid = fabric == "membrane";
   return spec;
 }
 

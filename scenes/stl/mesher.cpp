@@ -266,7 +266,7 @@ Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::ve
     r_body = m.region_id("body");
   }
   auto region_of = [&](const Eigen::Vector3d& c) {
-    if (opt.has_slab && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
+    if (opt.has_slab && !opt.slab_mid && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
     if (!along_y) return r_body;
     if (c.z() < clo.z()) return r_base;
     if (c[length_axis] < clo[length_axis] || c[length_axis] > chi[length_axis]) return r_cap;
@@ -313,6 +313,27 @@ void cavity_faces(Mesh& m, const StuffedTets& st, const TriSurface& surface, con
     throw InputError(surface.path + ": cavity not found in the mesh: no element face lies on the chamber surface at "
                      "mesh.h_mm = " + short_num(h * 1e3) +
                      " (the chambers are smaller than the elements); use a smaller mesh.h_mm");
+}
+
+/// Surface FABRIC_MEMBRANE of a membrane fabric (slab_mid): the element faces on the slab's
+/// mid-plane, each taken once, from the element below it (as the built-in mesher).
+void membrane_faces(Mesh& m, const StuffingOptions& opt) {
+  const double zm = slab_planes(opt)[1];
+  auto& faces = m.surfaces["FABRIC_MEMBRANE"];
+  for (int e = 0; e < m.num_elements(); ++e) {
+    const int* el = m.element(e);
+    for (int f = 0; f < 4; ++f) {
+      const int* fn = face_local_nodes(m.type, f);
+      bool on = true;
+      for (int k = 0; k < 3 && on; ++k) on = m.X[el[fn[k]]].z() == zm;
+      int apex = 0;
+      while (apex == fn[0] || apex == fn[1] || apex == fn[2]) ++apex;
+      if (on && m.X[el[apex]].z() < zm) faces.push_back({e, f});
+    }
+  }
+  if (faces.empty())
+    throw InputError("mesh.fabric_slab_mm: no element face lies on the fabric's mid-plane z = " + short_num(zm * 1e3) +
+                     " mm, where mesh.fabric_model = \"membrane\" puts the membrane; the slab must lie inside the solid");
 }
 
 /// Node sets FIXED and TIP (the boundary faces on the two end planes) and SYMMETRY.
@@ -375,6 +396,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   const std::vector<FaceRef> boundary = boundary_faces(m);
   cavity_faces(m, st, surface, cavity, *dist, boundary, opt.h);
   end_and_symmetry_sets(m, st, spec, fixed_plane, tip_plane, boundary);
+  if (opt.has_slab && opt.slab_mid) membrane_faces(m, opt);
   if (spec.element == ElementType::Tet10) {
     m = promote_to_tet10(m);
     curve_boundary(m, st.on_surface, st.on_symmetry, *dist, rep);

@@ -15,7 +15,9 @@
 //    every shell of a separate cavity file.
 //  * FIXED: the nodes of the boundary faces on the fixed plane, the extreme face of the surface
 //    along an axis ("y-": lowest y) or a plane through a point; TIP: the opposite end face.
-//  * FABRIC: the elements whose centroid lies in the slab z0 < z < z1 (its faces are grid planes).
+//  * FABRIC: the elements whose centroid lies in the slab z0 < z < z1 (its faces are grid planes);
+//    with a membrane fabric (StuffingOptions::slab_mid) FABRIC is empty and the surface
+//    FABRIC_MEMBRANE holds the element faces on the slab's mid-plane.
 //  * Thin features: a meshed volume more than 5 % off the surface's is an error (walls or chambers
 //    thinner than the elements were lost), more than 1 % a note.
 #include <optional>

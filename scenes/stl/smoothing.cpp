@@ -64,7 +64,7 @@ Freedom freedom_of(int v, const StuffedTets& st, const std::vector<Eigen::Vector
   Freedom fr;
   int planes = 0;
   if (st.on_symmetry[v]) ++planes, fr.n = Eigen::Vector3d::UnitX();
-  if (o.has_slab && (st.X[v].z() == o.slab_z0 || st.X[v].z() == o.slab_z1)) ++planes, fr.n = Eigen::Vector3d::UnitZ();
+  if (std::find(o.forced_z.begin(), o.forced_z.end(), st.X[v].z()) != o.forced_z.end()) ++planes, fr.n = Eigen::Vector3d::UnitZ();
   if (st.on_surface[v]) {
     if (planes > 0 || normals.empty()) return fr;  // Fixed
     for (const auto& n : normals)

@@ -32,8 +32,7 @@ double tet_min_dihedral_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
 struct SmoothingOptions {
   double target_deg = 15.0;  ///< elements below it are improved
   int sweeps = 3;            ///< passes over them
-  bool has_slab = false;     ///< the slab's faces z = slab_z0, slab_z1 are forced planes
-  double slab_z0 = 0.0, slab_z1 = 0.0;
+  std::vector<double> forced_z;  ///< forced planes z = const (the fabric slab's, slab_planes())
   double zero_tol = 0.0;     ///< |phi| within which a point is on the surface (m)
 };
 

@@ -41,6 +41,12 @@ std::array<std::map<double, double>, 3> facet_planes(const TriSurface& s) {
 
 }  // namespace
 
+std::vector<double> slab_planes(const StuffingOptions& o) {
+  if (!o.has_slab) return {};
+  if (o.slab_mid) return {o.slab_z0, o.slab_z0 + 0.5 * (o.slab_z1 - o.slab_z0), o.slab_z1};
+  return {o.slab_z0, o.slab_z1};
+}
+
 std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& s, const StuffingOptions& o) {
   Eigen::Vector3d lo = s.V.front(), hi = s.V.front();
   for (const auto& p : s.V) {
@@ -68,8 +74,7 @@ std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& s, const St
                          "] must be an increasing z range strictly inside the actuator's z extent [" +
                          short_num(lo.z() * 1e3) + ", " + short_num(hi.z() * 1e3) +
                          "] mm; give the fabric layer's bottom and top, or [] for no fabric layer");
-      planes.push_back({o.slab_z0, kForced});
-      planes.push_back({o.slab_z1, kForced});
+      for (double z : slab_planes(o)) planes.push_back({z, kForced});
     }
     if (o.feature_planes) {
       // Heaviest planes first; one closer than h/10 to a kept plane would make cells ten times thinner
@@ -141,9 +146,11 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
     auto& L = lines[d];
     for (std::size_t m = 0; m + 1 < at.size(); ++m) {
       const double a = at[m], b = at[m + 1];
-      const bool slab = d == 2 && o.has_slab && a == o.slab_z0 && b == o.slab_z1;
+      const auto zs = d == 2 ? slab_planes(o) : std::vector<double>{};
+      const bool slab = zs.size() >= 2 && a >= zs.front() && b <= zs.back();  // an interval inside the slab
       if (slab) {
-        for (int k = 0; k < o.slab_cells; ++k) L.push_back(a + (b - a) * k / o.slab_cells);
+        const int n = o.slab_mid ? (o.slab_cells + 1) / 2 : o.slab_cells;
+        for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
         continue;
       }
       std::vector<double> sub = subdivide_interval(a, b, axis_h(o, d), o.sizes[d], o.grading);
@@ -352,6 +359,7 @@ class Stuffing {
       for (int k = 0; k < n_[2]; ++k)
         for (int i = 0; i < n_[0]; ++i) X_[vid(i, j, k)] = Eigen::Vector3d(out_.lines[0][i], out_.lines[1][j], out_.lines[2][k]);
     grid_X_ = X_;
+    slab_z_ = slab_planes(opt);
     h_min_ = std::min(opt.h, axis_h(opt, 2));
     zero_tol_ = 1e-9 * h_min_;  // round-off of a distance to a facet the vertex lies on
   }
@@ -373,9 +381,7 @@ class Stuffing {
     if (opt_.smooth_target_deg > 0.0) {
       SmoothingOptions so;
       so.target_deg = opt_.smooth_target_deg;
-      so.has_slab = opt_.has_slab;
-      so.slab_z0 = opt_.slab_z0;
-      so.slab_z1 = opt_.slab_z1;
+      so.forced_z = slab_planes(opt_);
       so.zero_tol = zero_tol_;
       out_.smoothed = smooth_cut_elements(out_, out_.from_cut, dist_, so);
     }
@@ -478,7 +484,7 @@ class Stuffing {
     forced_.assign(nv_, 0);
     for (int v = 0; v < nv_; ++v) {
       const bool on_x = opt_.half && X_[v].x() == 0.0;
-      const bool on_z = opt_.has_slab && (X_[v].z() == opt_.slab_z0 || X_[v].z() == opt_.slab_z1);
+      const bool on_z = std::find(slab_z_.begin(), slab_z_.end(), X_[v].z()) != slab_z_.end();
       forced_[v] = static_cast<char>((on_x ? 1 : 0) | (on_z ? 4 : 0));
     }
     nbr_.assign(nv_, {});
@@ -623,6 +629,7 @@ class Stuffing {
   int nv_ = 0;
   double h_min_ = 0.0, zero_tol_ = 0.0;
   std::vector<Eigen::Vector3d> X_, grid_X_;  // current and original positions of the grid vertices
+  std::vector<double> slab_z_;               // the slab's forced planes
   std::vector<double> phi_;
   std::vector<std::array<int, 4>> bg_;
   std::unordered_map<std::uint64_t, int, EdgeHash> cut_of_;  // edge -> index into cut_pos_

@@ -62,6 +62,9 @@ struct StuffingOptions {
   bool has_slab = false;             ///< a slab z0 < z < z1 whose faces are grid planes
   double slab_z0 = 0.0, slab_z1 = 0.0;
   int slab_cells = 1;                ///< grid cells through the slab
+  /// A membrane fabric: the slab's mid-plane is a grid plane too, and each half of the slab gets
+  /// (slab_cells + 1) / 2 cells (as the built-in mesher); the mesher puts the membrane on it.
+  bool slab_mid = false;
   double alpha = 0.25;               ///< warping threshold, a fraction of the edge length
   /// Graded refinement per axis (empty: every interval between planes gets ceil(length / h)
   /// cells). Within an interval the cell size follows s(x) = min(h, min_k spacing_k + grading *
@@ -99,6 +102,10 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& surface, cons
 /// beyond the surface), the forced planes and the feature planes. stuffing_grid subdivides
 /// every interval between them.
 std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& surface, const StuffingOptions& opt);
+
+/// The forced planes z = const of the slab: its faces and, with slab_mid, its mid-plane (empty
+/// without a slab). Grid vertices on them move only within them.
+std::vector<double> slab_planes(const StuffingOptions& opt);
 
 /// Lines from a to b (both included) with cells no longer than the graded size of `sizes` (and h);
 /// without a size below h in reach, ceil((b - a) / h) equal cells.

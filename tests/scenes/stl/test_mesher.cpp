@@ -78,6 +78,43 @@ TEST(StlMesher, PneuNetSurfaceGivesTheBuiltInSolid) {
   }
 }
 
+TEST(StlMesher, MembraneFabricGivesTheBuiltInMembraneMesh) {
+  // A membrane fabric (slab_mid): the slab's mid-plane becomes a grid plane, the slab's elements
+  // silicone, and FABRIC_MEMBRANE the faces on the mid-plane, as the built-in mesher does.
+  for (const int layers : {1, 2}) {
+    PneuNetParams p;
+    p.chambers = 3;
+    p.h = 4e-3;
+    p.fabric_layers = layers;
+    p.fabric_model = FabricModel::Membrane;
+    const Mesh built_in = build_pneunet(p);
+    StlMeshSpec spec = default_spec(p);
+    spec.stuffing.slab_mid = true;
+    const Mesh m = mesh_closed_surface(closed(test::pneunet_surface(p)), spec);
+    ASSERT_EQ(m.num_nodes(), built_in.num_nodes()) << layers;
+    double max_dx = 0.0;
+    for (int n = 0; n < m.num_nodes(); ++n) max_dx = std::max(max_dx, (m.X[n] - built_in.X[n]).norm());
+    EXPECT_LE(max_dx, 1e-18) << layers;  // the mid-plane z0 + (z1 - z0) / 2 against z0 + t / 2: round-off at most
+    EXPECT_EQ(m.conn, built_in.conn) << layers;
+    EXPECT_EQ(m.region, built_in.region) << layers;
+    EXPECT_TRUE(m.element_sets.at("FABRIC").empty());
+    auto face_nodes = [](const Mesh& mm) {
+      std::set<std::array<int, 3>> out;
+      for (const FaceRef& f : mm.surfaces.at("FABRIC_MEMBRANE")) {
+        const int* fn = face_local_nodes(mm.type, f.local_face);
+        std::array<int, 3> t{mm.element(f.element)[fn[0]], mm.element(f.element)[fn[1]], mm.element(f.element)[fn[2]]};
+        std::sort(t.begin(), t.end());
+        out.insert(t);
+      }
+      return out;
+    };
+    const auto a = face_nodes(m), b = face_nodes(built_in);
+    EXPECT_FALSE(a.empty());
+    EXPECT_EQ(a, b) << layers;
+    EXPECT_EQ(m.surfaces.at("FABRIC_MEMBRANE").size(), a.size());  // each face once
+  }
+}
+
 TEST(StlMesher, UniformLatticeCutsTheBoxesToTheSurface) {
   // Without feature planes the grid ignores the CAD faces: every chamber wall is cut and warped.
   PneuNetParams p;
