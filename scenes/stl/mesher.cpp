@@ -371,10 +371,13 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   const std::vector<char> cavity = cavity_shells(surface, spec);
   const auto [fixed_plane, tip_plane] = end_planes(surface, spec);
   if (spec.wall_cells < 0) throw InputError("mesh.wall_cells must be >= 0 (0 = no refinement across thin walls)");
-  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, opt, spec.wall_cells, rep);
   StuffingOptions graded = opt;
+  for (const FacePlane& p : {fixed_plane, tip_plane})
+    for (int d = 0; d < 3; ++d)
+      if (std::abs(p.normal[d]) == 1.0) graded.end_planes[d].push_back(p.point[d]);
+  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, graded, spec.wall_cells, rep);
   {
-    ThinWalls thin = measure_thin_walls(surface, *dist, opt, spec.wall_cells);
+    ThinWalls thin = measure_thin_walls(surface, *dist, graded, spec.wall_cells);
     graded.sizes = std::move(thin.sizes);
     rep.thin_rays = thin.samples;
     rep.thin_found = thin.thin;

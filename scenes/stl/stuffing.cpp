@@ -68,6 +68,11 @@ std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& s, const St
     constexpr double kForced = std::numeric_limits<double>::infinity();
     std::vector<Plane> planes;
     if (d == 0 && o.half) planes.push_back({0.0, kForced});
+    for (double at : o.end_planes[d]) {
+      bool have = !(at >= lo[d] && at <= hi[d]);  // outside a half model's x >= 0: not meshed
+      for (const Plane& p : planes) have = have || p.at == at;
+      if (!have) planes.push_back({at, kForced});
+    }
     if (d == 2 && o.has_slab) {
       if (!(o.slab_z0 > lo.z() && o.slab_z1 < hi.z() && o.slab_z0 < o.slab_z1))
         throw InputError("mesh.fabric_slab_mm = [" + short_num(o.slab_z0 * 1e3) + ", " + short_num(o.slab_z1 * 1e3) +

@@ -6,7 +6,8 @@
 // 1. Background grid: a rectilinear grid over the surface's bounding box (one padding cell beyond
 //    it), whose lines include every axis-aligned plane that carries facets of the surface (CAD
 //    actuators are mostly boxes: those faces are then meshed exactly, as the built-in mesher
-//    does) and the forced planes (fabric slab, symmetry plane x = 0); each interval between
+//    does) and the forced planes (fabric slab, symmetry plane x = 0, the clamped face and the tip
+//    when they are normal to an axis); each interval between
 //    planes gets ceil(length / h) cells. Each cell is split into 5 tetrahedra with alternating
 //    parity (as scenes/pneunet.cpp), which conform across cells.
 // 2. phi at the grid vertices: the exact signed distance (scenes/stl/distance.h) within the band,
@@ -65,6 +66,10 @@ struct StuffingOptions {
   /// A membrane fabric: the slab's mid-plane is a grid plane too, and each half of the slab gets
   /// (slab_cells + 1) / 2 cells (as the built-in mesher); the mesher puts the membrane on it.
   bool slab_mid = false;
+  /// Planes forced into the grid along each axis (m): the clamped face and the tip when they are
+  /// normal to an axis, so that they are meshed exactly (no chamfer at their edges) also when
+  /// feature_planes is off. They must be faces of the surface.
+  std::array<std::vector<double>, 3> end_planes;
   double alpha = 0.25;               ///< warping threshold, a fraction of the edge length
   /// Graded refinement per axis (empty: every interval between planes gets ceil(length / h)
   /// cells). Within an interval the cell size follows s(x) = min(h, min_k spacing_k + grading *
