@@ -115,7 +115,7 @@ TEST(StlScene, UniformGridBendsCloseToTheBuiltInMesh) {
   // walls get two cells each (mesh.wall_cells = 2) and their own one in the built-in grid:
   // measured -10.5 % (-14.5 % with wall_cells = 0). At 5 kPa this short actuator's tip face warps
   // as much as it turns, and the angle (the plane through the tip nodes, each weighted alike)
-  // scatters by +-6 % between meshes; weighted by area the STL mesh bends +2.7 % more here
+  // scatters by +-6 % between meshes; weighted by area the STL mesh is within 0.3 % here
   // (bench/notes/2026-11-28-stl-thin-walls.md). The 20 % bound guards the path (a cavity face
   // set lost, a wall thickened by the stencils moves the angle by far more), not the
   // discretisation's accuracy at this h.
