@@ -56,7 +56,8 @@ const std::pair<const std::string, std::vector<FaceRef>>* find_surface(const Mes
 
 /// The membrane fabric: the faces of surface mesh.fabric_surface (the mesher's FABRIC_MEMBRANE on
 /// the layer's mid-plane, or a deck's surface: an embedded sheet of M3D3/M3D6/M3D4/M3D8 elements, a
-/// *SURFACE), thickness geometry.fabric_thickness_mm, plane-stress St Venant-Kirchhoff with E and
+/// *SURFACE), thickness geometry.fabric_thickness_mm (for mesh.source = "stl" that of
+/// mesh.fabric_slab_mm), plane-stress St Venant-Kirchhoff with E and
 /// nu of materials.fabric (which must be linear_elastic).
 MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   const std::string T = "materials.fabric";
@@ -86,6 +87,10 @@ MembraneSet fabric_membrane(const Scene& s, const Mesh& mesh) {
   m.name = surface->first;
   m.nodes = membrane_nodes_of_faces(mesh, surface->second);
   m.thickness_m = positive(s, "geometry.fabric_thickness_mm") * kmm;
+  if (s.string("mesh.source") == "stl") {  // the layer is the slab of the surface's mesh
+    const std::vector<double> slab = s.numbers("mesh.fabric_slab_mm");
+    if (slab.size() == 2) m.thickness_m = (slab[1] - slab[0]) * kmm;
+  }
   // Plane-stress SVK is linear in E: materials.fabric.stiffness_scale scales E exactly (the region
   // scales of [regions] apply to solid elements only).
   m.law = PlaneStressSVK((scaled ? scaled->scale() : 1.0) * svk->youngs_modulus(), svk->poisson_ratio());

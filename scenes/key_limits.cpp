@@ -48,6 +48,7 @@ std::vector<KeyLimit> make_limits() {
   // Elements through a layer: a few resolve it; 100 would multiply the mesh through it a hundredfold.
   l.push_back(closed("mesh.fabric_layers", 1, 100, "a few elements resolve a layer; 100 is a mistake"));
   l.push_back(closed("mesh.wall_layers", 0, 100, "0 = from mesh.h_mm; a few elements resolve a wall; 100 is a mistake"));
+  l.push_back(closed("mesh.wall_cells", 0, 8, "0 = no refinement; two or three cells resolve a wall; each more multiplies the cells there"));
   // mesh.source = "stl": points and z ranges in the model's frame (mm).
   for (const char* k : {"mesh.cavity_inlet_mm", "mesh.fixed_point_mm", "mesh.fabric_slab_mm"})
     l.push_back(closed(k, -kMaxLength_mm, kMaxLength_mm, kLengthWhy));

@@ -31,6 +31,7 @@ StlMeshSpec stl_spec(const Scene& s) {
   o.h_z = m.h_z_m;
   o.half = m.half;
   o.feature_planes = s.boolean("mesh.feature_planes");
+  spec.wall_cells = s.integer("mesh.wall_cells");
   const std::vector<double> slab = s.numbers("mesh.fabric_slab_mm");
   if (!slab.empty()) {
     if (slab.size() != 2 || !(slab[0] < slab[1]))
@@ -50,9 +51,13 @@ StlMeshSpec stl_spec(const Scene& s) {
   spec.fixed_face = s.string("mesh.fixed_face");
   spec.fixed_point = s.vec3("mesh.fixed_point_mm") * kmm;
   spec.fixed_normal = s.vec3("mesh.fixed_normal");
-  if (s.string("mesh.fabric_model") != "solid")
-    s.fail("mesh.fabric_model", "must be \"solid\" with mesh.source = \"stl\" (the fabric is the slab "
-                                "mesh.fabric_slab_mm; a membrane needs a surface the STL mesher does not make)");
+  const std::string fabric = s.string("mesh.fabric_model");
+  if (fabric != "solid" && fabric != "membrane")
+    s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + fabric + "\"");
+  if (fabric == "membrane" && !o.has_slab)
+    s.fail("mesh.fabric_model", "\"membrane\" with mesh.source = \"stl\" puts the membrane on the mid-plane of "
+                                "mesh.fabric_slab_mm: give the fabric layer's z range there");
+  o.slab_mid = fabric == "membrane";
   return spec;
 }
 
@@ -91,7 +96,7 @@ Mesh stl_scene_mesh(const Scene& s, std::vector<std::string>* warnings, StlMeshR
   } catch (const InputError& e) {
     const std::string what = e.what();
     // The mesher names the key it refuses; others are the file's.
-    for (const char* key : {"mesh.cavity_inlet_mm", "mesh.fixed_face", "mesh.fabric_slab_mm", "mesh.half", "mesh.h_mm"})
+    for (const char* key : {"mesh.cavity_inlet_mm", "mesh.fixed_face", "mesh.fabric_slab_mm", "mesh.half", "mesh.wall_cells", "mesh.h_mm"})
       if (what.find(key) != std::string::npos)
         s.fail(key, what.rfind(std::string(key) + ": ", 0) == 0 ? what.substr(std::string(key).size() + 2) : what);
     s.fail("mesh.file", what);

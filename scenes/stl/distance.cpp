@@ -124,6 +124,8 @@ SurfaceDistance::~SurfaceDistance() = default;
 
 long SurfaceDistance::voxels() const { return impl_->voxel_count; }
 
+const TriSurface& SurfaceDistance::surface() const { return impl_->s; }
+
 bool SurfaceDistance::nearest(const Eigen::Vector3d& p, SurfacePoint& out) const {
   const Impl& m = *impl_;
   const auto& tree = m.index->tree();

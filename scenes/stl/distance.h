@@ -37,6 +37,8 @@ class SurfaceDistance {
   bool nearest(const Eigen::Vector3d& p, SurfacePoint& out) const;
   /// OpenVDB's voxel count of the band (for the report).
   long voxels() const;
+  /// The surface it measures to.
+  const TriSurface& surface() const;
 
  private:
   struct Impl;

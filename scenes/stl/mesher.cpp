@@ -15,6 +15,7 @@
 #include "core/number_text.h"
 #include "engine/tet_element.h"
 #include "scenes/stl/distance.h"
+#include "scenes/stl/thin_walls.h"
 
 namespace pneufem {
 
@@ -203,27 +204,46 @@ namespace {
 
 /// The OpenVDB band must hold every background edge that can cross the surface: the longest cell
 /// diagonal of the grid, plus a margin of voxels. Voxels of h/3.
-std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const StuffingOptions& opt, StlMeshReport& rep) {
+/// The thin-wall rays (scenes/stl/thin_walls.h) need half the thickest wall they refine,
+/// wall_cells * h / 2; refinement only shortens the cells, so the band of the uniform grid holds
+/// the graded one's.
+std::unique_ptr<SurfaceDistance> distance_for(const TriSurface& surface, const StuffingOptions& opt, int wall_cells,
+                                              StlMeshReport& rep) {
   const auto lines = stuffing_grid(surface, opt);
   double diag2 = 0.0;
   for (int d = 0; d < 3; ++d) {
     double longest = 0.0;
     for (std::size_t i = 0; i + 1 < lines[d].size(); ++i) longest = std::max(longest, lines[d][i + 1] - lines[d][i]);
     diag2 += longest * longest;
-    rep.grid_lines[d] = static_cast<int>(lines[d].size());
   }
+  const double h_max = std::max(opt.h, opt.h_z > 0.0 ? opt.h_z : opt.h);
   rep.voxel_m = std::min(opt.h, opt.h_z > 0.0 ? opt.h_z : opt.h) / 3.0;
-  auto dist = std::make_unique<SurfaceDistance>(surface, rep.voxel_m, std::sqrt(diag2) + 3.0 * rep.voxel_m);
+  const double band = std::max(std::sqrt(diag2), 0.5 * wall_cells * h_max) + 3.0 * rep.voxel_m;
+  auto dist = std::make_unique<SurfaceDistance>(surface, rep.voxel_m, band);
   rep.band_voxels = dist->voxels();
   return dist;
+}
+
+/// The axis (0 = x, 1 = y) along which the actuator lies when its fixed face is normal to x or y
+/// ("x-", "x+", "y-", "y+", or a "plane" whose normal is within 1 degree of one of them); -1 else.
+int horizontal_length_axis(const StlMeshSpec& spec) {
+  const std::string& f = spec.fixed_face;
+  if (f == "x-" || f == "x+") return 0;
+  if (f == "y-" || f == "y+") return 1;
+  if (f == "plane" && spec.fixed_normal.norm() > 0.0) {
+    const Eigen::Vector3d n = spec.fixed_normal.normalized();
+    for (int d = 0; d < 2; ++d)
+      if (std::abs(n[d]) > std::cos(std::numbers::pi / 180.0)) return d;
+  }
+  return -1;
 }
 
 /// The Tet4 mesh of the stuffed tetrahedra with region tags, element sets SILICONE and FABRIC,
 /// and its dihedral angles in the report. Tags, by the element's centroid against the bounding
 /// box of the cavity (the built-in pneu-net's rules, scenes/pneunet.cpp, when the actuator lies
-/// as it does: along y, fixed face "y-" or "y+"): fabric (in the slab), base (below the cavity),
-/// end_cap (beyond it along y), roof (above it), side_wall (beside it in x), interior_wall (the
-/// walls between chambers); another frame tags all but the fabric "body".
+/// along y as it does, or along x; z up): fabric (in the slab), base (below the cavity), end_cap
+/// (beyond it along the length), roof (above it), side_wall (beside it across the width),
+/// interior_wall (the walls between chambers); another frame tags all but the fabric "body".
 Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::vector<char>& cavity, const StlMeshSpec& spec,
                  StlMeshReport& rep) {
   const StuffingOptions& opt = spec.stuffing;
@@ -234,7 +254,9 @@ Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::ve
   for (int f = 0; f < static_cast<int>(surface.F.size()); ++f)
     if (cavity[surface.face_shell[f]])
       for (int v : surface.F[f]) clo = clo.cwiseMin(surface.V[v]), chi = chi.cwiseMax(surface.V[v]);
-  const bool along_y = spec.fixed_face == "y-" || spec.fixed_face == "y+";
+  const int length_axis = horizontal_length_axis(spec);
+  const bool along_y = length_axis >= 0;  // an actuator lying along x or y, z up
+  const int width_axis = 1 - std::max(length_axis, 0);
   const std::uint16_t r_base = m.region_id(regions::kBase), r_fabric = m.region_id(regions::kFabric);
   std::uint16_t r_cap = 0, r_side = 0, r_roof = 0, r_wall = 0, r_body = 0;
   if (along_y) {
@@ -244,12 +266,12 @@ Mesh tagged_tet4(const StuffedTets& st, const TriSurface& surface, const std::ve
     r_body = m.region_id("body");
   }
   auto region_of = [&](const Eigen::Vector3d& c) {
-    if (opt.has_slab && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
+    if (opt.has_slab && !opt.slab_mid && c.z() > opt.slab_z0 && c.z() < opt.slab_z1) return r_fabric;
     if (!along_y) return r_body;
     if (c.z() < clo.z()) return r_base;
-    if (c.y() < clo.y() || c.y() > chi.y()) return r_cap;
+    if (c[length_axis] < clo[length_axis] || c[length_axis] > chi[length_axis]) return r_cap;
     if (c.z() > chi.z()) return r_roof;
-    if (c.x() < clo.x() || c.x() > chi.x()) return r_side;
+    if (c[width_axis] < clo[width_axis] || c[width_axis] > chi[width_axis]) return r_side;
     return r_wall;
   };
   for (const auto& t : st.tets) {
@@ -293,6 +315,27 @@ void cavity_faces(Mesh& m, const StuffedTets& st, const TriSurface& surface, con
                      " (the chambers are smaller than the elements); use a smaller mesh.h_mm");
 }
 
+/// Surface FABRIC_MEMBRANE of a membrane fabric (slab_mid): the element faces on the slab's
+/// mid-plane, each taken once, from the element below it (as the built-in mesher).
+void membrane_faces(Mesh& m, const StuffingOptions& opt) {
+  const double zm = slab_planes(opt)[1];
+  auto& faces = m.surfaces["FABRIC_MEMBRANE"];
+  for (int e = 0; e < m.num_elements(); ++e) {
+    const int* el = m.element(e);
+    for (int f = 0; f < 4; ++f) {
+      const int* fn = face_local_nodes(m.type, f);
+      bool on = true;
+      for (int k = 0; k < 3 && on; ++k) on = m.X[el[fn[k]]].z() == zm;
+      int apex = 0;
+      while (apex == fn[0] || apex == fn[1] || apex == fn[2]) ++apex;
+      if (on && m.X[el[apex]].z() < zm) faces.push_back({e, f});
+    }
+  }
+  if (faces.empty())
+    throw InputError("mesh.fabric_slab_mm: no element face lies on the fabric's mid-plane z = " + short_num(zm * 1e3) +
+                     " mm, where mesh.fabric_model = \"membrane\" puts the membrane; the slab must lie inside the solid");
+}
+
 /// Node sets FIXED and TIP (the boundary faces on the two end planes) and SYMMETRY.
 void end_and_symmetry_sets(Mesh& m, const StuffedTets& st, const StlMeshSpec& spec, const FacePlane& fixed_plane,
                            const FacePlane& tip_plane, const std::vector<FaceRef>& boundary) {
@@ -327,20 +370,36 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   if (!(opt.h > 0.0 && std::isfinite(opt.h))) throw InputError("mesh.h_mm must be a positive element size");
   const std::vector<char> cavity = cavity_shells(surface, spec);
   const auto [fixed_plane, tip_plane] = end_planes(surface, spec);
-  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, opt, rep);
+  if (spec.wall_cells < 0) throw InputError("mesh.wall_cells must be >= 0 (0 = no refinement across thin walls)");
+  StuffingOptions graded = opt;
+  for (const FacePlane& p : {fixed_plane, tip_plane})
+    for (int d = 0; d < 3; ++d)
+      if (std::abs(p.normal[d]) == 1.0) graded.end_planes[d].push_back(p.point[d]);
+  const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, graded, spec.wall_cells, rep);
+  {
+    ThinWalls thin = measure_thin_walls(surface, *dist, graded, spec.wall_cells);
+    graded.sizes = std::move(thin.sizes);
+    rep.thin_rays = thin.samples;
+    rep.thin_found = thin.thin;
+    rep.thinnest_m = thin.thinnest;
+    rep.notes.insert(rep.notes.end(), thin.notes.begin(), thin.notes.end());
+  }
 
-  const StuffedTets st = stuff_surface(surface, *dist, opt);
+  const StuffedTets st = stuff_surface(surface, *dist, graded);
+  for (int d = 0; d < 3; ++d) rep.grid_lines[d] = static_cast<int>(st.lines[d].size());
   rep.warped = st.warped;
   rep.creased = st.creased;
   rep.on_sharp_edges = st.on_sharp_edges;
   rep.cut_points = st.cut_points;
   rep.flat_dropped = st.flat_dropped;
+  rep.smoothed = st.smoothed;
 
   Mesh m = tagged_tet4(st, surface, cavity, spec, rep);
   check_volume(surface, m, opt, rep);
   const std::vector<FaceRef> boundary = boundary_faces(m);
   cavity_faces(m, st, surface, cavity, *dist, boundary, opt.h);
   end_and_symmetry_sets(m, st, spec, fixed_plane, tip_plane, boundary);
+  if (opt.has_slab && opt.slab_mid) membrane_faces(m, opt);
   if (spec.element == ElementType::Tet10) {
     m = promote_to_tet10(m);
     curve_boundary(m, st.on_surface, st.on_symmetry, *dist, rep);
@@ -357,13 +416,13 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
 }
 
 std::string describe(const StlMeshReport& r) {
-  char buf[512];
+  char buf[640];
   std::snprintf(buf, sizeof buf,
-                "background grid %d x %d x %d lines; OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
-                "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
+                "background grid %d x %d x %d lines (%d of %d thin-wall rays refined it, thinnest %.3g mm); OpenVDB band %ld voxels of %.3g mm; %d cut points, %d vertices warped "
+                "onto the surface, %d onto creases, %d onto sharp edges, %d flat stencil tets dropped, %d smoothing moves\n%d elements, %d nodes; dihedral angles %.1f to %.1f deg, "
                 "min radius ratio %.3f; volume %+.2f %% of the surface's; %d mid-nodes on the surface, %d kept straight; %.2f s\n",
-                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
-                r.flat_dropped, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
+                r.grid_lines[0], r.grid_lines[1], r.grid_lines[2], r.thin_found, r.thin_rays, r.thinnest_m * 1e3, r.band_voxels, r.voxel_m * 1e3, r.cut_points, r.warped, r.creased, r.on_sharp_edges,
+                r.flat_dropped, r.smoothed, r.tets, r.nodes, r.min_dihedral_deg, r.max_dihedral_deg, r.min_radius_ratio,
                 100.0 * r.volume_error, r.midnodes_on_surface, r.midnodes_kept_straight, r.seconds);
   std::string s = buf;
   s += "min dihedral angle per element (10-degree bins from 0):";

@@ -3,8 +3,10 @@
 // pneu-net mesher gives (scenes/pneunet.h): element sets SILICONE and FABRIC, node sets FIXED, TIP
 // and, for a half model, SYMMETRY, the surface CAVITY, and region tags (fabric, base, end_cap,
 // roof, side_wall, interior_wall, by the built-in mesher's rules against the cavity's bounding box,
-// when the actuator lies along y; else fabric and body).
+// when the actuator lies along y or x with z up, by its fixed face; else fabric and body).
 //
+//  * Grid: graded so that at least wall_cells cells lie across every wall and gap the grid cuts
+//    (scenes/stl/thin_walls.h).
 //  * Tetrahedra: isosurface stuffing of the solid (scenes/stl/stuffing.h), promoted to Tet10 with
 //    the mid-nodes of boundary edges moved onto the surface (closest point); a mid-node whose move
 //    would leave an element's scaled Jacobian (engine/tet_element.h) below 0.5 stays straight.
@@ -13,7 +15,9 @@
 //    every shell of a separate cavity file.
 //  * FIXED: the nodes of the boundary faces on the fixed plane, the extreme face of the surface
 //    along an axis ("y-": lowest y) or a plane through a point; TIP: the opposite end face.
-//  * FABRIC: the elements whose centroid lies in the slab z0 < z < z1 (its faces are grid planes).
+//  * FABRIC: the elements whose centroid lies in the slab z0 < z < z1 (its faces are grid planes);
+//    with a membrane fabric (StuffingOptions::slab_mid) FABRIC is empty and the surface
+//    FABRIC_MEMBRANE holds the element faces on the slab's mid-plane.
 //  * Thin features: a meshed volume more than 5 % off the surface's is an error (walls or chambers
 //    thinner than the elements were lost), more than 1 % a note.
 #include <optional>
@@ -38,13 +42,18 @@ struct StlMeshSpec {
   std::string fixed_face = "y-";
   Eigen::Vector3d fixed_point = Eigen::Vector3d::Zero();   ///< m
   Eigen::Vector3d fixed_normal = Eigen::Vector3d(0, -1, 0);
+  /// Fewest background cells across every wall and gap the grid cuts (scenes/stl/thin_walls.h);
+  /// walls between two grid planes are meshed exactly and keep ceil(t / h) cells. 0 = uniform h.
+  int wall_cells = 2;
 };
 
 struct StlMeshReport {
   int grid_lines[3] = {0, 0, 0};
+  int thin_rays = 0, thin_found = 0;    ///< rays cast for thin walls and gaps; those that refined the grid
+  double thinnest_m = 0.0;              ///< the thinnest wall or gap refined (0 = none)
   long band_voxels = 0;
   double voxel_m = 0.0;
-  int warped = 0, creased = 0, on_sharp_edges = 0, cut_points = 0, flat_dropped = 0;
+  int warped = 0, creased = 0, on_sharp_edges = 0, cut_points = 0, flat_dropped = 0, smoothed = 0;
   int tets = 0, nodes = 0;
   double min_dihedral_deg = 0.0, max_dihedral_deg = 0.0;
   std::vector<int> dihedral_histogram;  ///< counts per 10 degrees, 0-10 ... 170-180 (corner tetrahedra)

@@ -12,6 +12,7 @@
 
 #include "core/errors.h"
 #include "core/number_text.h"
+#include "scenes/stl/smoothing.h"
 
 namespace pneufem {
 
@@ -40,7 +41,13 @@ std::array<std::map<double, double>, 3> facet_planes(const TriSurface& s) {
 
 }  // namespace
 
-std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const StuffingOptions& o) {
+std::vector<double> slab_planes(const StuffingOptions& o) {
+  if (!o.has_slab) return {};
+  if (o.slab_mid) return {o.slab_z0, o.slab_z0 + 0.5 * (o.slab_z1 - o.slab_z0), o.slab_z1};
+  return {o.slab_z0, o.slab_z1};
+}
+
+std::array<std::vector<double>, 3> stuffing_planes(const TriSurface& s, const StuffingOptions& o) {
   Eigen::Vector3d lo = s.V.front(), hi = s.V.front();
   for (const auto& p : s.V) {
     lo = lo.cwiseMin(p);
@@ -55,20 +62,24 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
     lo.x() = 0.0;
   }
   const auto facets = facet_planes(s);
-  std::array<std::vector<double>, 3> lines;
+  std::array<std::vector<double>, 3> ends;
   for (int d = 0; d < 3; ++d) {
     const double h = axis_h(o, d);
     constexpr double kForced = std::numeric_limits<double>::infinity();
     std::vector<Plane> planes;
     if (d == 0 && o.half) planes.push_back({0.0, kForced});
+    for (double at : o.end_planes[d]) {
+      bool have = !(at >= lo[d] && at <= hi[d]);  // outside a half model's x >= 0: not meshed
+      for (const Plane& p : planes) have = have || p.at == at;
+      if (!have) planes.push_back({at, kForced});
+    }
     if (d == 2 && o.has_slab) {
       if (!(o.slab_z0 > lo.z() && o.slab_z1 < hi.z() && o.slab_z0 < o.slab_z1))
         throw InputError("mesh.fabric_slab_mm = [" + short_num(o.slab_z0 * 1e3) + ", " + short_num(o.slab_z1 * 1e3) +
                          "] must be an increasing z range strictly inside the actuator's z extent [" +
                          short_num(lo.z() * 1e3) + ", " + short_num(hi.z() * 1e3) +
                          "] mm; give the fabric layer's bottom and top, or [] for no fabric layer");
-      planes.push_back({o.slab_z0, kForced});
-      planes.push_back({o.slab_z1, kForced});
+      for (double z : slab_planes(o)) planes.push_back({z, kForced});
     }
     if (o.feature_planes) {
       // Heaviest planes first; one closer than h/10 to a kept plane would make cells ten times thinner
@@ -90,12 +101,65 @@ std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const Stuf
     if (!(d == 0 && o.half)) at.push_back(!planes.empty() && planes.front().at <= lo[d] ? planes.front().at - h : lo[d] - 0.5 * h);
     for (const Plane& p : planes) at.push_back(p.at);
     at.push_back(!planes.empty() && planes.back().at >= hi[d] ? planes.back().at + h : hi[d] + 0.5 * h);
+    ends[d] = std::move(at);
+  }
+  return ends;
+}
+
+std::vector<double> subdivide_interval(double a, double b, double h, const std::vector<AxisSize>& sizes, double grading) {
+  auto size_at = [&](double x) {
+    double s = h;
+    for (const AxisSize& z : sizes) s = std::min(s, z.spacing + grading * std::max({0.0, z.lo - x, x - z.hi}));
+    return s;
+  };
+  double s_min = h;
+  for (const AxisSize& z : sizes) s_min = std::min(s_min, z.spacing + grading * std::max({0.0, z.lo - b, a - z.hi}));
+  std::vector<double> L;
+  if (!(s_min < h)) {  // nothing finer in reach: equal cells, as the built-in mesher
+    const int n = static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
+    for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+    L.push_back(b);
+    return L;
+  }
+  // Cumulative integral of 1/s on a fine uniform sampling (trapezoid rule; 16 samples per
+  // smallest cell keep the cells' sizes within a few per cent of s), then inverted linearly.
+  const int m = static_cast<int>(std::clamp(std::ceil(16.0 * (b - a) / s_min), 16.0, 4e6));
+  std::vector<double> cum(m + 1, 0.0);
+  double f0 = 1.0 / size_at(a);
+  for (int i = 1; i <= m; ++i) {
+    const double f1 = 1.0 / size_at(a + (b - a) * i / m);
+    cum[i] = cum[i - 1] + 0.5 * (f0 + f1) * (b - a) / m;
+    f0 = f1;
+  }
+  const int n = static_cast<int>(std::max(1.0, std::ceil(cum[m] * (1.0 - 1e-12))));
+  L.push_back(a);
+  for (int k = 1, i = 1; k < n; ++k) {
+    const double target = cum[m] * k / n;
+    while (cum[i] < target) ++i;
+    const double t = (target - cum[i - 1]) / (cum[i] - cum[i - 1]);
+    L.push_back(a + (b - a) * (i - 1 + t) / m);
+  }
+  L.push_back(b);
+  return L;
+}
+
+std::array<std::vector<double>, 3> stuffing_grid(const TriSurface& s, const StuffingOptions& o) {
+  const auto ends = stuffing_planes(s, o);
+  std::array<std::vector<double>, 3> lines;
+  for (int d = 0; d < 3; ++d) {
+    const auto& at = ends[d];
     auto& L = lines[d];
     for (std::size_t m = 0; m + 1 < at.size(); ++m) {
       const double a = at[m], b = at[m + 1];
-      const bool slab = d == 2 && o.has_slab && a == o.slab_z0 && b == o.slab_z1;
-      const int n = slab ? o.slab_cells : static_cast<int>(std::max(1.0, std::ceil((b - a) / h * (1.0 - 1e-12))));
-      for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+      const auto zs = d == 2 ? slab_planes(o) : std::vector<double>{};
+      const bool slab = zs.size() >= 2 && a >= zs.front() && b <= zs.back();  // an interval inside the slab
+      if (slab) {
+        const int n = o.slab_mid ? (o.slab_cells + 1) / 2 : o.slab_cells;
+        for (int k = 0; k < n; ++k) L.push_back(a + (b - a) * k / n);
+        continue;
+      }
+      std::vector<double> sub = subdivide_interval(a, b, axis_h(o, d), o.sizes[d], o.grading);
+      L.insert(L.end(), sub.begin(), sub.end() - 1);
     }
     L.push_back(at.back());
   }
@@ -201,23 +265,6 @@ int snap_to_creases(std::vector<Eigen::Vector3d>& X, const std::vector<double>& 
   return moved;
 }
 
-/// Smallest dihedral angle (degrees) of tetrahedron (a, b, c, d); 0 when it is flat or inverted.
-double min_dihedral_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                        const Eigen::Vector3d& d) {
-  if ((b - a).cross(c - a).dot(d - a) <= 0.0) return 0.0;
-  const Eigen::Vector3d p[4] = {a, b, c, d};
-  static constexpr int kPairs[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
-  double lo = 180.0;
-  for (const auto& q : kPairs) {
-    const Eigen::Vector3d e = (p[q[1]] - p[q[0]]).normalized();
-    Eigen::Vector3d u = p[q[2]] - p[q[0]], w = p[q[3]] - p[q[0]];
-    u -= u.dot(e) * e;
-    w -= w.dot(e) * e;
-    lo = std::min(lo, std::acos(std::clamp(u.normalized().dot(w.normalized()), -1.0, 1.0)) * 180.0 / 3.141592653589793);
-  }
-  return lo;
-}
-
 /// Step 6: sharp edges. Stencils cut a sharp edge of the surface (two facets meeting at more than
 /// 30 degrees: a box's edge, a chamber's) with a chamfer about a cell wide. Each surface node within
 /// `reach` of a sharp edge and on a boundary face that leaves the surface (a chamfer: its centroid
@@ -283,13 +330,13 @@ int snap_to_sharp_edges(StuffedTets& out, const TriSurface& s, const SurfaceDist
     std::vector<double> before;
     for (int t : tets_of[v]) {
       const auto& q = out.tets[t];
-      before.push_back(min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]));
+      before.push_back(tet_min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]));
     }
     out.X[v] = target[v];
     bool ok = true;
     for (std::size_t i = 0; i < tets_of[v].size() && ok; ++i) {
       const auto& q = out.tets[tets_of[v][i]];
-      ok = min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]) >= std::min(5.0, before[i]);
+      ok = tet_min_dihedral_deg(out.X[q[0]], out.X[q[1]], out.X[q[2]], out.X[q[3]]) >= std::min(5.0, before[i]);
     }
     if (ok)
       ++moved;
@@ -316,6 +363,8 @@ class Stuffing {
     for (int j = 0; j < n_[1]; ++j)
       for (int k = 0; k < n_[2]; ++k)
         for (int i = 0; i < n_[0]; ++i) X_[vid(i, j, k)] = Eigen::Vector3d(out_.lines[0][i], out_.lines[1][j], out_.lines[2][k]);
+    grid_X_ = X_;
+    slab_z_ = slab_planes(opt);
     h_min_ = std::min(opt.h, axis_h(opt, 2));
     zero_tol_ = 1e-9 * h_min_;  // round-off of a distance to a facet the vertex lies on
   }
@@ -334,6 +383,13 @@ class Stuffing {
     out_.creased = snap_to_creases(X_, phi_, nbr_, forced_, dist_, opt_.alpha, zero_tol_);
     compact(stencils());
     out_.on_sharp_edges = snap_to_sharp_edges(out_, s_, dist_, 0.9 * h_min_);
+    if (opt_.smooth_target_deg > 0.0) {
+      SmoothingOptions so;
+      so.target_deg = opt_.smooth_target_deg;
+      so.forced_z = slab_planes(opt_);
+      so.zero_tol = zero_tol_;
+      out_.smoothed = smooth_cut_elements(out_, out_.from_cut, dist_, so);
+    }
     return std::move(out_);
   }
 
@@ -433,7 +489,7 @@ class Stuffing {
     forced_.assign(nv_, 0);
     for (int v = 0; v < nv_; ++v) {
       const bool on_x = opt_.half && X_[v].x() == 0.0;
-      const bool on_z = opt_.has_slab && (X_[v].z() == opt_.slab_z0 || X_[v].z() == opt_.slab_z1);
+      const bool on_z = std::find(slab_z_.begin(), slab_z_.end(), X_[v].z()) != slab_z_.end();
       forced_[v] = static_cast<char>((on_x ? 1 : 0) | (on_z ? 4 : 0));
     }
     nbr_.assign(nv_, {});
@@ -560,6 +616,7 @@ class Stuffing {
           out_.X.push_back(pos_of(v));
           out_.on_surface.push_back(v >= nv_ || phi_[v] == 0.0 ? 1 : 0);
           out_.on_symmetry.push_back(opt_.half && out_.X.back().x() == 0.0 ? 1 : 0);
+          out_.from_cut.push_back(v >= nv_ || X_[v] != grid_X_[v] ? 1 : 0);
         }
         v = new_id[v];
       }
@@ -576,7 +633,8 @@ class Stuffing {
   int n_[3] = {0, 0, 0};
   int nv_ = 0;
   double h_min_ = 0.0, zero_tol_ = 0.0;
-  std::vector<Eigen::Vector3d> X_;
+  std::vector<Eigen::Vector3d> X_, grid_X_;  // current and original positions of the grid vertices
+  std::vector<double> slab_z_;               // the slab's forced planes
   std::vector<double> phi_;
   std::vector<std::array<int, 4>> bg_;
   std::unordered_map<std::uint64_t, int, EdgeHash> cut_of_;  // edge -> index into cut_pos_
