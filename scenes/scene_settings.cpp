@@ -31,7 +31,7 @@ MeshSettings mesh_settings(const Scene& s) {
     if (el != "tet10" && el != "tet4") s.fail("mesh.element", "must be \"tet10\" or \"tet4\", got \"" + el + "\"");
     m.element = el == "tet10" ? ElementType::Tet10 : ElementType::Tet4;
   }
-  if (!stl) {
+  {
     const std::string v = s.string("mesh.fabric_model");
     if (v != "solid" && v != "membrane") s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + v + "\"");
     m.membrane_fabric = v == "membrane";

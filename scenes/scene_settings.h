@@ -28,7 +28,7 @@ struct MeshSettings {
   bool half = false;                         ///< mesh.half: the x >= 0 half with a symmetry plane
   int fabric_layers = 1;                     ///< mesh.fabric_layers: elements through the fabric layer
   ElementType element = ElementType::Tet10;  ///< mesh.element: "tet10" or "tet4"
-  /// mesh.fabric_model = "membrane" (source "pneunet" or "inp"; the STL mesher checks its own "solid").
+  /// mesh.fabric_model = "membrane" (every source; for "stl" the mesher also needs mesh.fabric_slab_mm).
   bool membrane_fabric = false;
   /// mesh.length_unit: metres per length unit of the file (source "inp" or "stl": "mm" or "m").
   double length_unit_m = 1e-3;

@@ -51,13 +51,10 @@ StlMeshSpec stl_spec(const Scene& s) {
   spec.fixed_face = s.string("mesh.fixed_face");
   spec.fixed_point = s.vec3("mesh.fixed_point_mm") * kmm;
   spec.fixed_normal = s.vec3("mesh.fixed_normal");
-  const std::string fabric = s.string("mesh.fabric_model");
-  if (fabric != "solid" && fabric != "membrane")
-    s.fail("mesh.fabric_model", "must be \"solid\" or \"membrane\", got \"" + fabric + "\"");
-  if (fabric == "membrane" && !o.has_slab)
+  if (m.membrane_fabric && !o.has_slab)
     s.fail("mesh.fabric_model", "\"membrane\" with mesh.source = \"stl\" puts the membrane on the mid-plane of "
                                 "mesh.fabric_slab_mm: give the fabric layer's z range there");
-  o.slab_mid = fabric == "membrane";
+  o.slab_mid = m.membrane_fabric;
   return spec;
 }
 
