@@ -35,7 +35,7 @@
 #include "core/version.h"
 #include "scenes/build_model.h"
 #include "scenes/scene.h"
-#include "viz/svg_plot.h"
+#include "app/sweep/plot.h"
 
 namespace pneufem {
 
@@ -182,8 +182,6 @@ void read_point(SweepPoint& pt, const fs::path& dir, int exit_code, double measu
                (tail.empty() ? "" : ": " + tail);
   }
 }
-
-double final_nrmse(const SweepPoint& p) { return p.nrmse.empty() ? kNaN : p.nrmse.back(); }
 
 /// Fills a --fem-points comparison from the point's run directory and its FEM run in DIR/fem:
 /// the FEM's NRMSE, and the largest angle difference over the reports, which both runs make at
@@ -342,56 +340,6 @@ std::string file_key(const std::string& key) {
   return s;
 }
 
-/// Final-trial NRMSE (or, without metrics, the final angle) against parameter j.
-void write_plot(const fs::path& file, const std::vector<ParamSpec>& params, std::size_t j,
-                const std::vector<SweepPoint>& points) {
-  const ParamSpec& p = params[j];
-  const bool have_nrmse = std::any_of(points.begin(), points.end(), [](const SweepPoint& q) { return !q.nrmse.empty(); });
-  auto metric = [&](const SweepPoint& q) { return have_nrmse ? final_nrmse(q) : q.final_angle_deg; };
-  std::vector<std::pair<double, double>> ok;
-  std::vector<double> failed_x;
-  for (const SweepPoint& q : points) {
-    if (q.status == "ok" && std::isfinite(metric(q))) ok.emplace_back(q.values[j], metric(q));
-    if (q.status == "failed") failed_x.push_back(q.values[j]);
-  }
-  std::sort(ok.begin(), ok.end());
-  std::vector<double> x, y;
-  for (const auto& [a, b] : ok) x.push_back(a), y.push_back(b);
-
-  svg::Figure fig(640, 420);
-  svg::Axes& ax = fig.axes();
-  ax.title((have_nrmse ? "final-trial NRMSE vs " : "final angle vs ") + p.key)
-      .xlabel(p.key)
-      .ylabel(have_nrmse ? "NRMSE of the final trial (vs ideal elastic)" : "final bending angle (deg)")
-      .xlog(p.log);
-  // The x range is the swept range, whatever the outcome of its points.
-  const svg::Ticks xt = p.log ? svg::log_ticks(p.lo, p.hi, true) : svg::linear_ticks(p.lo, p.hi, 6, true);
-  ax.xlim(xt.lo, xt.hi);
-  double ylo = 0.0, yhi = 1.0;
-  if (!y.empty()) {
-    const auto [mn, mx] = std::minmax_element(y.begin(), y.end());
-    const svg::Ticks yt = svg::linear_ticks(have_nrmse ? std::min(0.0, *mn) : *mn, *mx, 5, true);
-    ylo = yt.lo, yhi = yt.hi;
-  }
-  ax.ylim(ylo, yhi);
-  svg::Style ok_style;
-  ok_style.color = "#0072B2";
-  ok_style.marker = svg::Marker::Circle;
-  if (params.size() == 1)
-    ax.line(x, y, "ok", ok_style);
-  else
-    ax.scatter(x, y, "ok (all other parameters)", ok_style);
-  if (!failed_x.empty()) {
-    svg::Style failed_style;
-    failed_style.color = "#D55E00";
-    failed_style.marker = svg::Marker::Cross;
-    failed_style.marker_size = 5.0;
-    ax.scatter(failed_x, std::vector<double>(failed_x.size(), ylo), "failed", failed_style);
-  }
-  if (x.empty()) ax.note(failed_x.empty() ? "no finished points yet" : "no point succeeded");
-  fig.save(file.string());
-}
-
 std::string sweep_json(const SweepOptions& o, const std::vector<ParamSpec>& params, const SweepResult& r,
                        const std::vector<std::string>& plots) {
   json::Object head;
@@ -476,7 +424,7 @@ void write_plots_and_json(const SweepOptions& recorded, const fs::path& out, con
   std::vector<std::string> plots;
   for (std::size_t j = 0; j < params.size(); ++j) {
     const std::string name = "sweep_" + file_key(params[j].key) + ".svg";
-    write_plot(out / name, params, j, result.points);
+    sweep_figure(params, j, result.points).save((out / name).string());
     plots.push_back(name);
   }
   write_file_atomic((out / "sweep.json").string(), sweep_json(recorded, params, result, plots));
