@@ -1,6 +1,7 @@
 """Opens a pneufem run directory in ParaView with the standard views.
 
     pvpython viz/paraview/open_run.py out/default            # opens, then saves views.png there
+    pvbatch viz/paraview/open_run.py out/default             # no window: views.png only
     paraview --script=viz/paraview/open_run.py                # GUI; run directory from PNEUFEM_RUN
                                                               # or the current directory
 
@@ -11,7 +12,8 @@ Views (the last reported state; the time slider walks through the states of resu
   * right: the same shape coloured by damage (cell data; 0 everywhere without a damage law);
   * below: angle against pressure from angles.csv, one line per trial's reports.
 Colour maps are Viridis (perceptually uniform, readable by colour-blind readers). Needs ParaView
-5.9 or later (paraview.simple); pneufem itself does not need ParaView.
+5.9 or later (paraview.simple); pneufem itself does not need ParaView. tests/viz/paraview/test_open_run.py
+runs this script against a stand-in for paraview.simple (the arrays it names must be in the run).
 """
 import os
 import sys
