@@ -57,10 +57,18 @@ std::string inline_svg(const std::string& doc) {
 std::string heatmap_svg(const std::vector<std::vector<double>>& values, const std::vector<std::string>& rows,
                         const std::vector<std::string>& cols, const std::string& title, const std::string& unit,
                         const std::string& col_axis) {
-  // Sizes for print as the svg::Figure ones (viz/svg_plot.h): 14 px text in a 480 px wide figure.
-  const double cw = 64, ch = 30, left = 84, top = 52, bottom = 100;
-  // Wide enough for the colour note below the cells.
-  const double width = std::max(svg::kColumnWidthPx, left + cw * static_cast<double>(std::max<std::size_t>(cols.size(), 1)) + 20);
+  // Sizes for print as the svg::Figure ones (viz/svg_plot.h): 14 px text in 480 px per journal
+  // column. One column (480 px) while the cells are at least 48 px wide (up to 7 steps), else two
+  // (960 px: the paper's ten steps), the cells filling it up to 64 / 96 px; cells too narrow for
+  // their numbers (under 40 px, beyond 21 steps) show colour only (the numbers are in the CSV and
+  // the cells' tooltips), and their column labels thin out.
+  const double ch = 30, left = 84, right = 20, top = 52, bottom = 100;
+  const double ncols = static_cast<double>(std::max<std::size_t>(cols.size(), 1));
+  const int columns = (svg::kColumnWidthPx - left - right) / ncols >= 48 ? 1 : 2;
+  const double width = columns * svg::kColumnWidthPx;
+  const double cw = std::min(columns == 1 ? 64.0 : 96.0, (width - left - right) / ncols);
+  const bool cell_numbers = cw >= 40;
+  const std::size_t label_stride = static_cast<std::size_t>(std::ceil(44.0 / cw));
   const double height = top + ch * static_cast<double>(std::max<std::size_t>(rows.size(), 1)) + bottom;
   double vmax = 0;
   for (const auto& r : values)
@@ -87,11 +95,12 @@ std::string heatmap_svg(const std::vector<std::vector<double>>& values, const st
       s += "<rect x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", y) + "\" width=\"" + fmt("%.1f", cw - 1) +
            "\" height=\"" + fmt("%.1f", ch - 1) + "\" fill=\"" + fill + "\"><title>" + escape(rows[i] + ", " + cols[j]) +
            ": " + fmt("%.3f", v) + " " + escape(unit) + "</title></rect>\n";
-      s += "<text x=\"" + fmt("%.1f", x + cw / 2) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 5) +
-           "\" text-anchor=\"middle\"" + ink + ">" + fmt("%.2f", v) + "</text>\n";
+      if (cell_numbers)
+        s += "<text x=\"" + fmt("%.1f", x + cw / 2) + "\" y=\"" + fmt("%.1f", y + ch / 2 + 5) +
+             "\" text-anchor=\"middle\"" + ink + ">" + fmt("%.2f", v) + "</text>\n";
     }
   }
-  for (std::size_t j = 0; j < cols.size(); ++j)
+  for (std::size_t j = 0; j < cols.size(); j += label_stride)
     s += "<text x=\"" + fmt("%.1f", left + cw * (static_cast<double>(j) + 0.5)) + "\" y=\"" +
          fmt("%.1f", top + ch * static_cast<double>(rows.size()) + 17) + "\" text-anchor=\"middle\">" + escape(cols[j]) +
          "</text>\n";

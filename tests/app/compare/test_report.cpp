@@ -122,14 +122,29 @@ TEST_F(CompareReport, AxesStartAtTheData) {
   for (const char* label : {">0.5<", ">1.5<", ">2.5<", ">3.5<"}) EXPECT_EQ(nrmse.find(label), std::string::npos) << label;
 }
 
+/// The width in px of an SVG document (its root's width attribute).
+double svg_width(const std::string& svg) {
+  const std::size_t p = svg.find("width=\"", svg.find("<svg"));
+  return std::stod(svg.substr(p + 7));
+}
+
+/// The smallest text of an SVG document printed `columns` journal columns wide (3.5 in, 252 pt each).
+double smallest_text_pt(const std::string& svg, int columns) {
+  double smallest = 1e9;
+  for (std::size_t p = svg.find("font-size=\""); p != std::string::npos; p = svg.find("font-size=\"", p + 1))
+    smallest = std::min(smallest, std::stod(svg.substr(p + 11)) * 252.0 * columns / svg_width(svg));
+  return smallest;
+}
+
 TEST_F(CompareReport, TextIsAtLeastSevenPointAtAColumnWidth) {
-  // Every figure is 480 px wide per column of axes (the heat map at least 480 px), printed at 3.5 in.
+  // Every figure printed one journal column wide (3.5 in), or two for the two-panel figure and a
+  // residual map of two columns (960 px).
   for (const ReportFigure& f : figs_) {
-    const std::string& s = f.svg;
-    std::size_t fonts = 0;
-    for (std::size_t p = s.find("font-size=\""); p != std::string::npos; p = s.find("font-size=\"", p + 1), ++fonts)
-      EXPECT_GE(std::stod(s.substr(p + 11)) * 252.0 / svg::kColumnWidthPx, 7.0 - 1e-9) << f.name;
-    EXPECT_GT(fonts, 0u) << f.name;
+    const int columns = f.name == "fig_error_spread" ? 2
+                        : f.name == "fig_residual_map" ? static_cast<int>(svg_width(f.svg) / svg::kColumnWidthPx)
+                                                       : 1;
+    EXPECT_GE(smallest_text_pt(f.svg, columns), 7.0 - 1e-9) << f.name;
+    EXPECT_LT(smallest_text_pt(f.svg, columns), 1e9) << f.name << ": no text";
   }
 }
 
@@ -169,6 +184,34 @@ TEST_F(CompareReport, EveryFigureHasItsSeriesAsCsvAndTheFramesAreWrittenToo) {
   text << in.rdbuf();
   EXPECT_EQ(text.str(), frames);
   fs::remove_all(dir);
+}
+
+// The residual map is one or two journal columns wide (480 or 960 px) with 14 px text whatever the
+// number of steps (a 10-step map was 744 px: 4.7 pt text at one column's width, 9.5 pt at two).
+TEST(CompareReportHeatmap, AWideMapIsTwoColumnsWideWithTextReadableThere) {
+  auto map = [](std::size_t steps) {
+    std::vector<std::string> cols;
+    std::vector<double> row;
+    for (std::size_t j = 0; j < steps; ++j) cols.push_back(std::to_string(5 * j)), row.push_back(0.01 * j - 0.05);
+    return heatmap_svg({row, row}, {"trial 1", "trial 2"}, cols, "t", "deg", "pressure step (kPa)");
+  };
+  // The first step's cells (-0.05 deg in both trials) with their number printed.
+  auto cell_numbers = [](const std::string& svg) { return count(svg, ">-0.05</text>"); };
+  const std::string seven = map(7), ten = map(10), thirty = map(30);
+  EXPECT_EQ(svg_width(seven), svg::kColumnWidthPx);
+  EXPECT_GE(smallest_text_pt(seven, 1), 7.0);
+  EXPECT_EQ(cell_numbers(seven), 2u);
+  EXPECT_EQ(svg_width(ten), 2 * svg::kColumnWidthPx);
+  EXPECT_GE(smallest_text_pt(ten, 2), 7.0);
+  EXPECT_EQ(cell_numbers(ten), 2u);
+  EXPECT_EQ(count(ten, ">45</text>"), 1u);  // every step labelled
+  // Thirty steps: cells of 28.5 px hold colour only; every second step is labelled.
+  EXPECT_EQ(svg_width(thirty), 2 * svg::kColumnWidthPx);
+  EXPECT_GE(smallest_text_pt(thirty, 2), 7.0);
+  EXPECT_EQ(cell_numbers(thirty), 0u);
+  EXPECT_EQ(count(thirty, ">140</text>"), 1u);
+  EXPECT_EQ(count(thirty, ">145</text>"), 0u);
+  EXPECT_EQ(count(thirty, "<rect x="), 60u);  // every cell is drawn
 }
 
 TEST(CompareReportHeatmap, ColoursComeFromTheColourBlindSafeMap) {
