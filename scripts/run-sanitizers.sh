@@ -5,7 +5,7 @@
 #     behaviour aborts; the libraries instrumented for libFuzzer too, so one build serves both) and
 #     asserts on (-O1, no NDEBUG); builds only the readers' libraries, their tests and the fuzzers
 #     (no VTK, no app);
-#  2. runs the readers' tests under the sanitizers: the deck reader (test_inp, test_inp_assembly),
+#  2. runs the readers' tests under the sanitizers: the deck reader (test_inp, test_inp_assembly, test_inp_text),
 #     the scene reader and its typed settings (test_scene, test_scene_settings, test_key_limits) and the
 #     measurement and DeepLabCut readers (test_measurements) — the code that meets users' files,
 #     in suites of seconds (but the three tests that bend an actuator); the solver suites run for
@@ -17,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${PNEUFEM_SANITIZE_BUILD:-build-sanitize}
 seconds=${PNEUFEM_FUZZ_SECONDS:-20}
-tests=(test_inp test_inp_assembly test_scene test_scene_settings test_key_limits test_measurements)
+tests=(test_inp test_inp_assembly test_inp_text test_scene test_scene_settings test_key_limits test_measurements)
 # The three tests that bend an actuator (a solver run, minutes under ASan) read no input their
 # siblings do not: left to the normal suite.
 cxx=$(command -v clang++-14 || command -v clang++ || true)
