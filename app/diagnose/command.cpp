@@ -709,6 +709,50 @@ std::vector<std::string> moved_outside_intervals(const RoundIntervals& before, c
   return notes;
 }
 
+std::vector<EquivalentModel> equivalent_models(const DiagnosisResult& r) {
+  std::vector<EquivalentModel> out;
+  if (r.selected.empty()) return out;
+  // The constants of the effects selected up to each round: the picks' counts.
+  std::vector<int> picked_params(r.selected.size(), 0);
+  for (const CandidateResult& c : r.candidates) {
+    const std::size_t k = static_cast<std::size_t>(c.round - 1);
+    if (c.round >= 1 && k < r.selected.size() && c.effect == r.selected[k]) picked_params[k] = static_cast<int>(c.params.size());
+  }
+  const double final_ms = sq(r.final_nrmse);
+  for (const CandidateResult& c : r.candidates) {
+    const std::size_t before = static_cast<std::size_t>(c.round - 1);
+    if (c.round < 1 || before >= r.selected.size() || !c.error.empty() || !c.significant || !std::isfinite(c.nrmse)) continue;
+    if (c.effect == r.selected[before]) continue;  // the model the selection built: tested against the next
+    if (sq(c.nrmse) > (1.0 + EquivalentModel::rss_tol) * final_ms) continue;
+    EquivalentModel m;
+    m.effects.assign(r.selected.begin(), r.selected.begin() + static_cast<std::ptrdiff_t>(before));
+    m.effects.push_back(c.effect);
+    m.round = c.round;
+    for (std::size_t k = 0; k < before; ++k) m.parameters += picked_params[k];
+    m.parameters += static_cast<int>(c.params.size());
+    m.nrmse = c.nrmse;
+    m.at_bound = c.at_bound;
+    out.push_back(std::move(m));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const EquivalentModel& a, const EquivalentModel& b) {
+    return a.parameters != b.parameters ? a.parameters < b.parameters : a.nrmse < b.nrmse;
+  });
+  return out;
+}
+
+std::string equivalent_model_text(const EquivalentModel& m, const DiagnosisResult& r) {
+  std::string s = join(m.effects, " + ") + " (" + std::to_string(m.parameters) + " constant" + (m.parameters == 1 ? "" : "s") +
+                  ", NRMSE " + fmt("%.4f", m.nrmse) + ") fits as well as the selected " + join(r.selected, " + ") + " (" +
+                  std::to_string(r.final_parameters) + ", NRMSE " + fmt("%.4f", r.final_nrmse) + "; RSS within " +
+                  fmt("%.0f", 100.0 * EquivalentModel::rss_tol) + " %)";
+  if (m.parameters < r.final_parameters)
+    s += ": a simpler model explains the recording as well, so it does not ask for the extra constants";
+  else
+    s += ": the recording does not tell these combinations apart";
+  if (!m.at_bound.empty()) s += " (caution: " + join(m.at_bound, ", ") + " at the edge of its range)";
+  return s;
+}
+
 namespace {
 
 /// The scene overrides of the selected effects with the constants `v` (all of them, in selection
@@ -882,6 +926,9 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
       out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
     }
     describe_static_remainder(s.current, s.current_static, opt, out);
+    out.final_parameters = 0;
+    for (const auto& [e, v] : s.chosen) out.final_parameters += static_cast<int>(v.size());
+    out.equivalent_models = equivalent_models(out);
   };
   auto fitted_toml = [&](const Scene& fitted) {
     const std::string head = out.failure.empty() ? "# pneufem diagnose: the input scene plus the selected effects ("

@@ -99,6 +99,21 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     for (std::size_t j = 0; j < out.equivalents.size(); ++j) eq += (j ? ", " : "") + json::quote(out.equivalents[j]);
     root.add("equivalents", eq + "]");
   }
+  {
+    std::string em = "[";
+    for (std::size_t j = 0; j < out.equivalent_models.size(); ++j) {
+      const EquivalentModel& m = out.equivalent_models[j];
+      std::string effects = "[", bound = "[";
+      for (std::size_t i = 0; i < m.effects.size(); ++i) effects += (i ? ", " : "") + json::quote(m.effects[i]);
+      for (std::size_t i = 0; i < m.at_bound.size(); ++i) bound += (i ? ", " : "") + json::quote(m.at_bound[i]);
+      json::Object o;
+      o.add("effects", effects + "]").add("round", m.round).add("parameters", m.parameters).add("nrmse", m.nrmse);
+      o.add("at_bound", bound + "]").add_str("text", equivalent_model_text(m, out));
+      em += (j ? ",\n    " : "\n    ") + o.str(4);
+    }
+    root.add("equivalent_models", em + (out.equivalent_models.empty() ? "]" : "\n  ]"));
+    root.add("final_parameters", out.final_parameters);
+  }
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
   root.add("selected", sel + "]");

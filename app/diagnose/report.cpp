@@ -192,6 +192,7 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
   }
   if (!out.stopped.empty()) s += "Stopped " + out.stopped + ".\n\n";
   for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
+  for (const EquivalentModel& m : out.equivalent_models) s += "Equivalent model: " + equivalent_model_text(m, out) + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";
   if (!out.fem_error.empty()) s += "Refinement / full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"
