@@ -160,8 +160,9 @@ struct CandidateResult {
   double delta_aic_beyond_static = 0.0;
   double removed_beyond_static = 0.0;
   bool beyond_static = false;
-  /// Effects without history: how much the calibrated effect changes the model's angle, RMS over the
-  /// recording in units of the NRMSE (min_static_change); -1 for history effects.
+  /// Effects without history, and history effects that in round 1 explain nothing beyond a static
+  /// misfit (they then act as a static change): how much the calibrated effect changes the model's
+  /// angle, RMS over the recording in units of the NRMSE (min_static_change); -1 otherwise.
   double static_change_nrmse = -1.0;
   /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
   /// always for history effects from round 2 on; in round 1 when only that calibration passes.
@@ -216,6 +217,16 @@ struct EquivalentModel {
   static constexpr double rss_tol = 0.25;  ///< the trade-off's and the per-round equivalence's tolerance
 };
 
+/// What one round of the selection cost (the rounds go on while an effect passes the tests, up to
+/// DiagnoseOptions::max_effects, so each round's cost is stated): its candidates, the path-model runs
+/// of their calibrations, re-fits and trade-offs plus the joint intervals after it, and its wall time.
+struct RoundCost {
+  int round = 0;
+  int candidates = 0;
+  long runs = 0;
+  double wall_s = 0.0;
+};
+
 struct DiagnosisResult {
   double baseline_nrmse = 0.0;
   std::vector<double> baseline_nrmse_per_trial;
@@ -246,6 +257,7 @@ struct DiagnosisResult {
   std::vector<double> final_nrmse_per_trial;      ///< ... per trial (the baseline's when none is selected)
   std::vector<double> final_rmse_deg_per_trial;
   std::vector<ModelAfterRound> after_round;       ///< one per selected effect, in order; the last is the final model
+  std::vector<RoundCost> round_costs;             ///< one per round run (also the last, which may select nothing)
   /// The final residual after a static correction (fit_static_discrepancy), and the share of the
   /// final error above the noise floor that it removes (in squared NRMSE; 0 when at the floor):
   /// near 1, what is left is a misfit of the elastic response, not a missing history effect.

@@ -101,6 +101,24 @@ TEST(OtherMeansNull, SmallStaticMisfitsNameNothing) {
   }
 }
 
+// The same 2 % softer silicone against instantaneous creep, which can stand in for it: a Prony term
+// at its smallest gamma and tau relaxes within 0.2 s of every step, a uniformly softer silicone. With
+// the whole catalog (2026-11-29, before the fix) viscoelastic_instantaneous was named, at gamma 0.021
+// and tau 0.2 s (both at their lower bounds), NRMSE 0.0246 -> 0.0063 raw but 0.0052 -> 0.0063 beyond
+// a static misfit, after stiffness had been rejected by its size; 963 s. A history effect that
+// explains nothing beyond a static misfit acts as a static change and is judged by its size too.
+TEST(OtherMeansNull, CreepThatOnlyActsAsAStaticChangeIsNotNamed) {
+  const DiagnosisResult r = diagnose("null_stiffness_2pc", {"stiffness", "viscoelastic_instantaneous"}, 1);
+  EXPECT_TRUE(r.selected.empty()) << r.missing_effect;
+  const auto creep = std::find_if(r.candidates.begin(), r.candidates.end(),
+                                  [](const CandidateResult& c) { return c.effect == "viscoelastic_instantaneous"; });
+  ASSERT_NE(creep, r.candidates.end());
+  EXPECT_FALSE(creep->beyond_static);
+  EXPECT_GE(creep->static_change_nrmse, 0.0);  // judged by its size, as a static effect
+  EXPECT_LT(creep->static_change_nrmse, 0.05);
+  EXPECT_NE(creep->why.find("what it explains is static"), std::string::npos) << creep->why;
+}
+
 // A 15 % larger angle (the h = 4 mesh's curve, diagnosed on h = 6) is no longer within an elastic
 // model's accuracy: stiffness is named (measured: scale 0.905, NRMSE 0.1045 -> 0.0151, 0.0081 beyond
 // a static misfit at a 0.0080 floor: what is left is the curve's shape, static) and the note says the
@@ -150,7 +168,9 @@ TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
 // mullins, max 2): fatigue named alone, NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor (1.2x the
 // floor; this effect is small, the baseline only 2.8x the floor, so 0.4x leaves 0.002 above it);
 // W_th 4.8 kPa, tau 289 s. Round 2: creep passes the raw tests with gamma at its bound, not selected.
-// 131 s of one core.
+// 131 s of one core. The cause (2026-11-29, bench/notes/2026-11-29-fatigue-saturation.md): the
+// candidate's law cannot slow down (its saturation exponent n stays at 1); with n held at 3 and 6
+// fatigue alone leaves 0.0153 (0.41x) and 0.0148 (0.40x, tau at its 100 s bound).
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
 // Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
 // mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
