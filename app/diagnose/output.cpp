@@ -113,6 +113,14 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     }
     root.add("equivalent_models", em + (out.equivalent_models.empty() ? "]" : "\n  ]"));
     root.add("final_parameters", out.final_parameters);
+    std::string rc = "[";
+    for (std::size_t j = 0; j < out.round_costs.size(); ++j) {
+      json::Object o;
+      o.add("round", out.round_costs[j].round).add("candidates", out.round_costs[j].candidates);
+      o.add("runs", static_cast<double>(out.round_costs[j].runs)).add("wall_s", out.round_costs[j].wall_s);
+      rc += (j ? ", " : "") + o.str(4);
+    }
+    root.add("round_costs", rc + "]");
   }
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);

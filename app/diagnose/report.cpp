@@ -114,6 +114,10 @@ std::string round_section(const DiagnosisResult& out, int round) {
     s += "Each remaining candidate added to the baseline + " + joined(out.after_round[before - 1].effects) + " (NRMSE " + fmt("%.4f", out.after_round[before - 1].nrmse) +
          "); from this round on a candidate must also explain error beyond a static misfit of the angle curve.\n\n";
   }
+  for (const RoundCost& c : out.round_costs)
+    if (c.round == round)
+      s += "Cost: " + std::to_string(c.candidates) + " candidates, " + std::to_string(c.runs) + " runs of the path model, " +
+           fmt("%.1f", c.wall_s) + " s.\n\n";
   s += "| effect | constants | NRMSE | delta AIC | error removed | NRMSE beyond static | removed beyond static | significant |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const CandidateResult& c : out.candidates) {

@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -271,6 +272,14 @@ TEST(GeneratedNull, AStaticMisfitThatIsNotAStiffnessNamesNothing) {
                                                {"stiffness", "viscoelastic_instantaneous", "mullins", "fatigue"}, 1);
   EXPECT_TRUE(r.selected.empty()) << r.missing_effect;
   EXPECT_TRUE(r.equivalent_models.empty());
+  // The cost of the one round that ran is stated: its four candidates and their calibrations' runs
+  // (each at most the 60-run budget plus the profiled re-calibration of a history effect).
+  ASSERT_EQ(r.round_costs.size(), 1u);
+  EXPECT_EQ(r.round_costs[0].round, 1);
+  EXPECT_EQ(r.round_costs[0].candidates, 4);
+  EXPECT_GE(r.round_costs[0].runs, 4 * 10);
+  EXPECT_LE(r.round_costs[0].runs, 4 * 2 * 60 + 4 * 30);  // + the trade-off walks of two-constant candidates
+  EXPECT_GT(r.round_costs[0].wall_s, 0.0);
 }
 
 // ---- Item 5: two effects together, generated here: logarithmic creep (no time constant; the
@@ -298,6 +307,13 @@ TEST(GeneratedRecording, LogarithmicCreepBehindALagAreBothNamed) {
     EXPECT_TRUE(s == "pressure_lag" || s == "viscoelastic_instantaneous" || s == "viscoelastic") << "spurious: " << s;
   EXPECT_LE(r.final_nrmse, 0.4 * r.baseline_nrmse);
   EXPECT_EQ(r.final_parameters, 4);  // tau, tau2 and gamma, tau: the count equivalent_models compares with
+  // ... and diagnosis.json carries the model-equivalence report (empty here: no other combination
+  // passed its round's tests within 25 % of the final RSS; the lag alone is 19x the final RSS).
+  EXPECT_TRUE(r.equivalent_models.empty());
+  std::ifstream in(fs::temp_directory_path() / "pneufem_diag_generated_logcreep_lag" / "out" / "diagnosis.json");
+  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(json.find("\"equivalent_models\": []"), std::string::npos);
+  EXPECT_NE(json.find("\"final_parameters\": 4"), std::string::npos);
 }
 
 }  // namespace
