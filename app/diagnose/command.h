@@ -160,9 +160,8 @@ struct CandidateResult {
   double delta_aic_beyond_static = 0.0;
   double removed_beyond_static = 0.0;
   bool beyond_static = false;
-  /// Effects without history, and history effects that in round 1 explain nothing beyond a static
-  /// misfit (they then act as a static change): how much the calibrated effect changes the model's
-  /// angle, RMS over the recording in units of the NRMSE (min_static_change); -1 otherwise.
+  /// Effects without history: how much the calibrated effect changes the model's angle, RMS over the
+  /// recording in units of the NRMSE (min_static_change); -1 for history effects.
   double static_change_nrmse = -1.0;
   /// Its constants were calibrated with the static misfit profiled out (fit_static_discrepancy):
   /// always for history effects from round 2 on; in round 1 when only that calibration passes.
