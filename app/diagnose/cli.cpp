@@ -130,6 +130,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
   }
   if (const std::string k = selected_constants_text(r); !k.empty()) std::printf("constants of the selected effects:\n%s", k.c_str());
   for (const std::string& e : r.equivalents) std::printf("equally good: %s\n", e.c_str());
+  for (const EquivalentModel& m : r.equivalent_models) std::printf("equivalent model: %s\n", equivalent_model_text(m, r).c_str());
   if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());
   if (r.verified_fitted_nrmse >= 0)
     std::printf("full FEM: baseline NRMSE %.4f, fitted NRMSE %.4f\n", r.verified_baseline_nrmse, r.verified_fitted_nrmse);

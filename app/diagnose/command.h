@@ -202,6 +202,30 @@ struct ModelAfterRound {
   std::vector<double> rmse_deg_per_trial;
 };
 
+/// Model equivalence across rounds: a combination of effects the selection calibrated (the effects
+/// selected before some round plus one candidate of that round) that fits the recording as well as
+/// the final model (its RSS within EquivalentModel::rss_tol of the final one's) although it is not
+/// the final model nor one of the models it was built through. The recording then does not tell the
+/// two combinations apart: e.g. long-term creep alone against stiffness + instantaneous creep.
+struct EquivalentModel {
+  std::vector<std::string> effects;   ///< the combination, in the order it was built
+  int round = 0;                      ///< the round whose candidate completed it
+  int parameters = 0;                 ///< its constants in all (the final model's: DiagnosisResult::final_parameters)
+  double nrmse = 0.0;                 ///< pooled, raw
+  std::vector<std::string> at_bound;  ///< its last effect's constants at the edge of their range
+  static constexpr double rss_tol = 0.25;  ///< the trade-off's and the per-round equivalence's tolerance
+};
+
+/// What one round of the selection cost (the rounds go on while an effect passes the tests, up to
+/// DiagnoseOptions::max_effects, so each round's cost is stated): its candidates, the path-model runs
+/// of their calibrations, re-fits and trade-offs plus the joint intervals after it, and its wall time.
+struct RoundCost {
+  int round = 0;
+  int candidates = 0;
+  long runs = 0;
+  double wall_s = 0.0;
+};
+
 struct DiagnosisResult {
   double baseline_nrmse = 0.0;
   std::vector<double> baseline_nrmse_per_trial;
@@ -219,6 +243,10 @@ struct DiagnosisResult {
   /// and fit as well (their RSS, beyond a static misfit from round 2 on, within 25 % of the chosen
   /// one's: below the reduced model's own error, so the recording cannot tell them apart), in words.
   std::vector<std::string> equivalents;
+  /// Model equivalence of the whole selection (equivalent_models): other combinations of effects that
+  /// fit as well as the final model, fewest constants first; and the final model's constant count.
+  std::vector<EquivalentModel> equivalent_models;
+  int final_parameters = 0;
   /// Constants with honest uncertainty: after each round, the joint intervals of all constants
   /// selected so far (DiagnoseOptions::intervals), and in words every constant that a later round's
   /// joint re-fit moved outside the interval it had after the round before.
@@ -228,6 +256,7 @@ struct DiagnosisResult {
   std::vector<double> final_nrmse_per_trial;      ///< ... per trial (the baseline's when none is selected)
   std::vector<double> final_rmse_deg_per_trial;
   std::vector<ModelAfterRound> after_round;       ///< one per selected effect, in order; the last is the final model
+  std::vector<RoundCost> round_costs;             ///< one per round run (also the last, which may select nothing)
   /// The final residual after a static correction (fit_static_discrepancy), and the share of the
   /// final error above the noise floor that it removes (in squared NRMSE; 0 when at the floor):
   /// near 1, what is left is a misfit of the elastic response, not a missing history effect.
@@ -270,6 +299,18 @@ std::string selected_constants_text(const DiagnosisResult& r);
 /// joint re-fit may have moved the earlier effects' constants) puts outside their interval: one
 /// sentence each, for DiagnosisResult::interval_notes. None when `before` was not computed.
 std::vector<std::string> moved_outside_intervals(const RoundIntervals& before, const RoundIntervals& now);
+
+/// The combinations of effects among those the selection calibrated (every candidate of every round
+/// on top of the effects selected before that round) that passed the tests of their round and fit
+/// within EquivalentModel::rss_tol of the final model's RSS (its pooled NRMSE squared, on the same
+/// frames), other than the final model and the models it was built through (each of those was
+/// tested against the next by the selection). Fewest constants first, then best fit. None when
+/// nothing was selected. A simpler combination in the list means that the recording does not ask
+/// for the final model's extra constants; one of the same size, that it does not tell which effect.
+std::vector<EquivalentModel> equivalent_models(const DiagnosisResult& r);
+
+/// One equivalent model in words (console, report.md).
+std::string equivalent_model_text(const EquivalentModel& m, const DiagnosisResult& r);
 
 /// The calibration mesh size diagnose uses for `requested_mm` (DiagnoseOptions::calibration_h_mm):
 /// itself when >= 0; for < 0 (auto) 3x the scene's element size when its built-in mesh has more

@@ -43,6 +43,32 @@ std::string intervals_json(const std::vector<RoundIntervals>& rounds) {
   return s + (rounds.empty() ? "]" : "\n  ]");
 }
 
+/// diagnosis.json's model-equivalence report (equivalent_models, final_parameters) and the cost of
+/// each round (round_costs).
+void add_equivalence_and_costs(json::Object& root, const DiagnosisResult& out) {
+  std::string em = "[";
+  for (std::size_t j = 0; j < out.equivalent_models.size(); ++j) {
+    const EquivalentModel& m = out.equivalent_models[j];
+    std::string effects = "[", bound = "[";
+    for (std::size_t i = 0; i < m.effects.size(); ++i) effects += (i ? ", " : "") + json::quote(m.effects[i]);
+    for (std::size_t i = 0; i < m.at_bound.size(); ++i) bound += (i ? ", " : "") + json::quote(m.at_bound[i]);
+    json::Object o;
+    o.add("effects", effects + "]").add("round", m.round).add("parameters", m.parameters).add("nrmse", m.nrmse);
+    o.add("at_bound", bound + "]").add_str("text", equivalent_model_text(m, out));
+    em += (j ? ",\n    " : "\n    ") + o.str(4);
+  }
+  root.add("equivalent_models", em + (out.equivalent_models.empty() ? "]" : "\n  ]"));
+  root.add("final_parameters", out.final_parameters);
+  std::string rc = "[";
+  for (std::size_t j = 0; j < out.round_costs.size(); ++j) {
+    json::Object o;
+    o.add("round", out.round_costs[j].round).add("candidates", out.round_costs[j].candidates);
+    o.add("runs", static_cast<double>(out.round_costs[j].runs)).add("wall_s", out.round_costs[j].wall_s);
+    rc += (j ? ", " : "") + o.str(4);
+  }
+  root.add("round_costs", rc + "]");
+}
+
 }  // namespace
 
 void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
@@ -99,6 +125,7 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     for (std::size_t j = 0; j < out.equivalents.size(); ++j) eq += (j ? ", " : "") + json::quote(out.equivalents[j]);
     root.add("equivalents", eq + "]");
   }
+  add_equivalence_and_costs(root, out);
   std::string sel = "[";
   for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
   root.add("selected", sel + "]");

@@ -114,6 +114,10 @@ std::string round_section(const DiagnosisResult& out, int round) {
     s += "Each remaining candidate added to the baseline + " + joined(out.after_round[before - 1].effects) + " (NRMSE " + fmt("%.4f", out.after_round[before - 1].nrmse) +
          "); from this round on a candidate must also explain error beyond a static misfit of the angle curve.\n\n";
   }
+  for (const RoundCost& c : out.round_costs)
+    if (c.round == round)
+      s += "Cost: " + std::to_string(c.candidates) + " candidates, " + std::to_string(c.runs) + " runs of the path model, " +
+           fmt("%.1f", c.wall_s) + " s.\n\n";
   s += "| effect | constants | NRMSE | delta AIC | error removed | NRMSE beyond static | removed beyond static | significant |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const CandidateResult& c : out.candidates) {
@@ -192,6 +196,7 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
   }
   if (!out.stopped.empty()) s += "Stopped " + out.stopped + ".\n\n";
   for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
+  for (const EquivalentModel& m : out.equivalent_models) s += "Equivalent model: " + equivalent_model_text(m, out) + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";
   if (!out.fem_error.empty()) s += "Refinement / full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"

@@ -101,6 +101,24 @@ TEST(OtherMeansNull, SmallStaticMisfitsNameNothing) {
   }
 }
 
+// The same 2 % softer silicone against instantaneous creep, which can stand in for it: a Prony term
+// at its smallest gamma and tau relaxes within 0.2 s of every step, a uniformly softer silicone. With
+// the whole catalog (2026-11-29, before the fix) viscoelastic_instantaneous was named, at gamma 0.021
+// and tau 0.2 s (both at their lower bounds), NRMSE 0.0246 -> 0.0063 raw but 0.0052 -> 0.0063 beyond
+// a static misfit, after stiffness had been rejected by its size; 963 s. A history effect that
+// explains nothing beyond a static misfit and fits no better than the static effect rejected by its
+// size stands in for that misfit (reject_static_stand_ins).
+TEST(OtherMeansNull, CreepThatOnlyStandsInForAStaticMisfitIsNotNamed) {
+  const DiagnosisResult r = diagnose("null_stiffness_2pc", {"stiffness", "viscoelastic_instantaneous"}, 1);
+  EXPECT_TRUE(r.selected.empty()) << r.missing_effect;
+  const auto creep = std::find_if(r.candidates.begin(), r.candidates.end(),
+                                  [](const CandidateResult& c) { return c.effect == "viscoelastic_instantaneous"; });
+  ASSERT_NE(creep, r.candidates.end());
+  EXPECT_FALSE(creep->beyond_static);
+  EXPECT_GE(creep->nrmse, r.candidates.front().nrmse);  // stiffness, rejected by its size, fits as well or better
+  EXPECT_NE(creep->why.find("stands in for that small static misfit"), std::string::npos) << creep->why;
+}
+
 // A 15 % larger angle (the h = 4 mesh's curve, diagnosed on h = 6) is no longer within an elastic
 // model's accuracy: stiffness is named (measured: scale 0.905, NRMSE 0.1045 -> 0.0151, 0.0081 beyond
 // a static misfit at a 0.0080 floor: what is left is the curve's shape, static) and the note says the
@@ -150,7 +168,9 @@ TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
 // mullins, max 2): fatigue named alone, NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor (1.2x the
 // floor; this effect is small, the baseline only 2.8x the floor, so 0.4x leaves 0.002 above it);
 // W_th 4.8 kPa, tau 289 s. Round 2: creep passes the raw tests with gamma at its bound, not selected.
-// 131 s of one core.
+// 131 s of one core. The cause (2026-11-29, bench/notes/2026-11-29-fatigue-saturation.md): the
+// candidate's law cannot slow down (its saturation exponent n stays at 1); with n held at 3 and 6
+// fatigue alone leaves 0.0153 (0.41x) and 0.0148 (0.40x, tau at its 100 s bound).
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
 // Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
 // mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
@@ -216,7 +236,16 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
-// Not measured in time with the whole catalog (the CI tests above run the stiffness candidate).
+// Measured with the whole catalog (2026-11-29, one thread of a machine at load 8): null_geometry_wall
+// names nothing (baseline 0.0105 at a 0.0098 floor; stiffness the best, 0.0103, dAIC -63, fails the
+// gain test; every history candidate ends with a constant at a bound), 442 s. null_stiffness_2pc
+// named viscoelastic_instantaneous (a stand-in: CreepThatOnlyStandsInForAStaticMisfitIsNotNamed
+// above); after that fix nothing (creep 0.0063 and fatigue 0.0136 rejected as stand-ins for
+// stiffness's 0.0052, which its size rejects), 213 s. null_stiffness_3pc_stiffer, after the fix,
+// round 1: nothing (long-term creep 0.0245, dAIC -957, tau at its bound, rejected as a stand-in for
+// stiffness's 0.0228), 279 s. null_mesh_h4 was not measured in time (the CI tests above run the stiffness
+// candidate; GeneratedNull in test_othermeans_generated.cpp runs four candidates on a null generated
+// in the test).
 TEST(OtherMeansNull, DISABLED_StaticMisfitsNameNothingWithTheWholeCatalog) {
   for (const std::string name : {"null_stiffness_3pc_stiffer", "null_stiffness_2pc", "null_geometry_wall"})
     EXPECT_TRUE(diagnose(name).selected.empty()) << name;
