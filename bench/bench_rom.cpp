@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,7 @@ int main(int argc, char** argv) {
     else if (a == "--pod-tol") ro.pod_tolerance = std::stod(next());
     else if (a == "--no-hyper") ro.hyper_reduce = false;
     else if (a == "--galerkin-theta") ro.galerkin_theta_row = true;  // the theta row tested with the path tangent
+    else if (a == "--tangent-free") ro.tangent_free_modes = true;  // modes orthogonal to every path tangent, no gauge
     else if (a == "--softened") ro.softened_levels = std::stoi(next());  // softened equilibria as snapshots (levels)
     else if (a == "--softened-max") ro.softened_max = std::stod(next());
     else if (a[0] != '-') scene_path = a;
@@ -207,7 +209,19 @@ int main(int argc, char** argv) {
     } else {
       Assembler A(sm->model);
       QuasiStaticRun q(A, sm->solver.quasi_static);
-      q.run(sm->load, [&](const StateRecord&, const Eigen::VectorXd& u, const std::vector<double>&) { snapshots.push_back(u); });
+      // The snapshot run's angles are also the FEM judge's record (step 4) of its own scene, so a
+      // run with --fem --snap-trials N over N trials pays one FEM run, not two.
+      const fs::path judge = fs::path(work) / ("fem_" + std::to_string(fnv(snap_scene.to_toml())) + ".csv");
+      std::ostringstream rec;
+      rec.precision(17);
+      q.run(sm->load, [&](const StateRecord& r, const Eigen::VectorXd& u, const std::vector<double>&) {
+        snapshots.push_back(u);
+        rec << r.trial << " " << r.time_s << " " << r.pressure_Pa << " " << r.angle_deg << "\n";
+      });
+      if (!fs::exists(judge)) {
+        std::ofstream(judge.string() + ".part") << rec.str();
+        fs::rename(judge.string() + ".part", judge);
+      }
       d.clear();
       for (const auto& u : snapshots) d.insert(d.end(), u.data(), u.data() + u.size());
       write_doubles(f, d);
@@ -237,6 +251,7 @@ int main(int argc, char** argv) {
     for (const std::string& s : snap_sets) snap_key += s + ";";
     if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
     if (ro.galerkin_theta_row) snap_key += "galerkin-theta";
+    if (ro.tangent_free_modes) snap_key += "tangent-free";
     const fs::path f = fs::path(work) / ("basis_" + std::to_string(fnv(ref_scene.model_toml() + opts + snap_key)) + ".bin");
     std::vector<double> d;
     if (read_doubles(f, d)) {

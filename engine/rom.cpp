@@ -262,6 +262,8 @@ struct ReducedOrderModel::Impl {
   std::vector<Eigen::MatrixXd> dK, dH, dKref;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<int> tip_nodes;               ///< nodes whose displacement the angle needs
+  bool galerkin_theta_row = false;          ///< every sample's theta row tests u_el' (ReducedBasis::wa all 0)
+  bool gauge_free = false;                  ///< the modes are orthogonal to the path's tangents (ReducedBasis::gauge all 0)
 };
 
 ReducedOrderModel::ReducedOrderModel(const Model& reference, const ReducedBasis& basis, const Model& model)
@@ -310,6 +312,8 @@ ReducedOrderModel::ReducedOrderModel(const Model& reference, const ReducedBasis&
   impl_->dKref = slopes_of(th, basis.Kref);
   impl_->dpw = slopes_of(th, basis.pw);
   impl_->gravity = model.gravity_m_s2;
+  impl_->galerkin_theta_row = std::all_of(basis.wa.begin(), basis.wa.end(), [](double a) { return a == 0.0; });
+  impl_->gauge_free = basis.num_modes() > 0 && basis.gauge.isZero(0.0);
 }
 
 ReducedOrderModel::~ReducedOrderModel() = default;
@@ -408,10 +412,15 @@ Eigen::VectorXd ReducedOrderModel::residual(const ReducedCoordinates& z, double 
     R.segment(1, r).noalias() -= (0.5 * p_Pa) * (B.pq * qq);
   }
 
-  // Gauge: q is mass-orthogonal to u_el'(theta); multiplier lambda.
-  R[0] += z.lambda * gauge.d.dot(q);
-  R.segment(1, r) += z.lambda * gauge.v;
-  R[n1] = gauge.v.dot(q);
+  // Gauge: q is mass-orthogonal to u_el'(theta); multiplier lambda (see galerkin_theta_row in Impl).
+  // A basis without a gauge (tangent_free_modes) keeps lambda at 0 (its row lambda = 0).
+  if (impl_->gauge_free) {
+    R[n1] = z.lambda;
+  } else {
+    if (impl_->galerkin_theta_row) R[0] += z.lambda * gauge.d.dot(q);
+    R.segment(1, r) += z.lambda * gauge.v;
+    R[n1] = gauge.v.dot(q);
+  }
 
   if (jacobian) {
     Eigen::MatrixXd& Jm = *jacobian;
@@ -442,13 +451,19 @@ Eigen::VectorXd ReducedOrderModel::residual(const ReducedCoordinates& z, double 
     // Gauge.
     const Eigen::VectorXd ddgauge = h.curvature<Eigen::VectorXd>(B.gauge.col(k), B.gauge.col(k + 1), impl_->dgauge.col(k),
                                                                  impl_->dgauge.col(k + 1));
-    Jm(0, 0) += z.lambda * ddgauge.dot(q);
-    Jm.block(0, 1, 1, r) += z.lambda * gauge.d.transpose();
-    Jm.block(1, 0, r, 1) += z.lambda * gauge.d;
-    Jm.block(0, n1, 1, 1)(0, 0) = gauge.d.dot(q);
-    Jm.block(1, n1, r, 1) = gauge.v;
-    Jm(n1, 0) = gauge.d.dot(q);
-    Jm.block(n1, 1, 1, r) = gauge.v.transpose();
+    if (impl_->gauge_free) {
+      Jm(n1, n1) = 1.0;
+    } else {
+      if (impl_->galerkin_theta_row) {
+        Jm(0, 0) += z.lambda * ddgauge.dot(q);
+        Jm.block(0, 1, 1, r) += z.lambda * gauge.d.transpose();
+        Jm.block(0, n1, 1, 1)(0, 0) = gauge.d.dot(q);
+      }
+      Jm.block(1, 0, r, 1) += z.lambda * gauge.d;
+      Jm.block(1, n1, r, 1) = gauge.v;
+      Jm(n1, 0) = gauge.d.dot(q);
+      Jm.block(n1, 1, 1, r) = gauge.v.transpose();
+    }
   }
   return R;
 }

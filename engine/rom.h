@@ -77,7 +77,13 @@
 //       element energies: the reduced model keeps a potential structure, and its cost is set by the
 //       number of sampled elements, not by the mesh.
 //   The gauge: theta and the part of Phi q along u_el'(theta) would describe the same motion, so q is
-//       kept mass-orthogonal to u_el'(theta) (one Lagrange multiplier).
+//       kept mass-orthogonal to u_el'(theta) (one Lagrange multiplier lambda, c(theta)^T q = 0 with
+//       c = Phi^T M u_el'). The multiplier enters the q rows only: eliminated, the equations are
+//       w^T R = 0 and N^T Phi^T R = 0 (N a basis of c's complement), the Petrov-Galerkin form on the
+//       constrained manifold. Its term lambda c'^T q in the theta row belongs to the Galerkin form's
+//       Lagrangian and is kept only there (galerkin_theta_row); in the Petrov-Galerkin form it changed
+//       no angle of the h = 6 story's ten trials (to 0.001 deg) and did not remove the spurious root of
+//       a basis rich in damaged states (bench/results/rom_h6_ceiling, section 5).
 //
 // Material history lives at the sampled elements' quadrature points only, evaluated by the run's own
 // Material objects (any law and decorator; committed/trial as in the FEM). Fields of the whole mesh
@@ -122,6 +128,14 @@ struct RomBasisOptions {
   /// rich in damaged shapes the Petrov-Galerkin row can admit a spurious root that the Galerkin row
   /// does not, at the price of the Galerkin row's bias on softening (bench/results/rom_h6_ceiling).
   bool galerkin_theta_row = false;
+  /// Modes made mass-orthogonal to every tangent of the path (the tangents' POD to 1e-6 of their
+  /// energy is projected out of Phi), so that theta and q cannot describe the same motion anywhere
+  /// and the reduced equations need no gauge (ReducedBasis::gauge is then zero, which the reduced
+  /// model reads as "no gauge"). For experiments: on the h = 6 story's ten trials it completed with
+  /// a basis of ten trials' FEM states, where the gauge's reaction makes a spurious root in trial 2,
+  /// and cut the default basis's largest error per trial by ~15 % from trial 3 on (trial 2 0.42 ->
+  /// 0.48 deg; bench/results/rom_h6_ceiling, section 5).
+  bool tangent_free_modes = false;
   bool verbose = false;
 };
 
@@ -141,7 +155,7 @@ struct ReducedBasis {
   std::vector<Eigen::MatrixXd> K, H;  ///< r x r per sample
   Eigen::MatrixXd gt;             ///< 3 x ns: w^T f_g per unit acceleration along x, y, z
   Eigen::MatrixXd gq;             ///< r x 3: Phi^T f_g per unit acceleration
-  Eigen::MatrixXd gauge;          ///< r x ns: Phi^T M u_el' (q is kept orthogonal to it)
+  Eigen::MatrixXd gauge;          ///< r x ns: Phi^T M u_el' (q is kept orthogonal to it); all zero: no gauge (tangent_free_modes)
   // Hyper-reduction: sampled elements and their ECSW weights; the reference's hyper-reduced force at
   // q = 0 on a fine grid of every segment (kRefSub + 1 points each) and its q-Jacobian per sample.
   std::vector<int> elements;

@@ -237,6 +237,25 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   }
 }
 
+/// Removes from `modes` (mass-orthonormal, unit RMS) their parts along the path's tangents (the
+/// columns of dU): the tangents' POD to 1e-6 of their energy is projected out and the modes are
+/// orthonormalised again; a mode with less than 1e-3 of its norm left is dropped (it was a tangent).
+void project_out_path_tangents(const Eigen::MatrixXd& dU, const Eigen::VectorXd& mass, std::vector<Eigen::VectorXd>& modes) {
+  const double m_tot = mass.sum();
+  std::vector<Eigen::VectorXd> tangents, tangent_modes;
+  for (Eigen::Index k = 0; k < dU.cols(); ++k) tangents.push_back(dU.col(k));
+  double left = 0.0;
+  pod_append(tangents, mass, static_cast<int>(tangents.size()), 1e-6, tangent_modes, left);
+  std::vector<Eigen::VectorXd> kept;
+  for (Eigen::VectorXd m : modes) {
+    for (const Eigen::VectorXd& t : tangent_modes) m -= (mass_dot(mass, t, m) / m_tot) * t;
+    for (const Eigen::VectorXd& k : kept) m -= (mass_dot(mass, k, m) / m_tot) * k;
+    const double norm = std::sqrt(mass_dot(mass, m, m) / m_tot);
+    if (norm > 1e-3) kept.push_back(m / norm);
+  }
+  modes = std::move(kept);
+}
+
 /// The isochoric part of a material scaled by s (the volumetric part kept): what a damage law's
 /// (1 - d) does to the stress.
 class IsochoricScaled final : public Material {
@@ -532,6 +551,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
   if (!snapshot_shapes.empty())
     pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false);
   pod_append(response_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left);
+  if (opt.tangent_free_modes) project_out_path_tangents(B.dU, mass, modes);
   const int r = static_cast<int>(modes.size());
   B.info.pod_energy_left = left;
   B.Phi = Eigen::MatrixXd::Zero(ndof, r);
@@ -573,6 +593,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
   for (int d = 0; d < 3; ++d) B.gq.col(d) = B.Phi.transpose() * f_axis[d];
   Eigen::MatrixXd MPhi = B.Phi;
   for (Eigen::Index i = 0; i < ndof; ++i) MPhi.row(i) *= mass[i / 3];
+  double tangent_share_lo = 1.0, tangent_share_hi = 0.0;
   for (std::size_t k = 0; k < ns; ++k) {
     const Eigen::Index kk = static_cast<Eigen::Index>(k);
     const Eigen::VectorXd uk = B.U.col(kk), tk = B.dU.col(kk);
@@ -611,7 +632,15 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     B.H[k] = 0.5 * (B.H[k] + B.H[k].transpose());
     for (int d = 0; d < 3; ++d) B.gt(d, kk) = w.dot(f_axis[d]);
     B.gauge.col(kk) = MPhi.transpose() * tk;
+    // The share of the path tangent's mass norm that the modes hold (Phi^T M Phi = m_tot I): near 1,
+    // theta and q would describe the same motion and only the gauge keeps them apart.
+    tangent_share_lo = std::min(tangent_share_lo, B.gauge.col(kk).squaredNorm() / (m_tot * mass_dot(mass, tk, tk)));
+    tangent_share_hi = std::max(tangent_share_hi, B.gauge.col(kk).squaredNorm() / (m_tot * mass_dot(mass, tk, tk)));
   }
+  if (opt.verbose)
+    std::fprintf(stderr, "reduced basis: the modes hold %.3g-%.3g of the path tangent's mass norm squared\n", tangent_share_lo,
+                 tangent_share_hi);
+  if (opt.tangent_free_modes) B.gauge.setZero();  // what is left is the tangents' POD remainder: no gauge
   pressure_second_order(A, B);
   if (opt.verbose) std::fprintf(stderr, "reduced basis: operators at %zu samples, %.1f s\n", ns, seconds_since(t_start));
 
