@@ -6,7 +6,7 @@
 //   * --protocol FILE: the scene's whole quasi-static protocol (e.g. the ten-trial story with its
 //     inelastic effects, issue 3's performance target) with the breakdown the issue asks for: states
 //     solved, Newton iterations per state, time per iteration, and the wall time of every trial.
-// Usage: bench_engine [--h-mm 2.0] [--threads N] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
+// Usage: bench_engine [--h-mm 2.0] [--threads N] [--blas-threads N] [--blas-ab] [--skip-trial] [--kernel-only] [--element tet4|tet10] [--reps 7]
 //                     [--checksum] [--scene-force FILE] [--protocol FILE [--trials N] [--set KEY=VALUE]... [--angles CSV]
 //                     [--save-after-first-trial CKPT | --save-each-trial PREFIX | --resume CKPT]]
 // --checksum prints a hash of the bits of f_int, of K's values and of the energy (1 and N threads),
@@ -14,6 +14,10 @@
 // --scene-force FILE times the force-only kernel of a scene with history (e.g. the story's
 // viscoelastic(fatigue(mullins(yeoh))), scenes/examples/paper_story.toml) at h = --h-mm, from the
 // virgin state and from a loaded one, and hashes f_int and the trial state of both (A/B as above).
+// --blas-threads N runs every factorisation with N OpenBLAS threads (engine/linear_solver.h; 1 as
+// pneufem runs it). --blas-ab times the numeric factorisation of the default mesh's tangent at h
+// with 1 and 2 BLAS threads alternately in one process (--reps pairs) and says whether the two
+// solutions agree to the bit.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -31,6 +35,7 @@
 #include <Eigen/CholmodSupport>
 
 #include "engine/assembly.h"
+#include "engine/factorisation_threads.h"
 #include "engine/linear_solver.h"
 #include "engine/quasi_static.h"
 #include "scenes/build_model.h"
@@ -237,6 +242,43 @@ void orderings(double h_mm, int threads, int reps) {
   }
 }
 
+/// Numeric factorisation of the unloaded tangent (default mesh at h) with 1 and 2 BLAS threads,
+/// alternately, `reps` pairs: the medians, their ratio and whether the solutions agree to the bit.
+void blas_threads_ab(double h_mm, int threads, int reps) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
+  auto bm = build_model(scene);
+  const Assembler A(bm->model);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
+  SparseMatrix K = A.tangent_pattern();
+  A.internal(u, {}, {}, {}, &f, &K, nullptr);
+  A.apply_constraints(K, 1.0);
+  LinearSolver ls;
+  ls.factorize(K);  // symbolic analysis
+  std::vector<double> times[2];
+  Eigen::VectorXd x[2];
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(K.rows());
+  for (int r = 0; r < reps; ++r)
+    for (int i = 0; i < 2; ++i) {
+      set_factorisation_blas_threads(i + 1);
+      const auto t0 = Clock::now();
+      ls.factorize(K);
+      times[i].push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      x[i] = ls.solve(b);
+      std::printf("  pair %d, %d BLAS thread%s: %.3f s\n", r + 1, i + 1, i ? "s" : "", times[i].back());
+    }
+  set_factorisation_blas_threads(1);
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  const double m1 = median(times[0]), m2 = median(times[1]);
+  std::printf("  %d dofs, %d TBB threads: median factorisation 1 BLAS thread %.3f s, 2 BLAS threads %.3f s "
+              "(2/1 = %.3f); solutions %s\n",
+              bm->model.num_dofs(), threads, m1, m2, m2 / m1,
+              std::memcmp(x[0].data(), x[1].data(), sizeof(double) * x[0].size()) ? "differ in their bits" : "identical");
+}
+
 /// The quasi-static protocol of `file` (its own mesh unless --h-mm is given, its own trials unless
 /// trials > 0, `sets` as simulate's --set), timed as a whole and per trial, with the solver's
 /// breakdown; with `angles` non-empty every report (trial, time, pressure, angle) goes to that CSV.
@@ -358,7 +400,7 @@ int main(int argc, char** argv) {
   int reps = 7;
   std::string only_element;  // "" = both
   std::string scene_file, protocol_file;
-  bool set_h = false, do_orderings = false;
+  bool set_h = false, do_orderings = false, do_blas_ab = false;
   int trials = 0;
   std::vector<std::string> sets;
   std::string angles, save_after_first, resume_file, save_each;
@@ -379,6 +421,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--resume") && i + 1 < argc) resume_file = argv[++i];
     else if (!std::strcmp(argv[i], "--save-each-trial") && i + 1 < argc) save_each = argv[++i];
     else if (!std::strcmp(argv[i], "--orderings")) do_orderings = true;
+    else if (!std::strcmp(argv[i], "--blas-threads") && i + 1 < argc) set_factorisation_blas_threads(std::max(1, std::atoi(argv[++i])));
+    else if (!std::strcmp(argv[i], "--blas-ab")) do_blas_ab = true;
+  }
+  if (do_blas_ab) {
+    std::printf("factorisation with 1 and 2 BLAS threads (h=%.2f mm):\n", h);
+    blas_threads_ab(h, threads, reps);
+    return 0;
   }
   if (do_orderings) {
     std::printf("fill-reducing orderings of the tangent (h=%.2f mm):\n", h);

@@ -1,9 +1,13 @@
 #include "engine/linear_solver.h"
 
+#include "engine/factorisation_threads.h"
+
 #include <malloc.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <mutex>
+#include <stdexcept>
 
 #include <Eigen/CholmodSupport>
 
@@ -23,29 +27,40 @@ namespace {
 //  * Debian's CHOLMOD opens OpenMP regions with an explicit num_threads(4) and OpenBLAS starts its
 //    own pthreads; next to our TBB workers on 2 cores they oversubscribe the machine and spend most
 //    of the time spinning and in futex calls. pneufem's parallelism is TBB (elements, sweep
-//    points), so the solver runs single-threaded: OpenMP regions are serialised (max active
-//    levels 0; an explicit num_threads clause ignores OMP_NUM_THREADS) and OpenBLAS uses one
-//    thread. Setting OMP_NUM_THREADS / OPENBLAS_NUM_THREADS in the environment keeps the user's.
-//    The OpenMP setting is per thread in libgomp (a TBB worker starts from the global defaults),
-//    so it is applied on the calling thread before every CHOLMOD call.
+//    points), so CHOLMOD's OpenMP regions are serialised (max active levels 0; an explicit
+//    num_threads clause ignores OMP_NUM_THREADS; setting OMP_NUM_THREADS keeps the user's) and
+//    OpenBLAS runs factorisation_blas_threads() threads (1 unless set), whatever
+//    OPENBLAS_NUM_THREADS says: the factor's bits depend on that count. The OpenMP setting is per
+//    thread in libgomp (a TBB worker starts from the global defaults), so it is applied on the
+//    calling thread before every CHOLMOD call, and the BLAS count with it (another library in the
+//    process, numpy say, may have changed it).
 //  * Every numeric factorisation allocates the permuted matrix afresh. Blocks above glibc's mmap
 //    threshold (at most 32 MiB by default) are mmapped and unmapped each time, so every
 //    factorisation page-faults its whole working set; raising the thresholds keeps the memory in
 //    the heap for reuse.
 bool serialise_openmp = false;
+std::atomic<int> blas_threads{1};
 
 void configure_process() {
   serialise_openmp = !std::getenv("OMP_NUM_THREADS") && omp_set_max_active_levels;
-  if (!std::getenv("OPENBLAS_NUM_THREADS") && openblas_set_num_threads) openblas_set_num_threads(1);
   mallopt(M_MMAP_THRESHOLD, 512 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
-void serialise_openmp_on_this_thread() {
+/// Before every CHOLMOD call: OpenMP serialised on this thread, OpenBLAS at the fixed count.
+void fix_threading_on_this_thread() {
   if (serialise_openmp) omp_set_max_active_levels(0);
+  if (openblas_set_num_threads) openblas_set_num_threads(blas_threads.load());
 }
 
 }  // namespace
+
+void set_factorisation_blas_threads(int threads) {
+  if (threads < 1) throw std::invalid_argument("set_factorisation_blas_threads: threads must be >= 1");
+  blas_threads.store(threads);
+}
+
+int factorisation_blas_threads() { return blas_threads.load(); }
 
 struct LinearSolver::Impl {
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
@@ -61,7 +76,7 @@ LinearSolver::LinearSolver() : impl_(std::make_unique<Impl>()) {
 LinearSolver::~LinearSolver() = default;
 
 bool LinearSolver::factorize(const SparseMatrix& K) {
-  serialise_openmp_on_this_thread();
+  fix_threading_on_this_thread();
   if (!analysed_) {
     impl_->llt.analyzePattern(K);
     analysed_ = true;
@@ -73,7 +88,7 @@ bool LinearSolver::factorize(const SparseMatrix& K) {
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {
-  serialise_openmp_on_this_thread();
+  fix_threading_on_this_thread();
   return impl_->llt.solve(b);
 }
 
