@@ -380,7 +380,7 @@ TEST(ReducedModel, TangentFreeModesNeedNoGaugeAndFollowTheFem) {
   const ReducedBasis tf = build_reduced_basis(o.ref->model, o.trace, opt);
   ASSERT_GT(tf.num_modes(), 0);
   EXPECT_TRUE(tf.gauge.isZero(0.0));
-  const Eigen::VectorXd& mass = Assembler(o.ref->model).lumped_mass();
+  const Eigen::VectorXd mass = Assembler(o.ref->model).lumped_mass();  // a copy: the Assembler is a temporary
   const double m_tot = mass.sum();
   auto mass_dot = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     double s = 0.0;
