@@ -131,10 +131,12 @@ struct RomBasisOptions {
   /// Modes made mass-orthogonal to every tangent of the path (the tangents' POD to 1e-6 of their
   /// energy is projected out of Phi), so that theta and q cannot describe the same motion anywhere
   /// and the reduced equations need no gauge (ReducedBasis::gauge is then zero, which the reduced
-  /// model reads as "no gauge"). For experiments: on the h = 6 story's ten trials it completed with
-  /// a basis of ten trials' FEM states, where the gauge's reaction makes a spurious root in trial 2,
-  /// and cut the default basis's largest error per trial by ~15 % from trial 3 on (trial 2 0.42 ->
-  /// 0.48 deg; bench/results/rom_h6_ceiling, section 5).
+  /// model reads as "no gauge"). For experiments: on the h = 6 story's ten trials, with the
+  /// Petrov-Galerkin row, it completed with a basis of ten trials' FEM states, where the gauge's
+  /// reaction makes a spurious root in trial 2, and cut the default basis's largest error per trial
+  /// by ~15 % from trial 3 on (trial 2 0.42 -> 0.48 deg); with the Galerkin row it overshoots from
+  /// trial 1 (0.8-0.9 deg), which needs the modes' parts along the tangents
+  /// (bench/results/rom_h6_ceiling, section 5).
   bool tangent_free_modes = false;
   bool verbose = false;
 };
