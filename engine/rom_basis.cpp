@@ -634,8 +634,9 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     B.gauge.col(kk) = MPhi.transpose() * tk;
     // The share of the path tangent's mass norm that the modes hold (Phi^T M Phi = m_tot I): near 1,
     // theta and q would describe the same motion and only the gauge keeps them apart.
-    tangent_share_lo = std::min(tangent_share_lo, B.gauge.col(kk).squaredNorm() / (m_tot * mass_dot(mass, tk, tk)));
-    tangent_share_hi = std::max(tangent_share_hi, B.gauge.col(kk).squaredNorm() / (m_tot * mass_dot(mass, tk, tk)));
+    const double tangent_share = B.gauge.col(kk).squaredNorm() / (m_tot * mass_dot(mass, tk, tk));
+    tangent_share_lo = std::min(tangent_share_lo, tangent_share);
+    tangent_share_hi = std::max(tangent_share_hi, tangent_share);
   }
   if (opt.verbose)
     std::fprintf(stderr, "reduced basis: the modes hold %.3g-%.3g of the path tangent's mass norm squared\n", tangent_share_lo,
