@@ -14,7 +14,6 @@
 // at their end. Deterministic: a fixed-seed 64-bit generator and our own normal deviates (Box-Muller
 // on 53-bit uniforms), so the recording is the same on every platform.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -31,6 +30,7 @@
 
 #include "app/diagnose/command.h"
 #include "scenes/scene.h"
+#include "tests/app/diagnose/run_and_print.h"
 
 namespace fs = std::filesystem;
 
@@ -205,19 +205,7 @@ DiagnosisResult diagnose_generated(const std::string& name, const std::vector<Tr
   o.max_effects = max_effects;
   o.out_dir = (dir / "out").string();
   o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();  // shared elastic work
-  const auto t0 = std::chrono::steady_clock::now();
-  const DiagnosisResult r = run_diagnosis(Scene::load("", kScene), o);
-  std::printf("%s: baseline %.4f, floor %.4f, final %.4f (%.2fx); selected:", name.c_str(), r.baseline_nrmse,
-              r.noise_floor_nrmse, r.final_nrmse, r.final_nrmse / r.baseline_nrmse);
-  for (const std::string& s : r.selected) std::printf(" %s", s.c_str());
-  std::printf("; %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  for (const CandidateResult& c : r.candidates) {
-    std::printf("  round %d %-27s NRMSE %.4f beyond static %.4f dAIC %8.1f%s", c.round, c.effect.c_str(), c.nrmse,
-                c.nrmse_beyond_static, c.delta_aic, c.significant ? " sig" : "");
-    for (std::size_t i = 0; i < c.params.size(); ++i) std::printf(" %s=%.4g", c.param_names[i].c_str(), c.params[i]);
-    std::printf("\n");
-  }
-  return r;
+  return test::run_and_print_diagnosis(name, kScene, o);
 }
 
 // The generator itself, against what it was given: the elastic curve at its own points, the slew
