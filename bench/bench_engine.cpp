@@ -206,24 +206,28 @@ void one_trial(double h_mm, int threads) {
       std::printf("    %5.1f  %9.3f\n", r.pressure_Pa * 1e-3, r.angle_deg);
 }
 
+/// The Newton tangent of the default mesh at h, unloaded (u = 0, no pressure), constraints applied.
+SparseMatrix unloaded_tangent(double h_mm) {
+  auto bm = build_model(Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)}));
+  const Assembler A(bm->model);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
+  SparseMatrix K = A.tangent_pattern();
+  A.internal(u, {}, {}, {}, &f, &K, nullptr);
+  A.apply_constraints(K, 1.0);
+  return K;
+}
+
 /// Fill-reducing orderings of the Newton tangent (default mesh at h, unloaded: u = 0, no pressure):
 /// for CHOLMOD's default choice and each single method, the analysis time, nnz(L), the flop count
 /// and the median numeric factorisation time (serial BLAS, as LinearSolver runs it).
 void orderings(double h_mm, int threads, int reps) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
-  auto bm = build_model(scene);
-  const Assembler A(bm->model);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
-  SparseMatrix K = A.tangent_pattern();
-  A.internal(u, {}, {}, {}, &f, &K, nullptr);
-  Eigen::VectorXd fe = Eigen::VectorXd::Zero(u.size());
-    A.apply_constraints(K, 1.0);
+  const SparseMatrix K = unloaded_tangent(h_mm);
   { LinearSolver warm; warm.factorize(K); }  // process settings (serial BLAS / OpenMP) as in a run
   struct Try { const char* name; int nmethods; int ordering; };
   const Try tries[] = {{"default (CHOLMOD's choice)", 0, -1}, {"AMD", 1, CHOLMOD_AMD}, {"METIS", 1, CHOLMOD_METIS},
                        {"NESDIS", 1, CHOLMOD_NESDIS}};
-  std::printf("  tangent: %d dofs, nnz(K) = %ld\n", bm->model.num_dofs(), static_cast<long>(K.nonZeros()));
+  std::printf("  tangent: %d dofs, nnz(K) = %ld\n", static_cast<int>(K.rows()), static_cast<long>(K.nonZeros()));
   for (const Try& t : tries) {
     Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
     llt.cholmod().print = 0;
@@ -246,13 +250,7 @@ void orderings(double h_mm, int threads, int reps) {
 /// alternately, `reps` pairs: the medians, their ratio and whether the solutions agree to the bit.
 void blas_threads_ab(double h_mm, int threads, int reps) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-  const Scene scene = Scene::load("", {"mesh.h_mm=" + std::to_string(h_mm)});
-  auto bm = build_model(scene);
-  const Assembler A(bm->model);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(bm->model.num_dofs()), f;
-  SparseMatrix K = A.tangent_pattern();
-  A.internal(u, {}, {}, {}, &f, &K, nullptr);
-  A.apply_constraints(K, 1.0);
+  const SparseMatrix K = unloaded_tangent(h_mm);
   LinearSolver ls;
   ls.factorize(K);  // symbolic analysis
   std::vector<double> times[2];
@@ -275,7 +273,7 @@ void blas_threads_ab(double h_mm, int threads, int reps) {
   const double m1 = median(times[0]), m2 = median(times[1]);
   std::printf("  %d dofs, %d TBB threads: median factorisation 1 BLAS thread %.3f s, 2 BLAS threads %.3f s "
               "(2/1 = %.3f); solutions %s\n",
-              bm->model.num_dofs(), threads, m1, m2, m2 / m1,
+              static_cast<int>(K.rows()), threads, m1, m2, m2 / m1,
               std::memcmp(x[0].data(), x[1].data(), sizeof(double) * x[0].size()) ? "differ in their bits" : "identical");
 }
 
