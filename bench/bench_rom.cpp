@@ -3,7 +3,7 @@
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--dump-points]
-//             [--galerkin-theta] [--fabric-strain]
+//             [--galerkin-theta] [--fabric-strain] [--rom-time-tol T]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --corrected reports|tops adds the
@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets, model_sets, snap_sets;
   bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
+  double rom_time_tol = 0.0;  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
   std::string save_corrected, extra_snapshots;
   int threads = 0;
   RomBasisOptions ro;
@@ -126,6 +127,7 @@ int main(int argc, char** argv) {
     else if (a == "--snap-trials") snap_trials = std::stoi(next());  // FEM snapshots of the first N trials enrich the basis
     else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
+    else if (a == "--rom-time-tol") rom_time_tol = std::stod(next());  // the reduced run's time_tol only
     else if (a == "--save-corrected") save_corrected = next();   // the enrichment's corrected states, to a file
     else if (a == "--extra-snapshots") extra_snapshots = next(); // snapshots from such a file join the basis
     else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
@@ -298,7 +300,9 @@ int main(int argc, char** argv) {
   }
   const auto t_on = Clock::now();
   const ReducedOrderModel rom(ref->model, basis, bm->model);
-  ReducedRun run(rom, bm->solver.quasi_static);
+  QuasiStaticOptions rom_steps = bm->solver.quasi_static;
+  if (rom_time_tol > 0.0) rom_steps.time_tol = rom_time_tol;
+  ReducedRun run(rom, rom_steps);
   std::vector<Eigen::VectorXd> rom_u, strain_u;
   std::vector<double> strain_lambda, strain_q, strain_theta;
   std::vector<std::vector<double>> rom_h;
