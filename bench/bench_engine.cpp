@@ -277,6 +277,64 @@ void blas_threads_ab(double h_mm, int threads, int reps) {
               std::memcmp(x[0].data(), x[1].data(), sizeof(double) * x[0].size()) ? "differ in their bits" : "identical");
 }
 
+/// Where a protocol run stands: the wall clock and the solver's counts so far. Two marks give the
+/// cost of what ran between them.
+struct ProgressMark {
+  Clock::time_point wall;
+  long states, iterations, factorizations;
+};
+
+ProgressMark progress_mark(const QuasiStaticRun& run) {
+  return ProgressMark{Clock::now(), run.stats().states, run.static_solver().stats().iterations,
+                      run.static_solver().stats().factorizations};
+}
+
+double seconds_between(const ProgressMark& a, const ProgressMark& b) { return std::chrono::duration<double>(b.wall - a.wall).count(); }
+
+/// A trial's climb, from its first report to its last (the line goes on with the gap after it).
+void print_trial(int trial, const ProgressMark& first, const ProgressMark& last) {
+  std::printf("  trial %2d: climb %8.1f s, %5ld states, %6ld Newton its, %5ld factorisations", trial, seconds_between(first, last),
+              last.states - first.states, last.iterations - first.iterations, last.factorizations - first.factorizations);
+  std::fflush(stdout);
+}
+
+/// The gap before the next trial's first report, after the last report of a trial: the release, the
+/// rest, then the first 2.5 s at 0 kPa.
+void print_gap(const ProgressMark& last, const ProgressMark& release_end, const ProgressMark& rest_end, const ProgressMark& now) {
+  std::printf(" | then release + rest %6.1f s, %3ld states, %4ld its, %4ld facts (release %5.1f s, %ld states, %ld its, "
+              "%ld facts; rest %5.1f s, %ld states, %ld its, %ld facts); 2.5 s at 0 kPa %5.1f s, %2ld states, "
+              "%3ld its, %3ld facts\n",
+              seconds_between(last, rest_end), rest_end.states - last.states, rest_end.iterations - last.iterations,
+              rest_end.factorizations - last.factorizations, seconds_between(last, release_end),
+              release_end.states - last.states, release_end.iterations - last.iterations,
+              release_end.factorizations - last.factorizations, seconds_between(release_end, rest_end),
+              rest_end.states - release_end.states, rest_end.iterations - release_end.iterations,
+              rest_end.factorizations - release_end.factorizations, seconds_between(rest_end, now), now.states - rest_end.states,
+              now.iterations - rest_end.iterations, now.factorizations - rest_end.factorizations);
+  std::fflush(stdout);
+}
+
+/// The whole run's cost, with the solver's breakdown.
+void print_totals(const QuasiStaticRun& run, double wall) {
+  const StaticStats& st = run.static_solver().stats();
+  const double states = static_cast<double>(run.stats().states), its = static_cast<double>(st.iterations);
+  std::printf("  total %.1f s wall: %ld states (+%ld rejected), %ld Newton iterations (%.2f per state), "
+              "%ld factorisations, %ld Krylov iterations\n",
+              wall, run.stats().states, run.stats().rejected_steps, st.iterations, its / std::max(1.0, states),
+              st.factorizations, st.krylov_iterations);
+  std::printf("  per Newton iteration %.3f s (assembly %.1f s, factorisation + solves %.1f s in all); per state %.3f s\n",
+              wall / std::max(1.0, its), st.assembly_s, st.factor_s, wall / std::max(1.0, states));
+}
+
+/// The protocol's header line: the model's size and the options.
+void print_protocol_header(const std::string& file, const BuiltModel& bm, int threads, const std::vector<std::string>& sets) {
+  std::printf("protocol %s: %d nodes, %d elements, %d dofs, %zu trials, %d threads", file.c_str(),
+              bm.model.mesh.num_nodes(), bm.model.mesh.num_elements(), bm.model.num_dofs(), bm.load.trials.size(),
+              threads);
+  for (const std::string& k : sets) std::printf(", --set %s", k.c_str());
+  std::printf("\n");
+}
+
 /// The quasi-static protocol of `file` (its own mesh unless --h-mm is given, its own trials unless
 /// trials > 0, `sets` as simulate's --set), timed as a whole and per trial, with the solver's
 /// breakdown; with `angles` non-empty every report (trial, time, pressure, angle) goes to that CSV.
@@ -290,11 +348,7 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
   auto bm = build_model(scene);
   const Assembler A(bm->model);
   QuasiStaticRun run(A, bm->solver.quasi_static);
-  std::printf("protocol %s: %d nodes, %d elements, %d dofs, %zu trials, %d threads", file.c_str(),
-              bm->model.mesh.num_nodes(), bm->model.mesh.num_elements(), bm->model.num_dofs(), bm->load.trials.size(),
-              threads);
-  for (const std::string& k : sets) std::printf(", --set %s", k.c_str());
-  std::printf("\n");
+  print_protocol_header(file, *bm, threads, sets);
   std::FILE* csv = angles.empty() ? nullptr : std::fopen(angles.c_str(), "w");
   if (csv) std::fprintf(csv, "trial,time_s,pressure_kPa,angle_deg\n");
   const auto t0 = Clock::now();
@@ -303,14 +357,6 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
   // top hold), and the gap before it: the release from the previous trial's top pressure and the
   // rest (counted at the end of the rest segment), then the first 2.5 s at 0 kPa. The gap's share
   // says how much of a trial's cost is not the climb.
-  struct Mark {
-    Clock::time_point wall;
-    long states, iterations, factorizations;
-  };
-  auto mark = [&] {
-    return Mark{Clock::now(), run.stats().states, run.static_solver().stats().iterations,
-                run.static_solver().stats().factorizations};
-  };
   const std::vector<QuasiStaticRun::Segment> segs = QuasiStaticRun::segments(bm->load);
   // --resume: continue from a checkpoint saved with --save-after-first-trial (e.g. by the other time
   // control: the release clears the step control's memory, so the gap that follows is a clean A/B).
@@ -321,20 +367,14 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
     std::printf("  resumed from %s before segment %zu\n", resume_file.c_str(), resume.next_segment);
   }
   int trial = resume_file.empty() ? 0 : segs[resume.next_segment - 1].trial + 1;
-  Mark first = mark(), last = first, release_end = first, rest_end = first;
-  auto seconds = [](const Mark& a, const Mark& b) { return std::chrono::duration<double>(b.wall - a.wall).count(); };
-  auto report_trial = [&] {
-    std::printf("  trial %2d: climb %8.1f s, %5ld states, %6ld Newton its, %5ld factorisations", trial, seconds(first, last),
-                last.states - first.states, last.iterations - first.iterations, last.factorizations - first.factorizations);
-    std::fflush(stdout);
-  };
+  ProgressMark first = progress_mark(run), last = first, release_end = first, rest_end = first;
   auto sink = [&](const QuasiStaticCheckpoint& c) {
     const QuasiStaticRun::Segment& sg = segs[c.next_segment - 1];
     if (!save_after_first.empty() && sg.trial == 0 && c.next_segment < segs.size() && segs[c.next_segment].trial == 1) {
       std::ofstream out(save_after_first, std::ios::binary);
       c.write(out);
       out.close();  // std::exit below does not destroy this scope's objects
-      report_trial();
+      print_trial(trial, first, last);
       std::printf("\n  saved the state after trial 1 to %s (%.1f s wall)\n", save_after_first.c_str(), since(t0));
       if (csv) std::fclose(csv);
       std::exit(0);
@@ -346,28 +386,18 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
       c.write(out);
     }
     if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 == sg.g0 && sg.p1 == 0.0 && sg.p0 != 0.0)
-      release_end = mark();                                                                  // the release
-    if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 > sg.g0) rest_end = mark();  // the rest
+      release_end = progress_mark(run);                                                                  // the release
+    if (sg.trial > 0 && sg.t0 == 0.0 && sg.t1 == 0.0 && sg.g1 > sg.g0) rest_end = progress_mark(run);  // the rest
   };
   run.run(
       bm->load,
       [&](const StateRecord& r, const Eigen::VectorXd&, const std::vector<double>&) {
-        const Mark now = mark();
+        const ProgressMark now = progress_mark(run);
         if (csv) std::fprintf(csv, "%d,%.6f,%.4f,%.9f\n", r.trial, r.time_s, r.pressure_Pa * 1e-3, r.angle_deg), std::fflush(csv);
         if (r.trial != trial) {
           if (trial > 0) {
-            report_trial();
-            std::printf(" | then release + rest %6.1f s, %3ld states, %4ld its, %4ld facts (release %5.1f s, %ld states, %ld its, "
-                        "%ld facts; rest %5.1f s, %ld states, %ld its, %ld facts); 2.5 s at 0 kPa %5.1f s, %2ld states, "
-                        "%3ld its, %3ld facts\n",
-                        seconds(last, rest_end), rest_end.states - last.states, rest_end.iterations - last.iterations,
-                        rest_end.factorizations - last.factorizations, seconds(last, release_end),
-                        release_end.states - last.states, release_end.iterations - last.iterations,
-                        release_end.factorizations - last.factorizations, seconds(release_end, rest_end),
-                        rest_end.states - release_end.states, rest_end.iterations - release_end.iterations,
-                        rest_end.factorizations - release_end.factorizations, seconds(rest_end, now), now.states - rest_end.states,
-                        now.iterations - rest_end.iterations, now.factorizations - rest_end.factorizations);
-            std::fflush(stdout);
+            print_trial(trial, first, last);
+            print_gap(last, release_end, rest_end, now);
           }
           trial = r.trial;
           first = now;
@@ -375,18 +405,10 @@ void protocol(const std::string& file, double h_mm, bool set_h, int trials, int 
         last = now;
       },
       sink, resume_file.empty() ? nullptr : &resume);
-  report_trial();
+  print_trial(trial, first, last);
   std::printf("\n");
   if (csv) std::fclose(csv);
-  const double wall = since(t0);
-  const StaticStats& st = run.static_solver().stats();
-  const double states = static_cast<double>(run.stats().states), its = static_cast<double>(st.iterations);
-  std::printf("  total %.1f s wall: %ld states (+%ld rejected), %ld Newton iterations (%.2f per state), "
-              "%ld factorisations, %ld Krylov iterations\n",
-              wall, run.stats().states, run.stats().rejected_steps, st.iterations, its / std::max(1.0, states),
-              st.factorizations, st.krylov_iterations);
-  std::printf("  per Newton iteration %.3f s (assembly %.1f s, factorisation + solves %.1f s in all); per state %.3f s\n",
-              wall / std::max(1.0, its), st.assembly_s, st.factor_s, wall / std::max(1.0, states));
+  print_totals(run, since(t0));
 }
 
 }  // namespace

@@ -22,7 +22,7 @@
 //
 // Between samples the reference's pressure p_el(theta) is a monotone cubic and the reference force
 // is cached at 64 sub-points per segment, so the elastic model stays on its FEM curve there too
-// (0.004 % of the angle on the test actuator's steepest part, tests/app/test_path_model.cpp).
+// (0.004 % of the angle on the test actuator's steepest part, tests/engine/test_path_model.cpp).
 // The path itself (F at every material point, V and S) is the cubic spline through the
 // samples, not a polyline: a polyline's F'(theta) jumps at the samples, and so would the
 // residual of every model but the reference, making its angle a step function of the material

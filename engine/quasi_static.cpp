@@ -434,22 +434,12 @@ double QuasiStaticRun::next_step(double h, const StepMeasure& sm, bool rejected)
   return std::clamp(h * grow, opt_.min_dt_s, opt_.max_dt_s);
 }
 
-// One loop of ~100 lines, on purpose: a step's save of u_, state_ and the Newton path, its solve, its
-// measure and its rejection (restore) or acceptance share that saved state; the parts with a name of
-// their own (the instant segment, the measures, the next step, the stall message) are functions.
-void QuasiStaticRun::solve_segment(const Segment& s) {
-  // A segment starts from what a checkpoint holds, and the factorisation is not in it: forgetting
-  // it here makes a resumed run continue bit for bit from any segment boundary (engine/quasi_static.h).
-  newton_.forget_factor();
-  const double span = s.g1 - s.g0;
-  const bool drive_control = opt_.time_control == TimeControl::Drive;
-  if (!rate_dependent_ || span <= 0.0) return solve_instant_segment(s);
-  auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
+QuasiStaticRun::SegmentStart QuasiStaticRun::start_segment(const Segment& s) {
   if (dt_suggest_ <= 0.0) dt_suggest_ = std::clamp(0.1, opt_.min_dt_s, opt_.max_dt_s);
-  const bool error_control = opt_.time_control == TimeControl::Error;
-  const double rate = (s.p1 - s.p0) / span;
+  SegmentStart st;
+  st.rate = (s.p1 - s.p0) / (s.g1 - s.g0);
   // A kink of the load (its rate changes): the last step's rate says nothing about this one.
-  const bool kink = std::abs(rate - rate_prev_) > 1e-9 * (std::abs(rate) + std::abs(rate_prev_));
+  const bool kink = std::abs(st.rate - rate_prev_) > 1e-9 * (std::abs(st.rate) + std::abs(rate_prev_));
   if (kink) hist_prev_.clear(), drive_prev_.clear();
   // A ramp that starts after a hold would otherwise be tried in the hold's long step, i.e. over the
   // whole ramp: a full Newton solve of the load increment, then rejected for its history change
@@ -460,14 +450,45 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
   // Only ramps after a hold (rate 0, as in a staircase) use and set it: between the segments of
   // a sampled pressure record the rate changes at every sample, and an increment learnt on a slow
   // segment would needlessly shorten the next fast one.
-  const int dir = rate > 0.0 ? 1 : 0;
-  const bool ramp_start = kink && rate != 0.0 && rate_prev_ == 0.0;
-  if (ramp_start && ramp_start_dp_[dir] > 0.0)
-    dt_suggest_ = std::max(opt_.min_dt_s, std::min(dt_suggest_, ramp_start_dp_[dir] / std::abs(rate)));
+  st.dir = st.rate > 0.0 ? 1 : 0;
+  st.ramp_start = kink && st.rate != 0.0 && rate_prev_ == 0.0;
+  if (st.ramp_start && ramp_start_dp_[st.dir] > 0.0)
+    dt_suggest_ = std::max(opt_.min_dt_s, std::min(dt_suggest_, ramp_start_dp_[st.dir] / std::abs(st.rate)));
   // Drive control: a hold or rest with no curvature known yet starts from the relaxation times.
-  const bool hold_start = drive_control && rate == 0.0 && !drive_kinds_.empty() && !damage_grew_ &&
-                          (hist_prev_.empty() || drive_prev_.empty());
-  if (hold_start) dt_suggest_ = first_hold_step();
+  st.hold_start = opt_.time_control == TimeControl::Drive && st.rate == 0.0 && !drive_kinds_.empty() && !damage_grew_ &&
+                  (hist_prev_.empty() || drive_prev_.empty());
+  if (st.hold_start) dt_suggest_ = first_hold_step();
+  return st;
+}
+
+void QuasiStaticRun::accept_step(StepMeasure& sm, double h, double rate) {
+  const bool drive_control = opt_.time_control == TimeControl::Drive;
+  if (opt_.time_control == TimeControl::Error || drive_control) {
+    hist_prev_ = std::move(hist_cur_);
+    h_prev_ = h;
+  }
+  if (drive_control) {
+    drive_prev_ = std::move(drive_cur_);
+    drive_cur_ = std::move(sm.drive_new);
+    unchecked_ = std::move(sm.unchecked_new);
+    damage_grew_ = sm.damage_grew;
+  }
+  hist_cur_ = std::move(sm.hist_new);
+  rate_prev_ = rate;
+}
+
+// One loop, on purpose: a step's save of u_, state_ and the Newton path, its solve, its measure and
+// its rejection (restore) or acceptance share that saved state; the parts with a name of their own
+// (the instant segment, the segment's start, the measures, the next step, the acceptance, the stall
+// message) are functions.
+void QuasiStaticRun::solve_segment(const Segment& s) {
+  // A segment starts from what a checkpoint holds, and the factorisation is not in it: forgetting
+  // it here makes a resumed run continue bit for bit from any segment boundary (engine/quasi_static.h).
+  newton_.forget_factor();
+  const double span = s.g1 - s.g0;
+  if (!rate_dependent_ || span <= 0.0) return solve_instant_segment(s);
+  auto p_at = [&](double g) { return s.p0 + (s.p1 - s.p0) * (g - s.g0) / span; };
+  const SegmentStart start = start_segment(s);
   bool first_step = true;
   double t = s.g0;
   long steps = 0;
@@ -486,6 +507,12 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
     const Eigen::VectorXd u_saved = u_;
     const std::vector<double> state_saved = state_;
     const StaticSolver::Path path_saved = newton_.path();
+    auto reject = [&] {
+      u_ = u_saved;
+      state_ = state_saved;
+      newton_.set_path(path_saved);
+      ++stats_.rejected_steps;
+    };
     try {
       equilibrium(p_at(t), p_at(t + h), t, t + h);
     } catch (const PhysicsError& e) {
@@ -494,46 +521,29 @@ void QuasiStaticRun::solve_segment(const Segment& s) {
       if (opt_.newton.verbose)
         std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: equilibrium failed (rejected): %s\n",
                      t + h, h, p_at(t + h) * 1e-3, e.what());
-      u_ = u_saved;
-      state_ = state_saved;
-      newton_.set_path(path_saved);
+      reject();
       dt_suggest_ = std::max(opt_.min_dt_s, 0.25 * h);
-      ++stats_.rejected_steps;
       continue;
     }
-    StepMeasure sm = measure_step(state_saved, h, hold_start);
+    StepMeasure sm = measure_step(state_saved, h, start.hold_start);
     last_element = sm.worst_point >= 0 ? asm_.element_of_point(sm.worst_point) : -1;
     last_change = sm.change;
     last_h = h;
-    const bool reject = sm.measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
+    const bool too_far = sm.measure > 2.0 * opt_.time_tol && !minimal && h > opt_.min_dt_s * (1.0 + 1e-9);
     if (opt_.newton.verbose)
       std::fprintf(stderr, "  physical step t = %.6g s, h = %.3g s, p = %.4g kPa: history %s %.3g (tol %.3g) at %s%s\n",
                    t + h, h, p_at(t + h) * 1e-3, sm.estimate ? "error estimate" : "change", sm.measure, opt_.time_tol,
-                   last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-", reject ? " (rejected)" : "");
-    dt_suggest_ = next_step(h, sm, reject);
-    if (reject) {
-      u_ = u_saved;
-      state_ = state_saved;
-      newton_.set_path(path_saved);
-      ++stats_.rejected_steps;
+                   last_element >= 0 ? asm_.model().mesh.element_label(last_element).c_str() : "-", too_far ? " (rejected)" : "");
+    dt_suggest_ = next_step(h, sm, too_far);
+    if (too_far) {
+      reject();
       continue;
     }
     // The ramp's first step, when the control (not the segment's end) set its length: the step
     // the control would now take, as a pressure increment, starts the next ramp.
-    if (ramp_start && first_step && by_control) ramp_start_dp_[dir] = dt_suggest_ * std::abs(rate);
+    if (start.ramp_start && first_step && by_control) ramp_start_dp_[start.dir] = dt_suggest_ * std::abs(start.rate);
     first_step = false;
-    if (error_control || drive_control) {
-      hist_prev_ = std::move(hist_cur_);
-      h_prev_ = h;
-    }
-    if (drive_control) {
-      drive_prev_ = std::move(drive_cur_);
-      drive_cur_ = std::move(sm.drive_new);
-      unchecked_ = std::move(sm.unchecked_new);
-      damage_grew_ = sm.damage_grew;
-    }
-    hist_cur_ = std::move(sm.hist_new);
-    rate_prev_ = rate;
+    accept_step(sm, h, start.rate);
     t += h;
   }
 }

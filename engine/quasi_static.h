@@ -234,6 +234,21 @@ class QuasiStaticRun {
   /// at most h (at least 0.2 h), else within [0.5 h, 2 h]; always within [min_dt_s, max_dt_s] (a
   /// rejection: at least min_dt_s).
   double next_step(double h, const StepMeasure& sm, bool rejected) const;
+  /// How a segment of physical time starts: its load rate (Pa/s), the direction of a ramp (1 up,
+  /// 0 down: ramp_start_dp_'s index), whether it is a ramp after a hold (its first step, when the
+  /// control set its length, then sets ramp_start_dp_) and whether it is drive control's first step
+  /// of a hold.
+  struct SegmentStart {
+    double rate = 0.0;
+    int dir = 0;
+    bool ramp_start = false, hold_start = false;
+  };
+  /// The first step of segment s (span > 0) into dt_suggest_: from the last ramp's start after a
+  /// hold, from the relaxation times at the start of a hold under drive control; a kink of the
+  /// load forgets the previous step.
+  SegmentStart start_segment(const Segment& s);
+  /// An accepted step of length h at load rate `rate`: the step control's memory moves on by one step.
+  void accept_step(StepMeasure& sm, double h, double rate);
   void equilibrium(double p0, double p1, double t0, double t1);
   /// Drive control: the first step of a hold or rest, from the current viscous strains (see above).
   double first_hold_step() const;

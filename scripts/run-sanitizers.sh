@@ -5,9 +5,11 @@
 #     behaviour aborts; the libraries instrumented for libFuzzer too, so one build serves both) and
 #     asserts on (-O1, no NDEBUG); builds only the readers' libraries, their tests and the fuzzers
 #     (no VTK, no app);
-#  2. runs the readers' tests under the sanitizers: the deck reader (test_inp, test_inp_assembly, test_inp_text),
-#     the scene reader and its typed settings (test_scene, test_scene_settings, test_key_limits) and the
-#     measurement and DeepLabCut readers (test_measurements) — the code that meets users' files,
+#  2. runs the readers' tests under the sanitizers: the deck reader and writer (test_inp_reader,
+#     test_inp_read_sets, test_inp_read_loads, test_inp_surface_elements, test_inp_writer,
+#     test_inp_assembly, test_inp_text) and a deck through the scene (test_angle_frame,
+#     test_build_model), the scene reader and its typed settings (test_scene, test_scene_settings,
+#     test_key_limits) and the measurement and DeepLabCut readers (test_measurements) — the code that meets users' files,
 #     in suites of seconds (but the three tests that bend an actuator); the solver suites run for
 #     minutes and read no user input;
 #  3. runs each fuzzer over its seed corpus (fuzz/corpus/) and on new inputs for
@@ -17,7 +19,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${PNEUFEM_SANITIZE_BUILD:-build-sanitize}
 seconds=${PNEUFEM_FUZZ_SECONDS:-20}
-tests=(test_inp test_inp_assembly test_inp_text test_scene test_scene_settings test_key_limits test_measurements)
+tests=(test_inp_reader test_inp_read_sets test_inp_read_loads test_inp_surface_elements test_inp_writer test_inp_assembly
+       test_inp_text test_angle_frame test_build_model test_scene test_scene_settings test_key_limits test_measurements)
 # The three tests that bend an actuator (a solver run, minutes under ASan) read no input their
 # siblings do not: left to the normal suite.
 cxx=$(command -v clang++-14 || command -v clang++ || true)

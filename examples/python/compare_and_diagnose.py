@@ -16,6 +16,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import pneufem
+from pneufem import style
 
 ap = argparse.ArgumentParser()
 ap.add_argument("out", nargs="?", default="out/python_example")
@@ -39,16 +40,18 @@ dia = pneufem.diagnose(scene, data=data, out=out / "diagnose", candidates=["visc
                        max_effects=1, evaluations=20, threads=2)
 
 rec = pneufem._commands.read_csv(data)
+style.use()  # pneufem's figures' palette (Okabe & Ito, colour-blind safe)
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-for trial in np.unique(rec["trial"]):
+for k, trial in enumerate(np.unique(rec["trial"])):
     rows = rec[(rec["trial"] == trial) & ~np.isnan(rec["angle_deg"])]
-    ax1.plot(rows["time_s"], rows["angle_deg"], ".", ms=2, label=f"trial {trial}")
+    ax1.plot(rows["time_s"], rows["angle_deg"], ".", ms=2, color=style.color(k), label=f"trial {trial}")
 ax1.set(xlabel="time in trial (s)", ylabel="measured angle (deg)")
 ax1.legend()
 trials = np.arange(1, len(cmp.trial_nrmse) + 1)
-ax2.bar(trials - 0.2, cmp.trial_nrmse, 0.4, label="elastic model (compare)")
-ax2.bar(trials + 0.2, dia.diagnosis["final_nrmse_per_trial"], 0.4, label=f"+ {dia.missing_effect} (diagnose)")
-ax2.axhline(cmp.noise_floor_nrmse, color="grey", ls="--", label="noise floor")
+ax2.bar(trials - 0.2, cmp.trial_nrmse, 0.4, color=style.color(0), label="elastic model (compare)")
+ax2.bar(trials + 0.2, dia.diagnosis["final_nrmse_per_trial"], 0.4, color=style.color(1),
+        label=f"+ {dia.missing_effect} (diagnose)")
+ax2.axhline(cmp.noise_floor_nrmse, color=style.GREY, ls="--", label="noise floor")
 ax2.set(xlabel="trial", ylabel="NRMSE", xticks=trials)
 ax2.legend()
 fig.tight_layout()

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import pneufem
+from pneufem import style
 
 out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "out/python_example")
 scene = pneufem.Scene.defaults().update({
@@ -22,11 +23,13 @@ scene = pneufem.Scene.defaults().update({
 })
 run = pneufem.simulate(scene, out=out / "run", threads=2)
 
+style.use()  # pneufem's figures' palette (Okabe & Ito, colour-blind safe)
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-for trial in np.unique(run.angles["trial"]):
+for k, trial in enumerate(np.unique(run.angles["trial"])):
     rows = run.states[run.states["trial"] == trial]
-    ax1.plot(rows["time_s"], rows["angle_deg"], label=f"trial {trial}")
-    ax2.plot(rows["pressure_kPa"], rows["angle_deg"], "o-", label=f"trial {trial}")
+    c = style.color(k)  # one colour per trial in both panels
+    ax1.plot(rows["time_s"], rows["angle_deg"], color=c, label=f"trial {trial}")
+    ax2.plot(rows["pressure_kPa"], rows["angle_deg"], "o-", color=c, label=f"trial {trial}")
 ax1.set(xlabel="time in trial (s)", ylabel="bending angle (deg)")
 ax2.set(xlabel="pressure (kPa)", ylabel="bending angle (deg)")
 ax1.legend()

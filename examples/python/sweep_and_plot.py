@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import pneufem
+from pneufem import style
 
 out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "out/python_example")
 scene = pneufem.Scene.defaults().update({
@@ -27,8 +28,9 @@ for row in sweep.table:
     run = sweep.point(int(row["point"]))  # each point's run directory, read back
     scales.append(run.scene[key])
     top_angles.append(run.angles["angle_deg"].max())
+style.use()  # pneufem's figures' palette (Okabe & Ito, colour-blind safe)
 fig, ax = plt.subplots(figsize=(5, 4))
-ax.plot(scales, top_angles, "o-")
+ax.plot(scales, top_angles, "o-", color=style.color(0))
 ax.set(xlabel="silicone stiffness scale", ylabel="angle at the top (deg)")
 fig.tight_layout()
 fig.savefig(out / "sweep.png", dpi=100)

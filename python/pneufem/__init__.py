@@ -13,9 +13,10 @@ whole interface.
 """
 from ._core import InputError, PhysicsError, version
 from ._scene import Scene
+from . import style
 from ._commands import (CompareResult, DiagnoseResult, SimulationResult, SweepResult, SynthResult, compare,
                         diagnose, simulate, sweep, synth)
 
 __version__ = version()
 __all__ = ["Scene", "simulate", "compare", "diagnose", "synth", "sweep", "SimulationResult", "CompareResult",
-           "DiagnoseResult", "SynthResult", "SweepResult", "InputError", "PhysicsError", "version"]
+           "DiagnoseResult", "SynthResult", "SweepResult", "InputError", "PhysicsError", "version", "style"]
