@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -214,7 +215,46 @@ Scene with_deck_moduli(const Scene& s, const InpDeck& deck, std::vector<std::str
   return s.with(sets);
 }
 
-/// mesh.regions (element sets of a deck as regions), then the [[parts]]: every element gets one part,
+/// [[mesh.region_boxes]]: the elements whose centroid (the mean of their corner nodes, reference
+/// configuration) lies in a box take its region tag, box after box. A box must hold at least one
+/// centroid: an empty one is a typo in its coordinates or units, and is named with the mesh's extent.
+void apply_region_boxes(const Scene& s, Mesh& mesh) {
+  const int nboxes = s.array_size("mesh.region_boxes");
+  if (nboxes == 0) return;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Eigen::Vector3d& x : mesh.X) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  constexpr int corners = 4;  // Tet4 and Tet10 list their corner nodes first
+  std::vector<Eigen::Vector3d> centroid(static_cast<std::size_t>(mesh.num_elements()), Eigen::Vector3d::Zero());
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    for (int a = 0; a < corners; ++a) centroid[static_cast<std::size_t>(e)] += mesh.X[static_cast<std::size_t>(mesh.element(e)[a])];
+    centroid[static_cast<std::size_t>(e)] /= corners;
+  }
+  auto mm = [](const Eigen::Vector3d& x) {
+    std::ostringstream os;
+    os << '[' << short_num(1e3 * x.x()) << ", " << short_num(1e3 * x.y()) << ", " << short_num(1e3 * x.z()) << ']';
+    return os.str();
+  };
+  for (int i = 0; i < nboxes; ++i) {
+    const std::string key = "mesh.region_boxes[" + std::to_string(i) + "]";
+    const std::string tag = s.string(key + ".region");
+    if (tag.empty()) s.fail(key + ".region", "must name a region tag, e.g. \"interior_wall\"");
+    const Eigen::Vector3d bmin = 1e-3 * s.vec3(key + ".min_mm"), bmax = 1e-3 * s.vec3(key + ".max_mm");
+    if (!(bmin.array() < bmax.array()).all())
+      s.fail(key + ".max_mm", "must be above min_mm along x, y and z (min " + mm(bmin) + ", max " + mm(bmax) + " mm)");
+    std::vector<int> inside;
+    for (int e = 0; e < mesh.num_elements(); ++e) {
+      const Eigen::Vector3d& c = centroid[static_cast<std::size_t>(e)];
+      if ((c.array() >= bmin.array()).all() && (c.array() <= bmax.array()).all()) inside.push_back(e);
+    }
+    if (inside.empty())
+      s.fail(key, "the box " + mm(bmin) + " to " + mm(bmax) + " mm holds no element's centroid; the mesh spans " + mm(lo) +
+                      " to " + mm(hi) + " mm");
+    const std::uint16_t r = mesh.region_id(tag);
+    for (int e : inside) mesh.region[static_cast<std::size_t>(e)] = r;
+  }
+}
+
+/// mesh.regions (element sets of a deck as regions), then mesh.region_boxes, then the [[parts]]: every element gets one part,
 /// the elements of a region with a stiffness scale a part of their own. With a membrane fabric an
 /// empty element set (FABRIC) makes no part.
 void assign_parts(const Scene& s, Model& model, bool membrane_fabric) {
@@ -229,6 +269,8 @@ void assign_parts(const Scene& s, Model& model, bool membrane_fabric) {
     const std::uint16_t r = mesh.region_id(s.string_entry("mesh.regions", elset));
     for (int e : *els) mesh.region[e] = r;
   }
+
+  apply_region_boxes(s, mesh);
 
   // Parts: element set -> material.
   const int nparts = s.array_size("parts");

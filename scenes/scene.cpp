@@ -50,6 +50,25 @@ bool free_form(const std::string& path) {
   return path == "materials" || path == "mesh.regions" || path == "regions" || path.rfind("materials.", 0) == 0;
 }
 
+// Arrays of tables ([[parts]], [[mesh.region_boxes]]): every entry's keys are checked against the
+// ones it may have. Also for a --set of the whole array, which check_known lets through because the
+// key exists.
+void check_entries(const std::string& key, const toml::node& v) {
+  static const std::map<std::string, std::vector<std::string>> entry_keys = {
+      {"parts", {"elset", "material"}}, {"mesh.region_boxes", {"region", "min_mm", "max_mm"}}};
+  const auto keys = entry_keys.find(key);
+  if (keys == entry_keys.end() || !v.is_array()) return;
+  std::string list;
+  for (const std::string& k : keys->second) list += (list.empty() ? "'" : ", '") + k + "'";
+  for (auto&& item : *v.as_array()) {
+    if (!item.is_table()) throw InputError(origin_of(item) + ": '" + key + "' must be an array of tables ([[" + key + "]])");
+    for (auto&& [pk, pv] : *item.as_table())
+      if (std::find(keys->second.begin(), keys->second.end(), std::string(pk.str())) == keys->second.end())
+        throw InputError(printable(origin_of(pv) + ": key '" + key + "." + std::string(pk.str()) + "': unknown key; an entry of '" +
+                                   key + "' has " + list));
+  }
+}
+
 // Rejects keys of `user` that the default scene does not have.
 void check_known(const toml::table& user, const toml::table& defaults, const std::string& prefix) {
   for (auto&& [k, v] : user) {
@@ -72,15 +91,7 @@ void check_known(const toml::table& user, const toml::table& defaults, const std
       throw InputError(printable(msg));
     }
     if (v.is_table() && d->is_table() && !free_form(key)) check_known(*v.as_table(), *d->as_table(), key);
-    if (key == "parts" && v.is_array()) {
-      for (auto&& item : *v.as_array()) {
-        if (!item.is_table()) throw InputError(origin_of(item) + ": 'parts' must be an array of tables ([[parts]])");
-        for (auto&& [pk, pv] : *item.as_table())
-          if (pk.str() != "elset" && pk.str() != "material")
-            throw InputError(printable(origin_of(pv) + ": key 'parts." + std::string(pk.str()) +
-                                       "': unknown key; a part has 'elset' and 'material'"));
-      }
-    }
+    check_entries(key, v);
   }
 }
 
@@ -187,6 +198,7 @@ void apply_override(Scene::Impl& impl, const std::string& ov) {
     // A key that exists in the current scene (e.g. a user-defined material) is fine too.
     if (!impl.table.at_path(key)) throw;
   }
+  if (const toml::node* n = nested.at_path(key).node()) check_entries(key, *n);
   Origins ignored;  // the nested copy lost its source; record the override itself
   merge(impl.table, nested, "", ignored);
   for (auto it = impl.origins.lower_bound(key + "."); it != impl.origins.end() && it->first.rfind(key + ".", 0) == 0;)
