@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -154,13 +155,30 @@ TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
   expect_found(diagnose("fatigue_powerlaw"), {"fatigue"});
 }
-// FAILS the 0.4x bound only (measured with the candidates stiffness, fatigue, viscoelastic_instantaneous,
-// mullins, max 2): fatigue named alone, NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor (1.2x the
-// floor; this effect is small, the baseline only 2.8x the floor, so 0.4x leaves 0.002 above it);
-// W_th 4.8 kPa, tau 289 s. Round 2: creep passes the raw tests with gamma at its bound, not selected.
-// 131 s of one core. The cause (2026-11-29, bench/notes/2026-11-29-fatigue-saturation.md): the
-// candidate's law cannot slow down (its saturation exponent n stays at 1); with n held at 3 and 6
-// fatigue alone leaves 0.0153 (0.41x) and 0.0148 (0.40x, tau at its 100 s bound).
+// Fatigue growing as the logarithm of a load-weighted cycle count (a third of it in trial 1), against
+// fatigue in both forms and the static stand-in (what took part of it before). Before
+// fatigue_saturating (2026-11-29) this FAILED the 0.4x bound only: fatigue (n = 1) named alone,
+// NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor, because that law cannot slow down
+// (bench/notes/2026-11-29-fatigue-saturation.md). Measured since (bench/notes/2026-11-29-diag2.md),
+// with the candidates stiffness, fatigue, fatigue_saturating, viscoelastic_instantaneous, mullins
+// (max 2): fatigue_saturating named alone, 0.0374 -> 0.0148 = 0.396x (W_th 6.1 kPa, tau 54 s), fatigue
+// 0.0162 reported as equally good (RSS within 25 %: the recording, 1.1x the floor after either, does
+// not tell the two forms apart by the tests' standard), round 2 nothing (stiffness 0.0148 fails the
+// gain test; Mullins and creep at bounds); 190 s of one core at load 5. Here with three candidates:
+// the 0.4x bound is the target (this effect is small: its baseline is 2.8x the floor).
+TEST(OtherMeansRecording, LogarithmicFatigueIsNamedAsSaturatingFatigue) {
+  const DiagnosisResult r = diagnose("fatigue_log", {"stiffness", "fatigue", "fatigue_saturating"}, 2);
+  expect_found(r, {"fatigue"});
+  ASSERT_EQ(r.selected, std::vector<std::string>{"fatigue_saturating"});
+  const auto first = [&](const std::string& name) {
+    const auto c = std::find_if(r.candidates.begin(), r.candidates.end(),
+                                [&](const CandidateResult& x) { return x.effect == name && x.round == 1; });
+    EXPECT_NE(c, r.candidates.end()) << name;
+    return c == r.candidates.end() ? std::numeric_limits<double>::infinity() : c->nrmse;
+  };
+  EXPECT_LT(first("fatigue_saturating"), first("fatigue"));  // the law that slows down fits better
+}
+// The whole catalog (measured with five candidates above).
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
 // Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
 // mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
