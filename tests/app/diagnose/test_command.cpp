@@ -754,6 +754,21 @@ TEST(HiddenEffect, CreepAndFatigueTogetherAreBothFound) {
                               [](const CandidateResult& c) { return c.effect == "fatigue" && c.round == 2; });
   ASSERT_NE(f, r.candidates.end());
   std::printf("fatigue: W_th %.4g MPa, tau %.4g s (truth 0.004, 200)\n", f->params[0], f->params[1]);
+  // Round 2's reasons read the residual the creep left, not the baseline's: the growth over the
+  // trials they quote is another. Before the fix (2026-11-29) round 2's fatigue quoted the
+  // baseline's "the error falls from trial 1 to the last trial (rms 0.80 -> 0.62 deg)"; now it
+  // quotes what the creep left, "the error grows from trial 1 to the last trial (rms 0.13 -> 0.26
+  // deg)", the fatigue's signature (the numbers are printed, the difference asserted).
+  const auto f1 = std::find_if(r.candidates.begin(), r.candidates.end(),
+                               [](const CandidateResult& c) { return c.effect == "fatigue" && c.round == 1; });
+  ASSERT_NE(f1, r.candidates.end());
+  const auto growth = [](const std::string& why) {
+    const std::size_t a = why.find("Residual signature: "), b = why.find(" deg)", a);
+    return a == std::string::npos || b == std::string::npos ? std::string() : why.substr(a, b - a);
+  };
+  std::printf("round 1: %s\nround 2: %s\n", growth(f1->why).c_str(), growth(f->why).c_str());
+  EXPECT_FALSE(growth(f->why).empty());
+  EXPECT_NE(growth(f1->why), growth(f->why));
   EXPECT_NEAR(std::log10(f->params[0]), std::log10(0.004), std::log10(2.0));
   // Issue 35 item 3: after each round, the joint intervals of every constant selected so far (the
   // fit within 25 % of its RSS, the other constants re-adjusting). Each holds its value and has a
