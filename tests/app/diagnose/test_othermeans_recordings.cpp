@@ -240,7 +240,13 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // errors (0.1534 -> 0.0771 -> 0.0136, 0.09x; fatigue in round 3 0.0136 -> 0.0135, delta AIC 0.8);
 // the lag first order as the truth's (tau 0.311 s, tau2 0; re-fitted in round 3 to 0.310 s, 0);
 // in round 1, alone under the creep, it had fitted tau 0.18 s, tau2 0.25 s. 927 s on two threads
-// of a shared machine. Still FAILS: fatigue not found.
+// of a shared machine. Still FAILS: fatigue not found. Measured again with fatigue_saturating
+// (2026-11-29, candidates stiffness, creep, lag and both fatigue forms, 941 s of one thread): the same
+// rounds; round 3 fatigue 0.0136 -> 0.0135 (dAIC +0.8), fatigue_saturating 0.0136 (+1.5). The cause
+// (bench/notes/2026-11-29-diag2.md): the same recording made without the fatigue leaves 0.0214 after
+// creep and lag (gamma 0.26, tau 10.1 s; its error growing over the trials), this one 0.0136 (gamma
+// 0.35, tau 10.6 s; none): the one-term creep, re-fitted, takes the fatigue's growth, and nothing is
+// left for fatigue. A creep law that can follow a power-law creep is the fix, not looser tests.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
