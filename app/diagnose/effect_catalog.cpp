@@ -200,7 +200,8 @@ std::vector<CandidateEffect> builtin_candidates() {
   // the same 60-run budget the three-constant calibration left more error on the FEM-made fatigue
   // recording (n = 1 truth) than the two-constant one, and its trade-off walk stopped at once at
   // n's bound; the two ends as separate candidates keep each calibration at two constants, and
-  // cost one more candidate per round.
+  // cost one more candidate per round. `fatigue` now sets n = 1 itself (it kept the scene's n): a
+  // scene's own fatigue table with another n is not switched over, as for the creep conventions.
   c.push_back(material_candidate(
       "fatigue",
       "progressive fatigue damage of the most strained silicone, growing with time under load (n = 1: at a constant "
@@ -214,7 +215,8 @@ std::vector<CandidateEffect> builtin_candidates() {
     // overload g = 1 for 160 s, d = 0.58 at tau = 10 s and 0.36 at 100 s); tau/(5 g) is only the
     // time of the knee after which the growth slows, and a few seconds of overload is where lab
     // softening is fastest. Measured on tests/data/othermeans/fatigue_log.csv with n held at 6 and
-    // tau's bound at 100 s: tau ended on that bound (bench/notes/2026-11-29-fatigue-saturation.md).
+    // tau's bound at 100 s: tau ended on that bound (bench/notes/2026-11-29-fatigue-saturation.md);
+    // from 10 s it ends inside, at 54 s (bench/notes/2026-11-29-diag2.md).
     CandidateEffect e = material_candidate(
         "fatigue",
         "progressive fatigue damage of the most strained silicone that slows down as it saturates (n = 6: damaged "
