@@ -13,7 +13,7 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   c->cmd = app.add_subcommand(
       "diagnose",
       "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, viscoelastic_instantaneous, mullins, "
-      "fatigue, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
+      "fatigue, fatigue_saturating, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
       "them by the error they remove with an information criterion, and writes diagnosis.json, fitted.toml and report.md");
   c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
       ->check(CLI::ExistingFile);

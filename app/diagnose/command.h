@@ -4,8 +4,9 @@
 // 1. The recording (analysis/measurements.h) is compared with the scene's model (the baseline):
 //    residual = model - measured at every kept frame (outlier frames dropped, analysis/model_vs_measured.h).
 // 2. Every candidate effect of the catalog (app/diagnose/effect_catalog.h: stiffness, viscoelastic,
-//    mullins, fatigue, pressure_lag, gravity and any registered material effect) is added to the
-//    scene and its few bounded parameters are calibrated (NLopt BOBYQA in [0, 1]-scaled, log where
+//    viscoelastic_instantaneous, mullins, fatigue, fatigue_saturating, pressure_lag, gravity and any
+//    registered material effect) is added to the scene and its few bounded parameters are
+//    calibrated (NLopt BOBYQA in [0, 1]-scaled, log where
 //    the catalog says so, after a coarse start grid) to minimise the residual sum of squares.
 // 3. Candidates are ranked by the error they leave. An information criterion makes extra
 //    parameters earn their place: AIC = n_eff ln(RSS / n_eff) + 2 k, where n_eff is the number of

@@ -4,7 +4,8 @@
 // parameters and the scene overrides that add it to a scene.
 //
 // Built-ins: stiffness, viscoelastic (moduli = long_term), viscoelastic_instantaneous (moduli =
-// instantaneous), mullins, fatigue, pressure_lag, gravity; then every effect
+// instantaneous), mullins, fatigue (integrity exponent n = 1), fatigue_saturating (n = 6), pressure_lag,
+// gravity; then every effect
 // of the material-effect registry (damage/registry.h) that is not a built-in, with the registry's
 // parameters and bounds (truth = initial = the registered default). Material effects apply to every
 // soft material of the scene's parts (model != "linear_elastic"; the fabric is not softened).

@@ -198,7 +198,7 @@ std::string rest_sentence(const Signature& s) {
 }  // namespace
 
 std::string evidence(const std::string& effect, const Signature& s) {
-  if (effect == "fatigue") return growth_sentence(s) + ", and " + top_creep_sentence(s);
+  if (effect == "fatigue" || effect == "fatigue_saturating") return growth_sentence(s) + ", and " + top_creep_sentence(s);
   if (effect == "viscoelastic" || effect == "viscoelastic_instantaneous") return hold_creep_sentence(s);
   if (effect == "mullins") return first_trial_sentence(s);
   if (effect == "stiffness") return proportional_sentence(s);

@@ -16,7 +16,7 @@ std::unique_ptr<SynthCommand> add_synth_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sy->add_option("--hidden", c->hidden,
                  "EFFECT[,EFFECT...] hidden at their truth values (candidates: stiffness, viscoelastic, viscoelastic_instantaneous, mullins, "
-                 "fatigue, pressure_lag, gravity and registered material effects), or none (the control dataset)")
+                 "fatigue, fatigue_saturating, pressure_lag, gravity and registered material effects), or none (the control dataset)")
       ->required();
   sy->add_option("--out", synth.out_csv, "Measurement CSV to write (canonical format); truth files go beside it")
       ->required();

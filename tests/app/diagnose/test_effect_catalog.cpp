@@ -38,8 +38,9 @@ void register_test_effect_once() {
 
 TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   const auto& all = candidate_effects();
-  const std::vector<std::string> names = {"stiffness", "viscoelastic", "viscoelastic_instantaneous", "mullins",
-                                          "fatigue",   "pressure_lag", "gravity"};
+  const std::vector<std::string> names = {"stiffness", "viscoelastic",       "viscoelastic_instantaneous",
+                                          "mullins",   "fatigue",            "fatigue_saturating",
+                                          "pressure_lag", "gravity"};
   ASSERT_GE(all.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   for (const CandidateEffect& c : all) {
@@ -59,7 +60,8 @@ TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   EXPECT_FALSE(candidate_effect("stiffness").history);
   const std::string e = error_of([] { candidate_effect("creep"); });
   EXPECT_NE(e.find("unknown candidate effect 'creep'"), std::string::npos) << e;
-  EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, mullins, fatigue, pressure_lag, gravity"),
+  EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, mullins, fatigue, fatigue_saturating, "
+                   "pressure_lag, gravity"),
             std::string::npos)
       << e;
 }
@@ -102,6 +104,11 @@ TEST(EffectCatalog, EveryCandidateBuildsOnTheDefaultSceneWithItsValuesOnTheRight
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.W_th_MPa"), 0.02);
   EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.tau_s"), 2000.0);
   EXPECT_EQ(s.string("materials.silicone.fatigue.driver"), base.string("materials.silicone.fatigue.driver"));
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.n"), 1.0);  // first-order kinetics
+  s = with("fatigue_saturating", {0.01, 50.0});
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.W_th_MPa"), 0.01);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.tau_s"), 50.0);
+  EXPECT_DOUBLE_EQ(s.number("materials.silicone.fatigue.n"), 6.0);  // saturating
   EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag_s"), 0.5);
   EXPECT_DOUBLE_EQ(with("pressure_lag", {0.5, 0.0}).number("load.pressure_lag2_s"), 0.0);  // first order
   EXPECT_DOUBLE_EQ(with("pressure_lag", {0.24, 0.27}).number("load.pressure_lag2_s"), 0.27);  // second order
@@ -154,19 +161,28 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
   register_test_effect_once();
   int checked = 0;
   for (const CandidateEffect& c : candidate_effects()) {
-    const MaterialEffect* fx = find_material_effect(c.name == "viscoelastic_instantaneous" ? "viscoelastic" : c.name);
+    const std::string effect = c.name == "viscoelastic_instantaneous" ? "viscoelastic"
+                               : c.name == "fatigue_saturating"       ? "fatigue"
+                                                                      : c.name;
+    const MaterialEffect* fx = find_material_effect(effect);
     if (!fx) continue;
     EXPECT_EQ(c.history, fx->history) << c.name;
     for (const CandidateParameter& p : c.params) {
       const EffectParameter& r = fx->param(p.name);
       EXPECT_EQ(p.unit, r.unit) << c.name << "." << p.name;
-      EXPECT_EQ(p.lo, r.lo) << c.name << "." << p.name;
+      // The one range the catalog narrows the registry's for: the saturating fatigue's tau, whose
+      // lower bound is 10 s (effect_catalog.cpp: with n = 6, tau sets the knee, not the damage).
+      if (c.name == "fatigue_saturating" && p.name == "tau_s")
+        EXPECT_EQ(p.lo, 10.0);
+      else
+        EXPECT_EQ(p.lo, r.lo) << c.name << "." << p.name;
       EXPECT_EQ(p.hi, r.hi) << c.name << "." << p.name;
       EXPECT_EQ(p.log, r.log) << c.name << "." << p.name;
       ++checked;
     }
   }
-  EXPECT_GE(checked, 2 + 2 + 2 + 2 + 1);  // viscoelastic in both conventions, mullins, fatigue, the test effect
+  EXPECT_GE(checked, 2 + 2 + 2 + 2 + 2 + 1);  // viscoelastic in both conventions, mullins, fatigue with and
+                                              // without saturation, the test effect
   // Calibration start and synth truth are the catalog's own, and not defaults: Mullins starts at
   // r = 5 (near the middle of log [1.1, 20]) and hides r = 3, while a scene's default is 8.
   const CandidateEffect& m = candidate_effect("mullins");
@@ -223,6 +239,32 @@ TEST(EffectCatalog, CreepIsTriedInBothModuliConventions) {
   // A scene whose creep is switched off is free for either.
   const Scene off = with_lt.with({"materials.silicone.viscoelastic.enabled=false"});
   EXPECT_EQ(off.with(inst.sets(off, {0.3, 2.0})).string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+}
+
+// Fatigue with and without saturation (issue 35 item 5): the same law at its integrity exponent's two
+// ends, n = 1 and n = 6, which the candidates fix; the two cannot be stacked (one fatigue table per
+// material), as the two creep conventions cannot.
+TEST(EffectCatalog, FatigueIsTriedWithAndWithoutSaturation) {
+  const CandidateEffect& f1 = candidate_effect("fatigue");
+  const CandidateEffect& f6 = candidate_effect("fatigue_saturating");
+  EXPECT_TRUE(f6.history);
+  ASSERT_EQ(f6.params.size(), 2u);
+  EXPECT_EQ(f6.params[0].name, "W_th_MPa");
+  EXPECT_EQ(f6.params[1].name, "tau_s");
+  EXPECT_EQ(f6.params[0].lo, f1.params[0].lo);
+  EXPECT_EQ(f6.params[1].hi, f1.params[1].hi);
+  EXPECT_NE(f6.description.find("saturates"), std::string::npos) << f6.description;
+  const Scene base = Scene::load("", kTiny);
+  const Scene with1 = base.with(f1.sets(base, {0.02, 2000.0}));
+  const std::string e = error_of([&] { f6.sets(with1, {0.01, 50.0}); });
+  EXPECT_NE(e.find("candidate 'fatigue_saturating': materials.silicone.fatigue is already enabled with n = 1; this "
+                   "candidate would switch it to 6"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(error_of([&] { f1.sets(base.with(f6.sets(base, {0.01, 50.0})), {0.02, 2000.0}); }).find("already enabled"),
+            std::string::npos);
+  // A re-fit of the same form replaces the constants.
+  EXPECT_DOUBLE_EQ(with1.with(f1.sets(with1, {0.03, 900.0})).number("materials.silicone.fatigue.tau_s"), 900.0);
 }
 
 // End to end: a recording whose creep goes beyond the elastic model (tests/data/hidden/

@@ -11,12 +11,14 @@
 // peaks, steps and holds (README.md beside the recordings lists each one).
 //
 // Each diagnosis runs the whole catalog. Asserted, as the issue asks: every hidden effect is named
-// (creep in either moduli convention), nothing else is, and the error after the selection is at
-// most 0.4x the baseline's; the recordings with a static misfit only name nothing.
+// (creep in either moduli convention, fatigue with or without saturation), nothing else is, and the
+// error after the selection is at most 0.4x the baseline's; the recordings with a static misfit only
+// name nothing.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -53,6 +55,7 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
 std::set<std::string> names_of(const std::string& hidden) {
   if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous"};
   if (hidden == "lag") return {"pressure_lag"};
+  if (hidden == "fatigue") return {"fatigue", "fatigue_saturating"};  // with or without saturation
   return {hidden};
 }
 
@@ -152,13 +155,30 @@ TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
   expect_found(diagnose("fatigue_powerlaw"), {"fatigue"});
 }
-// FAILS the 0.4x bound only (measured with the candidates stiffness, fatigue, viscoelastic_instantaneous,
-// mullins, max 2): fatigue named alone, NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor (1.2x the
-// floor; this effect is small, the baseline only 2.8x the floor, so 0.4x leaves 0.002 above it);
-// W_th 4.8 kPa, tau 289 s. Round 2: creep passes the raw tests with gamma at its bound, not selected.
-// 131 s of one core. The cause (2026-11-29, bench/notes/2026-11-29-fatigue-saturation.md): the
-// candidate's law cannot slow down (its saturation exponent n stays at 1); with n held at 3 and 6
-// fatigue alone leaves 0.0153 (0.41x) and 0.0148 (0.40x, tau at its 100 s bound).
+// Fatigue growing as the logarithm of a load-weighted cycle count (a third of it in trial 1), against
+// fatigue in both forms and the static stand-in (what took part of it before). Before
+// fatigue_saturating (2026-11-29) this FAILED the 0.4x bound only: fatigue (n = 1) named alone,
+// NRMSE 0.0374 -> 0.0162 = 0.43x at a 0.0133 floor, because that law cannot slow down
+// (bench/notes/2026-11-29-fatigue-saturation.md). Measured since (bench/notes/2026-11-29-diag2.md),
+// with the candidates stiffness, fatigue, fatigue_saturating, viscoelastic_instantaneous, mullins
+// (max 2): fatigue_saturating named alone, 0.0374 -> 0.0148 = 0.396x (W_th 6.1 kPa, tau 54 s), fatigue
+// 0.0162 reported as equally good (RSS within 25 %: the recording, 1.1x the floor after either, does
+// not tell the two forms apart by the tests' standard), round 2 nothing (stiffness 0.0148 fails the
+// gain test; Mullins and creep at bounds); 190 s of one core at load 5. Here with three candidates:
+// the 0.4x bound is the issue's target (this effect is small: its baseline is 2.8x the floor).
+TEST(OtherMeansRecording, LogarithmicFatigueIsNamedAsSaturatingFatigue) {
+  const DiagnosisResult r = diagnose("fatigue_log", {"stiffness", "fatigue", "fatigue_saturating"}, 2);
+  expect_found(r, {"fatigue"});
+  ASSERT_EQ(r.selected, std::vector<std::string>{"fatigue_saturating"});
+  const auto first = [&](const std::string& name) {
+    const auto c = std::find_if(r.candidates.begin(), r.candidates.end(),
+                                [&](const CandidateResult& x) { return x.effect == name && x.round == 1; });
+    EXPECT_NE(c, r.candidates.end()) << name;
+    return c == r.candidates.end() ? std::numeric_limits<double>::infinity() : c->nrmse;
+  };
+  EXPECT_LT(first("fatigue_saturating"), first("fatigue"));  // the law that slows down fits better
+}
+// The whole catalog (measured with five candidates above).
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
 // Measured with the candidates stiffness, mullins, viscoelastic_instantaneous, fatigue (max 2):
 // mullins alone, NRMSE 0.0353 -> 0.0087 (0.25x) at a 0.0077 floor (r 1.1, its bound: the reload
@@ -220,7 +240,13 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // errors (0.1534 -> 0.0771 -> 0.0136, 0.09x; fatigue in round 3 0.0136 -> 0.0135, delta AIC 0.8);
 // the lag first order as the truth's (tau 0.311 s, tau2 0; re-fitted in round 3 to 0.310 s, 0);
 // in round 1, alone under the creep, it had fitted tau 0.18 s, tau2 0.25 s. 927 s on two threads
-// of a shared machine. Still FAILS: fatigue not found.
+// of a shared machine. Still FAILS: fatigue not found. Measured again with fatigue_saturating
+// (2026-11-29, candidates stiffness, creep, lag and both fatigue forms, 941 s of one thread): the same
+// rounds; round 3 fatigue 0.0136 -> 0.0135 (dAIC +0.8), fatigue_saturating 0.0136 (+1.5). The cause
+// (bench/notes/2026-11-29-diag2.md): the same recording made without the fatigue leaves 0.0214 after
+// creep and lag (gamma 0.26, tau 10.1 s; its error growing over the trials), this one 0.0136 (gamma
+// 0.35, tau 10.6 s; none): the one-term creep, re-fitted, takes the fatigue's growth, and nothing is
+// left for fatigue. A creep law that can follow a power-law creep is the fix, not looser tests.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
