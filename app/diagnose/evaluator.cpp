@@ -173,7 +173,7 @@ std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& varia
     // Elastic (stiffness, gravity, lag): the angle is a function of the chamber pressure alone:
     // one sweep 0 -> max pressure, then a lookup per sample. Without gravity the reduced model
     // gives the sweep (exact for the reference, ~1 % for a uniform stiffness change: see
-    // tests/app/test_path_model.cpp); gravity loads a different deformation mode, which the
+    // tests/engine/test_path_model.cpp); gravity loads a different deformation mode, which the
     // 1-dof reduced model cannot represent, so then the sweep is the full static FEM (fewer
     // points, quadratic interpolation; cached by scene without the lag).
     // Curves span the reference peak, above the inlet's peak pressure, which a lagged chamber

@@ -59,7 +59,7 @@ void refine_with_fem(const Scene& scene, const Scene& cal_scene, const Recording
                      DiagnosisResult& out, std::vector<Series>* fitted_fem) {
   // Space mapping (output correction): the path model is a 1-dof Ritz model and misjudges
   // strongly localised effects (damage concentrated in the walls) by up to a factor ~2 in angle
-  // change (tests/app/test_path_model.cpp). Each refinement runs the accurate model (the
+  // change (tests/engine/test_path_model.cpp). Each refinement runs the accurate model (the
   // reduced-order model, or the full FEM with --refine-model full) once at the current constants,
   // adds its frame-by-frame difference from the path model as a fixed correction, and
   // re-calibrates each selected effect in turn from its current constants. At convergence the
