@@ -3,7 +3,7 @@
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--dump-points]
-//             [--galerkin-theta] [--fabric-strain] [--rom-time-tol T]
+//             [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --corrected reports|tops adds the
@@ -113,7 +113,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets, model_sets, snap_sets;
   bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
-  double rom_time_tol = 0.0;  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
+  double rom_time_tol = 0.0;
+  int path_steps = 40;  // the elastic path's pressure step is p_max / path_steps (its samples' density)  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
   std::string save_corrected, extra_snapshots;
   int threads = 0;
   RomBasisOptions ro;
@@ -127,6 +128,7 @@ int main(int argc, char** argv) {
     else if (a == "--snap-trials") snap_trials = std::stoi(next());  // FEM snapshots of the first N trials enrich the basis
     else if (a == "--snap-set") snap_sets.push_back(next());          // the snapshot run's model (default: the run's)
     else if (a == "--fem") fem = true;
+    else if (a == "--path-steps") path_steps = std::stoi(next());  // the path traced at p_max / N steps (default 40)
     else if (a == "--rom-time-tol") rom_time_tol = std::stod(next());  // the reduced run's time_tol only
     else if (a == "--save-corrected") save_corrected = next();   // the enrichment's corrected states, to a file
     else if (a == "--extra-snapshots") extra_snapshots = next(); // snapshots from such a file join the basis
@@ -170,11 +172,11 @@ int main(int argc, char** argv) {
   // 1. Elastic path (cached).
   PathModelOptions po;
   po.p_top_Pa = 1.8 * p_max;
-  po.dp_Pa = p_max / 40.0;
+  po.dp_Pa = p_max / path_steps;
   po.newton = ref->solver.quasi_static.newton;
   ElasticPathTrace trace;
   {
-    const fs::path f = fs::path(work) / ("trace_" + key + ".bin");
+    const fs::path f = fs::path(work) / ("trace_" + key + (path_steps == 40 ? "" : "_steps" + std::to_string(path_steps)) + ".bin");
     std::printf("elastic path file: %s\n", f.c_str());
     std::vector<double> d;
     const auto t0 = Clock::now();
