@@ -67,10 +67,11 @@ class InpFiles : public ::testing::Test {
     std::ofstream(p, std::ios::binary) << text;
     return p.string();
   }
-  /// Reads `text` as bad.inp and returns the InputError message ("" if none was thrown).
+  /// Reads `text` as bad.inp (lengths times error_length_to_m_) and returns the InputError message
+  /// ("" if none was thrown).
   std::string error_of(const std::string& text, const std::string& name = "bad.inp") const {
     try {
-      read_inp(write(name, text), 1e-3);
+      read_inp(write(name, text), error_length_to_m_);
     } catch (const InputError& e) {
       return e.what();
     }
@@ -84,7 +85,34 @@ class InpFiles : public ::testing::Test {
     for (const std::string& h : hints) EXPECT_NE(msg.find(h), std::string::npos) << "missing '" << h << "' in: " << msg;
   }
   fs::path dir_;
+  double error_length_to_m_ = 1e-3;  ///< the length unit error_of() reads a bad deck in
 };
+
+/// Every mutilation of the deck `lines` (each line dropped, halved, extended by ", junk" and
+/// replaced by junk, for every junk), as the deck's text, to `attempt`.
+template <class Attempt>
+void for_each_mutilation(const std::vector<std::string>& lines, const std::vector<std::string>& junk, Attempt&& attempt) {
+  auto join = [](const std::vector<std::string>& ls) {
+    std::string s;
+    for (const auto& l : ls) s += l + "\n";
+    return s;
+  };
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    std::vector<std::string> ls = lines;
+    ls.erase(ls.begin() + static_cast<std::ptrdiff_t>(i));
+    attempt(join(ls));
+    ls = lines;
+    ls[i] = ls[i].substr(0, ls[i].size() / 2);
+    attempt(join(ls));
+    for (const std::string& j : junk) {
+      ls = lines;
+      ls[i] += ", " + j;
+      attempt(join(ls));
+      ls[i] = j;
+      attempt(join(ls));
+    }
+  }
+}
 
 /// Nodes 1-4 of a unit tetrahedron: lines 1-5 of a deck that goes on with its elements.
 inline const std::string kNodes = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n";

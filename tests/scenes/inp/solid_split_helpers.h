@@ -19,17 +19,12 @@
 
 #include "core/errors.h"
 #include "scenes/inp/deck.h"
+#include "tests/scenes/inp/deck_files.h"
 
 namespace pneufem::test {
 
 using Vec = Eigen::Vector3d;
 using Map = std::function<Vec(const Vec&)>;
-
-/// How many of `lines` (a deck's or model's notes) contain `needle`.
-inline int count_containing(const std::vector<std::string>& lines, const std::string& needle) {
-  return static_cast<int>(std::count_if(lines.begin(), lines.end(),
-                                        [&](const std::string& l) { return l.find(needle) != std::string::npos; }));
-}
 
 /// Area of the triangle a b c.
 inline double area(const Vec& a, const Vec& b, const Vec& c) { return 0.5 * (b - a).cross(c - a).norm(); }
@@ -165,41 +160,12 @@ class HexBlock {
   std::function<bool(int, int, int)> removed_;
 };
 
-/// Tests on decks: each writes its files into a temporary directory of its own; read() parses a
-/// deck's text, expect_error() checks the message of a bad one (its bad.inp:line and hints).
-class SolidDecks : public ::testing::Test {
+/// Tests on decks (InpFiles: a temporary directory of their own, expect_error() of a bad deck's
+/// bad.inp:line and hints), with read() of a deck's text; lengths in metres.
+class SolidDecks : public InpFiles {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("pneufem_split_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const std::filesystem::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
+  SolidDecks() { error_length_to_m_ = 1.0; }
   InpDeck read(const std::string& text, double length_to_m = 1.0) const { return read_inp(write("deck.inp", text), length_to_m); }
-  std::string error_of(const std::string& text) const {
-    try {
-      read_inp(write("bad.inp", text), 1.0);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  }
-  void expect_error(const std::string& text, int line, const std::vector<std::string>& hints) const {
-    const std::string msg = error_of(text);
-    ASSERT_FALSE(msg.empty()) << "no InputError for:\n" << text;
-    EXPECT_NE(msg.find("bad.inp:" + std::to_string(line) + ": "), std::string::npos) << msg;
-    for (const std::string& h : hints) EXPECT_NE(msg.find(h), std::string::npos) << "missing '" << h << "' in: " << msg;
-  }
-  std::filesystem::path dir_;
 };
 
 /// The sheared unit cube (planar faces): volume det A, boundary = the six parallelograms.

@@ -21,18 +21,15 @@
 #include "scenes/build_model.h"
 #include "scenes/inp/assembly.h"
 #include "scenes/inp/deck.h"
+#include "tests/scenes/inp/deck_files.h"
 
 namespace pneufem {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string data_path(const std::string& name) { return std::string(PNEUFEM_TEST_DATA_DIR) + "/inp/" + name; }
-
-int count_containing(const std::vector<std::string>& lines, const std::string& needle) {
-  return static_cast<int>(std::count_if(lines.begin(), lines.end(),
-                                        [&](const std::string& l) { return l.find(needle) != std::string::npos; }));
-}
+using test::count_containing;
+using test::data_path;
 
 /// 1-based number of the first line of `text` that contains `needle` (0 if none); a needle
 /// starting with '\n' names the line after that newline ("\n6\n": the line "6").
@@ -43,33 +40,9 @@ int line_of(const std::string& text, const std::string& needle) {
   return 1 + lead + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
 }
 
-/// A fresh directory per test, removed afterwards.
-class InpAssemblyFiles : public ::testing::Test {
+/// InpFiles (a fresh directory per test), with an error's line named by the text it holds.
+class InpAssemblyFiles : public test::InpFiles {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(::testing::TempDir()) / ("pneufem_inp_asm_" + std::string(info->name()) + "_" +
-                                             std::to_string(std::random_device{}()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-  /// The InputError message of reading `text` as bad.inp ("" if none was thrown).
-  std::string error_of(const std::string& text) const {
-    try {
-      read_inp(write("bad.inp", text), 1e-3);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  }
   /// The message must name bad.inp and the line holding `line_text`, and contain every hint.
   void expect_error(const std::string& text, const std::string& line_text, const std::vector<std::string>& hints) const {
     const int line = line_of(text, line_text);
@@ -79,7 +52,6 @@ class InpAssemblyFiles : public ::testing::Test {
     EXPECT_NE(msg.find("bad.inp:" + std::to_string(line) + ": "), std::string::npos) << msg;
     for (const std::string& h : hints) EXPECT_NE(msg.find(h), std::string::npos) << "missing '" << h << "' in: " << msg;
   }
-  fs::path dir_;
 };
 
 // -------------------------------------------------------------------------------------------
@@ -511,11 +483,6 @@ TEST_F(InpAssemblyFiles, MutilatedCaeDecksNeverCrash) {
   std::vector<std::string> lines;
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   ASSERT_GT(lines.size(), 50u);
-  auto join = [](const std::vector<std::string>& ls) {
-    std::string s;
-    for (const auto& l : ls) s += l + "\n";
-    return s;
-  };
   const std::vector<std::string> junk = {"", ",", "x", "*", "*End Part", "*End Instance", "*Instance, name=Z, part=Block",
                                          "*End Assembly", "Block-1.", ".1", "Block-1.99", "1e999", "0, 0, 0, 0, 0, 0, 90"};
   int accepted = 0, rejected = 0;
@@ -527,21 +494,7 @@ TEST_F(InpAssemblyFiles, MutilatedCaeDecksNeverCrash) {
       ++rejected;
     }
   };
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    std::vector<std::string> ls = lines;
-    ls.erase(ls.begin() + static_cast<std::ptrdiff_t>(i));
-    attempt(join(ls));
-    ls = lines;
-    ls[i] = ls[i].substr(0, ls[i].size() / 2);
-    attempt(join(ls));
-    for (const std::string& j : junk) {
-      ls = lines;
-      ls[i] += ", " + j;
-      attempt(join(ls));
-      ls[i] = j;
-      attempt(join(ls));
-    }
-  }
+  test::for_each_mutilation(lines, junk, attempt);
   EXPECT_GT(accepted, 0);
   EXPECT_GT(rejected, 0);
 }

@@ -207,11 +207,6 @@ TEST_F(InpFiles, GarbageNeverCrashes) {
   std::vector<std::string> lines;
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   ASSERT_GT(lines.size(), 20u);
-  auto join = [](const std::vector<std::string>& ls) {
-    std::string s;
-    for (const auto& l : ls) s += l + "\n";
-    return s;
-  };
   const std::vector<std::string> junk = {
       "", ",", ",,,,", "x", "*", "**", "-1", "99999999999999999999", "1e999", "*ELEMENT, TYPE=", "\xff\xfe", "S9", "P"};
   int accepted = 0, rejected = 0;
@@ -224,21 +219,7 @@ TEST_F(InpFiles, GarbageNeverCrashes) {
     }
   };
   std::mt19937 rng(42);
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    std::vector<std::string> ls = lines;
-    ls.erase(ls.begin() + static_cast<std::ptrdiff_t>(i));
-    attempt(join(ls));
-    ls = lines;
-    ls[i] = ls[i].substr(0, ls[i].size() / 2);
-    attempt(join(ls));
-    for (const std::string& j : junk) {
-      ls = lines;
-      ls[i] += ", " + j;
-      attempt(join(ls));
-      ls[i] = j;
-      attempt(join(ls));
-    }
-  }
+  for_each_mutilation(lines, junk, attempt);
   std::string bytes(4000, '\0');
   for (char& c : bytes) c = static_cast<char>(rng() & 0xff);
   attempt(bytes);
