@@ -197,9 +197,11 @@ namespace {
 /// Appends to `modes` (mass-orthonormal, unit RMS) up to `count` POD modes of `shapes` after their
 /// parts along `modes` are removed. With `normalise`, each shape is scaled to unit mass norm first,
 /// so that every shape counts alike; without, the shapes count by size. `left` is set to the relative
-/// energy of the projected shapes outside the kept modes.
+/// energy of the projected shapes outside the kept modes. With `metric` (symmetric, positive
+/// semi-definite), the shapes' correlation and `left` are measured in a^T metric b instead of the
+/// mass norm (which subspace is kept); the modes appended are still made mass-orthonormal.
 void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorXd& mass, int count, double tolerance,
-                std::vector<Eigen::VectorXd>& modes, double& left, bool normalise = true) {
+                std::vector<Eigen::VectorXd>& modes, double& left, bool normalise = true, const SparseMatrix* metric = nullptr) {
   const double m_tot = mass.sum();
   const std::size_t n = shapes.size();
   if (n == 0 || count <= 0) return;
@@ -209,10 +211,15 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
     for (const Eigen::VectorXd& m : modes) x[i] -= (mass_dot(mass, m, x[i]) / m_tot) * m;
   });
   Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  std::vector<Eigen::VectorXd> mx;  // metric * x[i]
+  if (metric) {
+    mx.resize(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { mx[i] = (*metric) * x[i]; });
+  }
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     for (std::size_t j = 0; j <= i; ++j)
       C(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = C(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) =
-          mass_dot(mass, x[i], x[j]) / m_tot;
+          metric ? x[i].dot(mx[j]) : mass_dot(mass, x[i], x[j]) / m_tot;
   });
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(C);
   const Eigen::VectorXd lam = eig.eigenvalues().reverse();
@@ -221,7 +228,7 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   // Shapes the earlier modes hold already leave only round-off of their energy: nothing to add.
   double before = 0.0;
   for (std::size_t i = 0; i < n; ++i)
-    before += normalise ? 1.0 : mass_dot(mass, shapes[i], shapes[i]) / m_tot;
+    before += metric ? shapes[i].dot((*metric) * shapes[i]) : normalise ? 1.0 : mass_dot(mass, shapes[i], shapes[i]) / m_tot;
   if (lam.sum() <= 1e-20 * before) return;
   int r = 0;
   left = total;
@@ -230,9 +237,11 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   for (int j = 0; j < r; ++j) {
     Eigen::VectorXd m = Eigen::VectorXd::Zero(mass.size() * 3);
     for (std::size_t i = 0; i < n; ++i) m += vec(static_cast<Eigen::Index>(i), j) * x[i];
-    for (const Eigen::VectorXd& prev : modes) m -= (mass_dot(mass, prev, m) / m_tot) * prev;  // round-off
+    const double size = std::sqrt(mass_dot(mass, m, m) / m_tot);
+    // Round-off in the mass norm; in another metric, the mass-orthogonalisation of the new subspace.
+    for (const Eigen::VectorXd& prev : modes) m -= (mass_dot(mass, prev, m) / m_tot) * prev;
     const double norm = std::sqrt(mass_dot(mass, m, m) / m_tot);
-    if (!(norm > 0.0)) break;
+    if (!(norm > 0.0) || (metric && !(norm > 1e-6 * size))) break;
     modes.push_back(m / norm);
   }
 }
@@ -405,23 +414,36 @@ void pressure_second_order(const Assembler& A, ReducedBasis& B) {
     }
 }
 
-}  // namespace
+/// The small-strain stiffness of the reference's mesh made of its softest material throughout
+/// (the stiff parts take the soft parts' material), at u = 0 without load: the metric of
+/// RomBasisOptions::snapshot_energy_norm. Homogeneous, so that the fabric's 10^5 times larger
+/// modulus does not make the metric measure the fabric's strain alone.
+SparseMatrix homogeneous_stiffness(const Model& reference, const std::vector<char>& stiff) {
+  Model hom = reference;
+  MaterialPtr soft;
+  for (std::size_t i = 0; i < hom.parts.size() && !soft; ++i)
+    if (!stiff[i]) soft = hom.parts[i].material;
+  if (!soft) throw InputError("reduced model: no soft part for the snapshots' energy norm");
+  for (std::size_t i = 0; i < hom.parts.size(); ++i)
+    if (stiff[i]) hom.parts[i].material = soft;
+  const Assembler A(hom);
+  return tangent(A, Eigen::VectorXd::Zero(A.num_dofs()), 0.0);
+}
 
-ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& opt,
-                                 const std::vector<Eigen::VectorXd>& snapshots) {
-  const auto t_start = Clock::now();
+void check_basis_options(const RomBasisOptions& opt) {
   if (opt.clusters < 1 || opt.mode_samples < 1 || opt.max_modes < 1 || !(opt.pod_tolerance > 0.0 && opt.pod_tolerance < 1.0) ||
       !(opt.ecsw_tolerance > 0.0 && opt.ecsw_tolerance < 1.0) || opt.training_fields < 0 ||
       !(opt.training_softening > 0.0 && opt.training_softening <= 1.0))
     throw InputError("reduced model: basis options out of range (clusters, mode_samples, max_modes >= 1; pod_tolerance and "
                      "ecsw_tolerance in (0, 1); training_softening in (0, 1])");
-  const Assembler A(reference);
-  if (A.state_size() != 0 || !reference.gravity_m_s2.isZero())
-    throw InputError("reduced model: the reference model must be elastic and without gravity");
+}
+
+/// The path's samples in B: pressures, displacements, their angles (unwrapped, strictly increasing)
+/// and the spline's slopes in theta.
+void set_path_samples(const Model& reference, const ElasticPathTrace& trace, ReducedBasis& B) {
   const int ndof = reference.num_dofs();
   const std::size_t ns = trace.u.size();
   if (ns < 3 || trace.p_Pa.size() != ns) throw InputError("reduced model: the elastic path trace needs at least three samples");
-  ReducedBasis B;
   B.p = trace.p_Pa;
   B.U.resize(ndof, static_cast<Eigen::Index>(ns));
   for (std::size_t k = 0; k < ns; ++k) {
@@ -435,50 +457,55 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     B.theta.push_back(th);
   }
   B.dU.resize(ndof, static_cast<Eigen::Index>(ns));
-  {
-    const std::vector<Eigen::VectorXd> m = spline_slopes<Eigen::VectorXd>(
-        B.theta, [&](std::size_t k) { return Eigen::VectorXd(B.U.col(static_cast<Eigen::Index>(k))); });
-    for (std::size_t k = 0; k < ns; ++k) B.dU.col(static_cast<Eigen::Index>(k)) = m[k];
-  }
-  B.stiff_part = stiff_parts(reference, opt.stiff_modulus_ratio);
-  B.mesh_fingerprint = mesh_fingerprint(reference.mesh);
-  const Eigen::VectorXd& mass = A.lumped_mass();
-  const double m_tot = mass.sum();
-  const ElementGeometry& geom = A.geometry();
+  const std::vector<Eigen::VectorXd> m = spline_slopes<Eigen::VectorXd>(
+      B.theta, [&](std::size_t k) { return Eigen::VectorXd(B.U.col(static_cast<Eigen::Index>(k))); });
+  for (std::size_t k = 0; k < ns; ++k) B.dU.col(static_cast<Eigen::Index>(k)) = m[k];
+}
 
-  // 1. Softening responses at the mode samples and their POD.
-  const std::vector<std::vector<int>> clusters = soft_clusters(reference, B.stiff_part, opt.clusters);
-  B.info.clusters = static_cast<int>(clusters.size());
-  for (const auto& c : clusters) B.info.soft_elements += static_cast<int>(c.size());
-  // Mode samples spread evenly along the path in pressure and in angle alike (the mean of the two
-  // normalised coordinates): the response shapes change with the load level (a wall's bulge at
-  // 5 kPa is not its bulge at 40 kPa, turned), and near a limit point the angle runs ahead of the
-  // pressure. Samples chosen by angle alone left the low levels without shapes of their own: a
-  // softening of the walls then moved the angle at 5 kPa 14 % too far on a 3-chamber actuator.
+/// The path samples at which the softening responses are computed: spread evenly along the path in
+/// pressure and in angle alike (the mean of the two normalised coordinates). The response shapes
+/// change with the load level (a wall's bulge at 5 kPa is not its bulge at 40 kPa, turned), and near
+/// a limit point the angle runs ahead of the pressure. Samples chosen by angle alone left the low
+/// levels without shapes of their own: a softening of the walls then moved the angle at 5 kPa 14 %
+/// too far on a 3-chamber actuator.
+std::vector<int> pick_mode_samples(const ReducedBasis& B, int count) {
+  const std::size_t ns = B.theta.size();
+  std::vector<double> s(ns);
+  for (std::size_t k = 0; k < ns; ++k) s[k] = 0.5 * (B.p[k] / B.p.back() + B.theta[k] / B.theta.back());
   std::vector<int> mode_k;
-  {
-    std::vector<double> s(ns);
-    for (std::size_t k = 0; k < ns; ++k) s[k] = 0.5 * (B.p[k] / B.p.back() + B.theta[k] / B.theta.back());
-    for (int j = 1; j <= opt.mode_samples; ++j) {
-      const double target = (j - 0.25) / opt.mode_samples;
-      std::size_t best = 1;
-      for (std::size_t k = 1; k < ns; ++k)
-        if (std::abs(s[k] - target) < std::abs(s[best] - target)) best = k;
-      if (std::find(mode_k.begin(), mode_k.end(), static_cast<int>(best)) == mode_k.end()) mode_k.push_back(static_cast<int>(best));
-    }
+  for (int j = 1; j <= count; ++j) {
+    const double target = (j - 0.25) / count;
+    std::size_t best = 1;
+    for (std::size_t k = 1; k < ns; ++k)
+      if (std::abs(s[k] - target) < std::abs(s[best] - target)) best = k;
+    if (std::find(mode_k.begin(), mode_k.end(), static_cast<int>(best)) == mode_k.end()) mode_k.push_back(static_cast<int>(best));
   }
-  std::vector<Eigen::VectorXd> softened;
-  if (opt.softened_levels > 0) softened = softened_states(reference, trace, mode_k, opt.softened_levels, opt.softened_max, opt.verbose,
-                                                           opt.stiff_modulus_ratio);
-  std::vector<Eigen::VectorXd> responses;
-  std::vector<int> response_sample, response_cluster;
+  return mode_k;
+}
+
+/// Shapes the modes are compressed from: the softening responses and the snapshots' departures
+/// from the path, each with the path sample it belongs to (-1: a snapshot's departure).
+struct CandidateShapes {
+  std::vector<Eigen::VectorXd> shape;
+  std::vector<int> sample;
+};
+
+/// The linear responses of the path at each mode sample k to softening one cluster of soft
+/// elements, du_c = K_T(theta_k)^-1 f_iso,c(theta_k) (see the header), without their part along the
+/// path tangent (theta's). A sample whose tangent cannot be factorised is skipped.
+void add_softening_responses(const Assembler& A, const Model& reference, const ReducedBasis& B,
+                             const std::vector<std::vector<int>>& clusters, const std::vector<int>& mode_k, bool verbose,
+                             CandidateShapes& out) {
+  const int ndof = reference.num_dofs();
+  const Eigen::VectorXd& mass = A.lumped_mass();
+  const ElementGeometry& geom = A.geometry();
   for (int k : mode_k) {
     const Eigen::VectorXd uk = B.U.col(k);
     SparseMatrix K = tangent(A, uk, B.p[k]);
     A.apply_constraints(K, 1.0);
     LinearSolver solver;
     if (!solver.factorize(K)) {
-      if (opt.verbose) std::fprintf(stderr, "reduced basis: tangent at %.3g kPa not positive definite, sample skipped\n", B.p[k] * 1e-3);
+      if (verbose) std::fprintf(stderr, "reduced basis: tangent at %.3g kPa not positive definite, sample skipped\n", B.p[k] * 1e-3);
       continue;
     }
     const Eigen::VectorXd t = B.dU.col(k);
@@ -490,27 +517,28 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
       Eigen::VectorXd fe;
       for (int e : clusters[c]) element_force(reference, geom, e, uk, fe, fel[static_cast<std::size_t>(e)]);
     });
-    auto add = [&](Eigen::VectorXd& f, int e, double s) {
-      const int* n = reference.mesh.element(e);
-      for (int a = 0; a < geom.npe; ++a) f.segment<3>(3 * n[a]) += s * fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
-    };
-    std::vector<Eigen::VectorXd> f(nc, Eigen::VectorXd::Zero(ndof));
-    for (std::size_t c = 0; c < nc; ++c)
-      for (int e : clusters[c]) add(f[c], e, 1.0);
-    for (std::size_t c = 0; c < f.size(); ++c) {
-      A.zero_fixed(f[c]);
-      Eigen::VectorXd du = solver.solve(f[c]);
+    for (std::size_t c = 0; c < nc; ++c) {
+      Eigen::VectorXd f = Eigen::VectorXd::Zero(ndof);
+      for (int e : clusters[c]) {
+        const int* n = reference.mesh.element(e);
+        for (int a = 0; a < geom.npe; ++a) f.segment<3>(3 * n[a]) += fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
+      }
+      A.zero_fixed(f);
+      Eigen::VectorXd du = solver.solve(f);
       A.zero_fixed(du);
       du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
-      responses.push_back(std::move(du));
-      response_sample.push_back(k);
-      response_cluster.push_back(static_cast<int>(c % nc));
+      out.shape.push_back(std::move(du));
+      out.sample.push_back(k);
     }
   }
-  // Snapshots: their departure from the path point of equal angle (bisection on the path's angle).
-  std::vector<Eigen::VectorXd> all_snapshots = snapshots;
-  all_snapshots.insert(all_snapshots.end(), softened.begin(), softened.end());
-  for (const Eigen::VectorXd& u : all_snapshots) {
+}
+
+/// Each state's departure from the path point of equal angle (bisection on the path's angle),
+/// without its part along the path tangent there.
+void add_departures(const Model& reference, const ReducedBasis& B, const Eigen::VectorXd& mass,
+                    const std::vector<Eigen::VectorXd>& states, CandidateShapes& out) {
+  const int ndof = reference.num_dofs();
+  for (const Eigen::VectorXd& u : states) {
     if (u.size() != ndof) throw InputError("reduced model: a snapshot has " + std::to_string(u.size()) + " dof, the model " + std::to_string(ndof));
     const double target = bending_angle(reference, u).angle_deg;
     double lo = B.theta.front(), hi = B.theta.back();
@@ -530,38 +558,44 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     Eigen::VectorXd du = u - path_at(0.5 * (lo + hi), &t);
     du -= (mass_dot(mass, t, du) / mass_dot(mass, t, t)) * t;
     if (mass_dot(mass, du, du) <= 0.0) continue;
-    responses.push_back(std::move(du));
-    response_sample.push_back(-1);
-    response_cluster.push_back(-1);
+    out.shape.push_back(std::move(du));
+    out.sample.push_back(-1);
   }
-  if (responses.empty())
-    throw PhysicsError("reduced model: no tangent along the elastic path could be factorised (the path may start at a limit "
-                       "point); check the model with pneufem simulate");
-  B.info.responses = static_cast<int>(responses.size());
-  // Snapshots first, then the softening responses in what the snapshots leave out. A damaged FEM
-  // state holds the local feedback of damage on stretch (a damaged point stretches more, which
-  // damages it faster) that no cluster-level softening shape resolves; pooled with the ~300
-  // responses at equal weight, its ~20 shapes lost the POD and the fatigue drift of a 3-chamber
-  // actuator stayed 8 % short after three trials; taken first, 1 % (docs/theory.md).
+}
+
+/// The modes: snapshots first, then the softening responses in what the snapshots leave out. A
+/// damaged FEM state holds the local feedback of damage on stretch (a damaged point stretches more,
+/// which damages it faster) that no cluster-level softening shape resolves; pooled with the ~300
+/// responses at equal weight, its ~20 shapes lost the POD and the fatigue drift of a 3-chamber
+/// actuator stayed 8 % short after three trials; taken first, 1 % (docs/theory.md). Sets B.Phi and
+/// B.info.pod_energy_left.
+void set_modes(const CandidateShapes& shapes, const Eigen::VectorXd& mass, const RomBasisOptions& opt, const SparseMatrix* metric,
+               ReducedBasis& B) {
   std::vector<Eigen::VectorXd> snapshot_shapes, response_shapes;
-  for (std::size_t i = 0; i < responses.size(); ++i)
-    (response_sample[i] < 0 ? snapshot_shapes : response_shapes).push_back(responses[i]);
+  for (std::size_t i = 0; i < shapes.shape.size(); ++i)
+    (shapes.sample[i] < 0 ? snapshot_shapes : response_shapes).push_back(shapes.shape[i]);
   std::vector<Eigen::VectorXd> modes;
   double left = 0.0;
   if (!snapshot_shapes.empty())
-    pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false);
+    pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false, metric);
   pod_append(response_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left);
   if (opt.tangent_free_modes) project_out_path_tangents(B.dU, mass, modes);
   const int r = static_cast<int>(modes.size());
   B.info.pod_energy_left = left;
-  B.Phi = Eigen::MatrixXd::Zero(ndof, r);
+  B.Phi = Eigen::MatrixXd::Zero(B.dofs(), r);
   for (int j = 0; j < r; ++j) B.Phi.col(j) = modes[static_cast<std::size_t>(j)];
-  if (opt.verbose)
-    std::fprintf(stderr, "reduced basis: %d clusters, %zu responses at %zu samples, %zu snapshots, %d modes (energy left %.2e), %.1f s\n",
-                 B.info.clusters, response_shapes.size(), mode_k.size(), snapshot_shapes.size(), r, B.info.pod_energy_left,
-                 seconds_since(t_start));
+}
 
-  // 2. Reference operators per path sample (from the assembled FEM tangent).
+/// The reference operators per path sample, from the assembled FEM tangent (the header's E and the
+/// theta row's test vector w), the gauge, and the follower load's second order. Returns the share of
+/// the path tangent's mass norm squared that the modes hold, lowest and highest over the samples.
+std::pair<double, double> set_reference_operators(const Assembler& A, const Model& reference, const RomBasisOptions& opt,
+                                                  ReducedBasis& B) {
+  const Eigen::Index ndof = B.dofs();
+  const std::size_t ns = B.theta.size();
+  const int r = B.num_modes();
+  const Eigen::VectorXd& mass = A.lumped_mass();
+  const double m_tot = mass.sum();
   Eigen::VectorXd unit_load;  // consistent gravity load per unit acceleration (same along x, y, z)
   {
     Model g1 = reference;
@@ -638,61 +672,126 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     tangent_share_lo = std::min(tangent_share_lo, tangent_share);
     tangent_share_hi = std::max(tangent_share_hi, tangent_share);
   }
-  if (opt.verbose)
-    std::fprintf(stderr, "reduced basis: the modes hold %.3g-%.3g of the path tangent's mass norm squared\n", tangent_share_lo,
-                 tangent_share_hi);
   if (opt.tangent_free_modes) B.gauge.setZero();  // what is left is the tangents' POD remainder: no gauge
   pressure_second_order(A, B);
-  if (opt.verbose) std::fprintf(stderr, "reduced basis: operators at %zu samples, %.1f s\n", ns, seconds_since(t_start));
+  return {tangent_share_lo, tangent_share_hi};
+}
 
-  // 3. ECSW: per cluster, non-negative element weights reproducing the cluster's reduced force on
-  // training states (path samples, and path samples plus the response to a random softening field).
-  struct TrainingState {
-    Eigen::VectorXd u, t;  // displacement, the theta row's test vector
-    double t_scale;        // its RMS size: the theta row in force per metre, as the modes' rows
-  };
+/// A state the ECSW weights are trained on.
+struct TrainingState {
+  Eigen::VectorXd u, t;  // displacement, the theta row's test vector
+  double t_scale;        // its RMS size: the theta row in force per metre, as the modes' rows
+};
+
+/// The ECSW training states: path samples (the top one and every stride-th below it), path samples
+/// plus the response to a random cluster-wise softening field, and the snapshots themselves.
+std::vector<TrainingState> ecsw_training_states(const ReducedBasis& B, const Eigen::VectorXd& mass, const Model& reference,
+                                                const CandidateShapes& shapes, const std::vector<int>& mode_k,
+                                                const std::vector<Eigen::VectorXd>& snapshots, const RomBasisOptions& opt) {
+  const std::size_t ns = B.theta.size();
+  const double m_tot = mass.sum();
   std::vector<TrainingState> train;
-  {
-    const std::size_t stride = std::max<std::size_t>(1, (ns + 15) / 16);
-    for (std::size_t k = ns - 1;; k -= stride) {  // the top sample and every stride-th below it
-      train.push_back({B.U.col(static_cast<Eigen::Index>(k)), B.W.col(static_cast<Eigen::Index>(k)), 0.0});
-      if (k <= stride) break;
+  const std::size_t stride = std::max<std::size_t>(1, (ns + 15) / 16);
+  for (std::size_t k = ns - 1;; k -= stride) {  // the top sample and every stride-th below it
+    train.push_back({B.U.col(static_cast<Eigen::Index>(k)), B.W.col(static_cast<Eigen::Index>(k)), 0.0});
+    if (k <= stride) break;
+  }
+  std::mt19937_64 rng(20261126);
+  std::uniform_real_distribution<double> unif(0.0, opt.training_softening);
+  // A field's linear response is capped at training_amplitude of the path's largest RMS
+  // displacement: near the limit point the linear response to a 30 % softening would invert
+  // elements, a state no run visits.
+  const Eigen::VectorXd u_top = B.U.col(static_cast<Eigen::Index>(ns - 1));
+  const double cap = opt.training_amplitude * std::sqrt(mass_dot(mass, u_top, u_top) / m_tot);
+  Eigen::MatrixXd MPhi = B.Phi;
+  for (Eigen::Index i = 0; i < B.dofs(); ++i) MPhi.row(i) *= mass[i / 3];
+  for (int k : mode_k) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < shapes.shape.size(); ++i)
+      if (shapes.sample[i] == k) idx.push_back(i);
+    if (idx.empty()) continue;
+    for (int f = 0; f < opt.training_fields; ++f) {
+      Eigen::VectorXd du = Eigen::VectorXd::Zero(B.dofs());
+      for (std::size_t i : idx) du += unif(rng) * shapes.shape[i];
+      Eigen::VectorXd q = MPhi.transpose() * du / m_tot;
+      if (q.norm() > cap) q *= cap / q.norm();
+      train.push_back({B.U.col(k) + B.Phi * q, B.W.col(k), 0.0});
     }
-    std::mt19937_64 rng(20261126);
-    std::uniform_real_distribution<double> unif(0.0, opt.training_softening);
-    // A field's linear response is capped at training_amplitude of the path's largest RMS
-    // displacement: near the limit point the linear response to a 30 % softening would invert
-    // elements, a state no run visits.
-    const Eigen::VectorXd u_top = B.U.col(static_cast<Eigen::Index>(ns - 1));
-    const double cap = opt.training_amplitude * std::sqrt(mass_dot(mass, u_top, u_top) / m_tot);
-    for (int k : mode_k) {
-      std::vector<std::size_t> idx;
-      for (std::size_t i = 0; i < responses.size(); ++i)
-        if (response_sample[i] == k) idx.push_back(i);
-      if (idx.empty()) continue;
-      for (int f = 0; f < opt.training_fields; ++f) {
-        Eigen::VectorXd du = Eigen::VectorXd::Zero(ndof);
-        for (std::size_t i : idx) du += unif(rng) * responses[i];
-        Eigen::VectorXd q = MPhi.transpose() * du / m_tot;
-        if (q.norm() > cap) q *= cap / q.norm();
-        train.push_back({B.U.col(k) + B.Phi * q, B.W.col(k), 0.0});
+  }
+  // The snapshots themselves: the states a run with history visits, with the theta row's test
+  // vector of the path sample nearest in angle. As among the path samples above, the unloaded
+  // sample 0 gives no training state.
+  for (const Eigen::VectorXd& u : snapshots) {
+    const double th = bending_angle(reference, u).angle_deg;
+    int k = path_segment_index(B.theta, th);
+    if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+    if (k > 0) train.push_back({u, B.W.col(k), 0.0});
+  }
+  for (TrainingState& s : train) s.t_scale = std::sqrt(mass_dot(mass, s.t, s.t) / m_tot) + 1e-300;
+  return train;
+}
+
+/// ECSW in one cluster: non-negative element weights that reproduce the cluster's reduced force
+/// (theta row and every mode, of the whole and of the isochoric force) on the training states
+/// within the tolerance. Returns the picked (element, weight) pairs and the relative residual.
+std::vector<std::pair<int, double>> ecsw_cluster_weights(const Model& reference, const ElementGeometry& geom, const ReducedBasis& B,
+                                                         const std::vector<int>& el, const std::vector<TrainingState>& train,
+                                                         double tolerance, double& residual) {
+  const int r = B.num_modes(), n1 = r + 1;
+  const std::size_t nt = train.size();
+  const Eigen::Index rows = static_cast<Eigen::Index>(nt * 2 * n1);
+  Eigen::MatrixXd G(rows, static_cast<Eigen::Index>(el.size()));
+  Eigen::VectorXd fe, fi;
+  for (std::size_t j = 0; j < el.size(); ++j) {
+    const int e = el[j];
+    const int* n = reference.mesh.element(e);
+    for (std::size_t s = 0; s < nt; ++s) {
+      element_force(reference, geom, e, train[s].u, fe, fi);
+      for (int blk = 0; blk < 2; ++blk) {
+        const Eigen::VectorXd& f = blk == 0 ? fe : fi;
+        const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1);
+        double gth = 0.0;
+        Eigen::VectorXd gq = Eigen::VectorXd::Zero(r);
+        for (int a = 0; a < geom.npe; ++a) {
+          gth += train[s].t.segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
+          for (int m = 0; m < r; ++m) gq[m] += B.Phi.col(m).segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
+        }
+        G(row, static_cast<Eigen::Index>(j)) = gth / train[s].t_scale;
+        G.block(row + 1, static_cast<Eigen::Index>(j), r, 1) = gq;
       }
     }
-    // The snapshots themselves: the states a run with history visits, with the theta row's test
-    // vector of the path sample nearest in angle. As among the path samples above, the unloaded
-    // sample 0 gives no training state.
-    for (const Eigen::VectorXd& u : all_snapshots) {
-      const double th = bending_angle(reference, u).angle_deg;
-      int k = path_segment_index(B.theta, th);
-      if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
-      if (k > 0) train.push_back({u, B.W.col(k), 0.0});
-    }
-    for (TrainingState& s : train) s.t_scale = std::sqrt(mass_dot(mass, s.t, s.t) / m_tot) + 1e-300;
   }
-  responses.clear();
-  responses.shrink_to_fit();
-  const int n1 = r + 1;
-  const std::size_t nt = train.size();
+  // A training state that inverts an element of this cluster says nothing about it: dropped.
+  for (Eigen::Index row = 0; row < rows; ++row)
+    if (!G.row(row).allFinite()) G.row(row).setZero();
+  Eigen::VectorXd target = G.rowwise().sum();
+  // Every generalised coordinate (theta and each mode, of the whole and of the isochoric force)
+  // counts alike, relative to its own size over the training states: the theta row, which sets
+  // the angle, is then fitted as well as any mode's, not drowned by the sixteen of them.
+  for (int comp = 0; comp < 2 * n1; ++comp) {
+    const int blk = comp / n1, i = comp % n1;
+    double ss = 0.0;
+    for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>((s * 2 + blk) * n1 + i)], 2);
+    const double scale = std::sqrt(ss / static_cast<double>(nt));
+    if (!(scale > 0.0)) continue;
+    for (std::size_t s = 0; s < nt; ++s) {
+      const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1 + i);
+      G.row(row) /= scale;
+      target[row] /= scale;
+    }
+  }
+  const NnlsResult res = nnls(G, target, tolerance);
+  residual = res.residual / std::max(target.norm(), 1e-300);
+  std::vector<std::pair<int, double>> picked;
+  for (std::size_t j = 0; j < el.size(); ++j)
+    if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked.push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
+  return picked;
+}
+
+/// The sampled elements and their weights (B.elements, B.weights, sorted by element): ECSW per
+/// cluster, or every soft element at weight 1 without hyper-reduction.
+void set_sampled_elements(const Model& reference, const ElementGeometry& geom, const std::vector<std::vector<int>>& clusters,
+                          const std::vector<TrainingState>& train, const RomBasisOptions& opt, ReducedBasis& B) {
   std::vector<std::vector<std::pair<int, double>>> picked(clusters.size());
   std::vector<double> cluster_residual(clusters.size(), 0.0);
   if (!opt.hyper_reduce) {
@@ -700,52 +799,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
       for (int e : clusters[c]) picked[c].push_back({e, 1.0});
   } else {
     tbb::parallel_for(std::size_t(0), clusters.size(), [&](std::size_t c) {
-      const std::vector<int>& el = clusters[c];
-      const Eigen::Index rows = static_cast<Eigen::Index>(nt * 2 * n1);
-      Eigen::MatrixXd G(rows, static_cast<Eigen::Index>(el.size()));
-      Eigen::VectorXd fe, fi;
-      for (std::size_t j = 0; j < el.size(); ++j) {
-        const int e = el[j];
-        const int* n = reference.mesh.element(e);
-        for (std::size_t s = 0; s < nt; ++s) {
-          element_force(reference, geom, e, train[s].u, fe, fi);
-          for (int blk = 0; blk < 2; ++blk) {
-            const Eigen::VectorXd& f = blk == 0 ? fe : fi;
-            const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1);
-            double gth = 0.0;
-            Eigen::VectorXd gq = Eigen::VectorXd::Zero(r);
-            for (int a = 0; a < geom.npe; ++a) {
-              gth += train[s].t.segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
-              for (int m = 0; m < r; ++m) gq[m] += B.Phi.col(m).segment<3>(3 * n[a]).dot(f.segment<3>(3 * a));
-            }
-            G(row, static_cast<Eigen::Index>(j)) = gth / train[s].t_scale;
-            G.block(row + 1, static_cast<Eigen::Index>(j), r, 1) = gq;
-          }
-        }
-      }
-      // A training state that inverts an element of this cluster says nothing about it: dropped.
-      for (Eigen::Index row = 0; row < rows; ++row)
-        if (!G.row(row).allFinite()) G.row(row).setZero();
-      Eigen::VectorXd target = G.rowwise().sum();
-      // Every generalised coordinate (theta and each mode, of the whole and of the isochoric force)
-      // counts alike, relative to its own size over the training states: the theta row, which sets
-      // the angle, is then fitted as well as any mode's, not drowned by the sixteen of them.
-      for (int comp = 0; comp < 2 * n1; ++comp) {
-        const int blk = comp / n1, i = comp % n1;
-        double ss = 0.0;
-        for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>((s * 2 + blk) * n1 + i)], 2);
-        const double scale = std::sqrt(ss / static_cast<double>(nt));
-        if (!(scale > 0.0)) continue;
-        for (std::size_t s = 0; s < nt; ++s) {
-          const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1 + i);
-          G.row(row) /= scale;
-          target[row] /= scale;
-        }
-      }
-      const NnlsResult res = nnls(G, target, opt.ecsw_tolerance);
-      cluster_residual[c] = res.residual / std::max(target.norm(), 1e-300);
-      for (std::size_t j = 0; j < el.size(); ++j)
-        if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked[c].push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
+      picked[c] = ecsw_cluster_weights(reference, geom, B, clusters[c], train, opt.ecsw_tolerance, cluster_residual[c]);
     });
   }
   std::vector<std::pair<int, double>> all;
@@ -758,32 +812,95 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     B.elements.push_back(e);
     B.weights.push_back(w);
   }
+}
+
+/// The reference's hyper-reduced force at q = 0 on the fine grid (B.Gref), and its Jacobian per
+/// sample (B.Kref).
+void set_reference_force(const Model& reference, ReducedBasis& B) {
+  const std::size_t ns = B.theta.size();
+  const rom_detail::KeptPoints pts(reference, B);
+  const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(B.num_modes());
+  const int nsub = ReducedBasis::kRefSub;
+  B.Gref.resize(B.num_modes() + 1, static_cast<Eigen::Index>((ns - 1) * (nsub + 1)));
+  Eigen::VectorXd g;
+  for (std::size_t k = 0; k + 1 < ns; ++k)
+    for (int j = 0; j <= nsub; ++j) {
+      const double th = B.theta[k] + (B.theta[k + 1] - B.theta[k]) * j / nsub;
+      // At j = nsub, theta_{k+1} itself would select segment k + 1: evaluate on segment k's end.
+      const double th_eval = j == nsub ? std::nextafter(B.theta[k + 1], B.theta[k]) : th;
+      pts.force(th_eval, q0, TimeStep{}, {}, {}, g, nullptr);
+      B.Gref.col(static_cast<Eigen::Index>(k * (nsub + 1) + j)) = g;
+    }
+  B.Kref.resize(ns);
+  for (std::size_t k = 0; k < ns; ++k) {
+    Eigen::MatrixXd J;
+    pts.force(B.theta[k], q0, TimeStep{}, {}, {}, g, &J);
+    B.Kref[k] = J;
+  }
+}
+
+}  // namespace
+
+ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace& trace, const RomBasisOptions& opt,
+                                 const std::vector<Eigen::VectorXd>& snapshots) {
+  const auto t_start = Clock::now();
+  check_basis_options(opt);
+  const Assembler A(reference);
+  if (A.state_size() != 0 || !reference.gravity_m_s2.isZero())
+    throw InputError("reduced model: the reference model must be elastic and without gravity");
+  ReducedBasis B;
+  set_path_samples(reference, trace, B);
+  B.stiff_part = stiff_parts(reference, opt.stiff_modulus_ratio);
+  B.mesh_fingerprint = mesh_fingerprint(reference.mesh);
+  const Eigen::VectorXd& mass = A.lumped_mass();
+
+  // 1. Correction modes: softening responses at the mode samples, the snapshots' and softened
+  // equilibria's departures from the path, and their POD.
+  const std::vector<std::vector<int>> clusters = soft_clusters(reference, B.stiff_part, opt.clusters);
+  B.info.clusters = static_cast<int>(clusters.size());
+  for (const auto& c : clusters) B.info.soft_elements += static_cast<int>(c.size());
+  const std::vector<int> mode_k = pick_mode_samples(B, opt.mode_samples);
+  std::vector<Eigen::VectorXd> all_snapshots = snapshots;
+  if (opt.softened_levels > 0) {
+    const std::vector<Eigen::VectorXd> softened = softened_states(reference, trace, mode_k, opt.softened_levels, opt.softened_max,
+                                                                  opt.verbose, opt.stiff_modulus_ratio);
+    all_snapshots.insert(all_snapshots.end(), softened.begin(), softened.end());
+  }
+  CandidateShapes shapes;
+  add_softening_responses(A, reference, B, clusters, mode_k, opt.verbose, shapes);
+  add_departures(reference, B, mass, all_snapshots, shapes);
+  if (shapes.shape.empty())
+    throw PhysicsError("reduced model: no tangent along the elastic path could be factorised (the path may start at a limit "
+                       "point); check the model with pneufem simulate");
+  B.info.responses = static_cast<int>(shapes.shape.size());
+  SparseMatrix energy;
+  if (opt.snapshot_energy_norm) energy = homogeneous_stiffness(reference, B.stiff_part);
+  set_modes(shapes, mass, opt, opt.snapshot_energy_norm ? &energy : nullptr, B);
+  if (opt.verbose) {
+    const auto n_snap = static_cast<std::size_t>(std::count(shapes.sample.begin(), shapes.sample.end(), -1));
+    std::fprintf(stderr, "reduced basis: %d clusters, %zu responses at %zu samples, %zu snapshots, %d modes (energy left %.2e), %.1f s\n",
+                 B.info.clusters, shapes.shape.size() - n_snap, mode_k.size(), n_snap, B.num_modes(), B.info.pod_energy_left,
+                 seconds_since(t_start));
+  }
+
+  // 2. Reference operators per path sample (from the assembled FEM tangent).
+  const auto [share_lo, share_hi] = set_reference_operators(A, reference, opt, B);
+  if (opt.verbose) {
+    std::fprintf(stderr, "reduced basis: the modes hold %.3g-%.3g of the path tangent's mass norm squared\n", share_lo, share_hi);
+    std::fprintf(stderr, "reduced basis: operators at %zu samples, %.1f s\n", B.theta.size(), seconds_since(t_start));
+  }
+
+  // 3. ECSW: per cluster, non-negative element weights reproducing the cluster's reduced force on
+  // training states (path samples, and path samples plus the response to a random softening field).
+  const std::vector<TrainingState> train = ecsw_training_states(B, mass, reference, shapes, mode_k, all_snapshots, opt);
+  shapes = CandidateShapes{};
+  set_sampled_elements(reference, A.geometry(), clusters, train, opt, B);
   if (opt.verbose)
     std::fprintf(stderr, "reduced basis: ECSW kept %zu of %d soft elements (%zu training states, worst cluster residual %.2e), %.1f s\n",
-                 B.elements.size(), B.info.soft_elements, nt, B.info.ecsw_worst_residual, seconds_since(t_start));
+                 B.elements.size(), B.info.soft_elements, train.size(), B.info.ecsw_worst_residual, seconds_since(t_start));
 
   // 4. The reference's hyper-reduced force at q = 0 on the fine grid, and its Jacobian per sample.
-  {
-    const rom_detail::KeptPoints pts(reference, B);
-    const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(r);
-    const int nsub = ReducedBasis::kRefSub;
-    B.Gref.resize(n1, static_cast<Eigen::Index>((ns - 1) * (nsub + 1)));
-    Eigen::VectorXd g;
-    for (std::size_t k = 0; k + 1 < ns; ++k)
-      for (int j = 0; j <= nsub; ++j) {
-        const double th = B.theta[k] + (B.theta[k + 1] - B.theta[k]) * j / nsub;
-        // At j = nsub, theta_{k+1} itself would select segment k + 1: evaluate on segment k's end.
-        const double th_eval = j == nsub ? std::nextafter(B.theta[k + 1], B.theta[k]) : th;
-        pts.force(th_eval, q0, TimeStep{}, {}, {}, g, nullptr);
-        B.Gref.col(static_cast<Eigen::Index>(k * (nsub + 1) + j)) = g;
-      }
-    B.Kref.resize(ns);
-    for (std::size_t k = 0; k < ns; ++k) {
-      Eigen::MatrixXd J;
-      pts.force(B.theta[k], q0, TimeStep{}, {}, {}, g, &J);
-      B.Kref[k] = J;
-    }
-  }
+  set_reference_force(reference, B);
   B.info.build_s = seconds_since(t_start);
   if (opt.verbose) std::fprintf(stderr, "reduced basis: done in %.1f s\n", B.info.build_s);
   return B;
