@@ -220,14 +220,18 @@ TEST(StlScene, UniformGridBendsCloseToTheBuiltInMesh) {
   const std::string file = pneunet_stl(p, "two_chambers_uniform.stl");
   std::vector<std::string> common = kLoad;
   common.insert(common.end(), {"geometry.chambers=2", "mesh.h_mm=1.5", "load.max_kPa=5.0"});
-  const std::vector<double> built_in = staircase_angles(Scene::load("", common));
+  const auto built_in = staircase_angles_both(Scene::load("", common));
   common.push_back("mesh.feature_planes=false");
-  const std::vector<double> cut = staircase_angles(Scene::load("", stl_sets(file, common)));
+  const auto cut = staircase_angles_both(Scene::load("", stl_sets(file, common)));
   ASSERT_EQ(built_in.size(), 1u);
   ASSERT_EQ(cut.size(), 1u);
-  std::printf("5 kPa: built-in %.4f deg, uniform grid %.4f deg (%+.2f %%)\n", built_in[0], cut[0],
-              100.0 * (cut[0] / built_in[0] - 1.0));
-  EXPECT_NEAR(cut[0], built_in[0], 0.20 * std::abs(built_in[0]));
+  std::printf("5 kPa: built-in %.6f deg, uniform grid %.6f deg (%+.2f %%); by area %.6f, %.6f (%+.2f %%)\n",
+              built_in[0].first, cut[0].first, 100.0 * (cut[0].first / built_in[0].first - 1.0), built_in[0].second,
+              cut[0].second, 100.0 * (cut[0].second / built_in[0].second - 1.0));
+  EXPECT_NEAR(cut[0].first, built_in[0].first, 0.20 * std::abs(built_in[0].first));
+  // By the area-weighted tip plane, the measure that does not depend on where a mesh puts its tip
+  // nodes, the general path is held to the 2 % (measured -0.28 %, 2026-11-28).
+  EXPECT_NEAR(cut[0].second, built_in[0].second, 0.02 * std::abs(built_in[0].second));
 }
 
 TEST(StlScene, CurvedTubeActuatorRunsEndToEnd) {
