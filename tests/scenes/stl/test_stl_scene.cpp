@@ -140,8 +140,8 @@ TEST(StlScene, DefaultActuatorFromStlBendsAsCalculixOnGmshsMesh) {
   // pneufem at the default h = 2 mm (feature planes: the built-in mesh), against CalculiX 2.20 on
   // gmsh's mesh of the same actuator at h = 2 (bench/calculix/results/default_h2_half_full.csv:
   // 34 934 nodes, 21 055 C3D10; the h = 6 deck of tests/data/ccx_gmsh is too coarse for a 2 %
-  // comparison of two different meshes: there the gmsh and pneufem meshes are 8-18 % apart at
-  // 5 kPa, bench/notes/2026-11-29-stl3.md). 5 and 10 kPa (the test's budget; 20 kPa measured).
+  // comparison of two different meshes: at h = 6 and 4 gmsh's and pneufem's meshes are 18 and 8 %
+  // apart at 5 kPa, both far from converged; bench/notes/2026-11-29-stl3.md). 5 and 10 kPa (the test's budget; 20 kPa measured).
   PneuNetParams p;
   const std::string file = pneunet_stl(p, "default_actuator_h2.stl");
   std::vector<std::string> sets = kLoad;
