@@ -250,6 +250,19 @@ TEST(StlMesher, BadInputsAreClearErrors) {
   }
   spec.fixed_face = "w+";
   EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("mesh.fixed_face must be"), std::string::npos);
+  // A tip that is no flat face normal to the length: the free end sloped (y grows with z; still
+  // planar, but only its top edge reaches the farthest y), so no face of the mesh lies on the tip plane.
+  {
+    TriSurface sloped = test::pneunet_surface(p);
+    const double L = p.length();
+    for (auto& v : sloped.V)
+      if (std::abs(v.y() - L) < 1e-12) v.y() += 0.25 * v.z();
+    const std::string tip = error_of([&] { mesh_closed_surface(closed(sloped), default_spec(p)); });
+    EXPECT_NE(tip.find("mesh.fixed_face = \"y-\": the tip (the end opposite the fixed face) is not a flat face"),
+              std::string::npos)
+        << tip;
+    EXPECT_NE(tip.find("y = 26.5 mm"), std::string::npos) << tip;  // L = 22 mm + 0.25 * 18 mm
+  }
 }
 
 }  // namespace
