@@ -394,7 +394,10 @@ void end_and_symmetry_sets(Mesh& m, const StuffedTets& st, const StlMeshSpec& sp
                            const FacePlane& tip_plane, const std::vector<FaceRef>& boundary) {
   Eigen::Vector3d lo = m.X.front(), hi = m.X.front();
   for (const auto& p : m.X) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const double tol = 1e-9 * (hi - lo).norm();
+  // 1e-6 of the part's size: an STL stores float coordinates (7 digits), so a flat end face that is
+  // not normal to an axis (an actuator turned in CAD) lies on its plane only to ~1e-7 of the
+  // coordinates; faces on grid planes are exact, and no other face of the part comes this close.
+  const double tol = 1e-6 * (hi - lo).norm();
   m.node_sets["FIXED"] = nodes_on_plane(m, boundary, fixed_plane, tol);
   if (m.node_sets["FIXED"].empty())
     throw InputError("mesh.fixed_face = \"" + spec.fixed_face + "\": fixed face not found: no face of the mesh lies on " +
