@@ -115,13 +115,23 @@ def gmsh_mesh(stl, h_mm):
     return np.array([[pos[int(n)] for n in t] for t in conn])  # mm, as the STL
 
 
+PERCENT = False
+
+
+def bins(h):
+    """Counts, or with --percent each bin's share of the elements (%), so meshes of different sizes compare."""
+    if not PERCENT:
+        return " ".join(str(c) for c in h)
+    return " ".join(f"{100.0 * c / max(h.sum(), 1):.1f}" for c in h)
+
+
 def summary(name, P):
     dih, rr = min_dihedral_deg(P), radius_ratio(P)
     vol = np.abs(np.einsum("ij,ij->i", P[:, 1] - P[:, 0], np.cross(P[:, 2] - P[:, 0], P[:, 3] - P[:, 0]))).sum() / 6.0
     hd = np.histogram(dih, bins=np.arange(0, 190, 10))[0]
     hr = np.histogram(rr, bins=np.linspace(0, 1, 11))[0]
     print(f"| {name} | {len(P)} | {vol:.1f} | {dih.min():.1f} / {np.percentile(dih, 1):.1f} | "
-          f"{rr.min():.3f} / {rr.mean():.3f} | {' '.join(str(c) for c in hd[:9])} | {' '.join(str(c) for c in hr)} |")
+          f"{rr.min():.3f} / {rr.mean():.3f} | {bins(hd[:9])} | {bins(hr)} |")
 
 
 def main():
@@ -131,9 +141,12 @@ def main():
     ap.add_argument("--h", type=float, required=True, help="element size, mm")
     ap.add_argument("--set", action="append", default=[], help="a scene key for pneufem mesh")
     ap.add_argument("--no-gmsh", action="store_true")
+    ap.add_argument("--percent", action="store_true", help="histograms as shares of the elements (%%)")
     a = ap.parse_args()
+    global PERCENT
+    PERCENT = a.percent
     print("| mesher | tets | volume mm^3 | min dihedral: smallest / 1st percentile (deg) | radius ratio min / mean "
-          "| elements by smallest dihedral, 10-deg bins 0-90 | by radius ratio, 0.1 bins |")
+          "| elements by smallest dihedral, 10-deg bins 0-90 | by radius ratio, 0.1 bins 0-1 |")
     print("|---|---|---|---|---|---|---|")
     summary(f"pneufem h={a.h} {' '.join(a.set)}", pneufem_mesh(a.pneufem, a.stl, a.h, a.set))
     if not a.no_gmsh:

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <map>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -180,6 +181,58 @@ void check_volume(const TriSurface& s, const Mesh& m, const StuffingOptions& opt
   if (std::abs(rep.volume_error) > 0.01) rep.notes.push_back(what + "; a smaller mesh.h_mm resolves them better");
 }
 
+/// The mesh keeps the surface's shells: its boundary faces (the symmetry plane's left out), joined
+/// across shared edges, form as many pieces as the surface has shells in the meshed part (x > 0 for
+/// a half model). A wall thinner than the cells can be lost without moving the volume much (a
+/// 0.05 mm lid over a chamber is 0.9 % of a small part): the chamber then opens to the outside and
+/// its boundary joins the outer skin, one piece fewer; a chamber thinner than the cells that closes
+/// up loses its piece too. Either is refused, with the thinnest wall the rays measured.
+void check_shells_kept(const TriSurface& s, const Mesh& m, const StuffedTets& st, const StuffingOptions& opt,
+                       const std::vector<FaceRef>& boundary, double thinnest, const Eigen::Vector3d& thinnest_at) {
+  Eigen::Vector3d lo = s.V.front(), hi = lo;
+  for (const auto& v : s.V) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double tol = 1e-9 * (hi - lo).norm();
+  std::vector<char> meshed(s.shells(), opt.half ? 0 : 1);
+  if (opt.half)
+    for (int f = 0; f < static_cast<int>(s.F.size()); ++f)
+      for (int v : s.F[f])
+        if (s.V[v].x() > tol) meshed[s.face_shell[f]] = 1;
+  const int expected = static_cast<int>(std::count(meshed.begin(), meshed.end(), 1));
+  // Union-find over the boundary faces, joined across shared corner edges.
+  std::vector<int> parent(boundary.size());
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::map<std::pair<int, int>, int> edge_face;
+  std::vector<char> kept(boundary.size(), 0);
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const int* fn = face_local_nodes(m.type, boundary[i].local_face);
+    const int* el = m.element(boundary[i].element);
+    const int c[3] = {el[fn[0]], el[fn[1]], el[fn[2]]};
+    if (opt.half && st.on_symmetry[c[0]] && st.on_symmetry[c[1]] && st.on_symmetry[c[2]]) continue;
+    kept[i] = 1;
+    for (int k = 0; k < 3; ++k) {
+      const std::pair<int, int> e = std::minmax(c[k], c[(k + 1) % 3]);
+      const auto [it, fresh] = edge_face.try_emplace(e, static_cast<int>(i));
+      if (!fresh) parent[root(static_cast<int>(i))] = root(it->second);
+    }
+  }
+  int pieces = 0;
+  for (std::size_t i = 0; i < boundary.size(); ++i) pieces += kept[i] && root(static_cast<int>(i)) == static_cast<int>(i);
+  if (pieces >= expected) return;
+  std::string where = thinnest > 0.0 ? "; the thinnest wall or gap the rays measured is " + short_num(thinnest * 1e3) +
+                                           " mm thick at " + mm_point(thinnest_at)
+                                     : "";
+  throw InputError("mesh.h_mm: a wall or chamber thinner than the elements was lost at mesh.h_mm = " + short_num(opt.h * 1e3) +
+                   ": the surface has " + std::to_string(expected) + " closed shell(s) (the outer skin and the chambers)" +
+                   (opt.half ? " in x >= 0" : "") + " but the mesh's boundary has " + std::to_string(pieces) +
+                   " (a chamber opened to the outside or into another, or closed up)" + where +
+                   "; thicken the wall in CAD or use a smaller mesh.h_mm (the cells go down to mesh.h_mm / 8, and "
+                   "a wall needs at least one cell across it)");
+}
+
 }  // namespace
 
 std::pair<double, double> dihedral_range_deg(const Mesh& m, int e) {
@@ -341,7 +394,10 @@ void end_and_symmetry_sets(Mesh& m, const StuffedTets& st, const StlMeshSpec& sp
                            const FacePlane& tip_plane, const std::vector<FaceRef>& boundary) {
   Eigen::Vector3d lo = m.X.front(), hi = m.X.front();
   for (const auto& p : m.X) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const double tol = 1e-9 * (hi - lo).norm();
+  // 1e-6 of the part's size: an STL stores float coordinates (7 digits), so a flat end face that is
+  // not normal to an axis (an actuator turned in CAD) lies on its plane only to ~1e-7 of the
+  // coordinates; faces on grid planes are exact, and no other face of the part comes this close.
+  const double tol = 1e-6 * (hi - lo).norm();
   m.node_sets["FIXED"] = nodes_on_plane(m, boundary, fixed_plane, tol);
   if (m.node_sets["FIXED"].empty())
     throw InputError("mesh.fixed_face = \"" + spec.fixed_face + "\": fixed face not found: no face of the mesh lies on " +
@@ -376,12 +432,14 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
     for (int d = 0; d < 3; ++d)
       if (std::abs(p.normal[d]) == 1.0) graded.end_planes[d].push_back(p.point[d]);
   const std::unique_ptr<SurfaceDistance> dist = distance_for(surface, graded, spec.wall_cells, rep);
+  Eigen::Vector3d thinnest_at = Eigen::Vector3d::Zero();
   {
     ThinWalls thin = measure_thin_walls(surface, *dist, graded, spec.wall_cells);
     graded.sizes = std::move(thin.sizes);
     rep.thin_rays = thin.samples;
     rep.thin_found = thin.thin;
     rep.thinnest_m = thin.thinnest;
+    thinnest_at = thin.thinnest_at;
     rep.notes.insert(rep.notes.end(), thin.notes.begin(), thin.notes.end());
   }
 
@@ -397,6 +455,7 @@ Mesh mesh_closed_surface(const TriSurface& surface, const StlMeshSpec& spec, Stl
   Mesh m = tagged_tet4(st, surface, cavity, spec, rep);
   check_volume(surface, m, opt, rep);
   const std::vector<FaceRef> boundary = boundary_faces(m);
+  check_shells_kept(surface, m, st, opt, boundary, rep.thinnest_m, thinnest_at);
   cavity_faces(m, st, surface, cavity, *dist, boundary, opt.h);
   end_and_symmetry_sets(m, st, spec, fixed_plane, tip_plane, boundary);
   if (opt.has_slab && opt.slab_mid) membrane_faces(m, opt);

@@ -383,7 +383,11 @@ bool segment_hits(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eige
                   const Eigen::Vector3d& c) {
   const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a, h = d.cross(e2);
   const double det = e1.dot(h);
-  if (std::abs(det) < 1e-300) return false;  // parallel: coplanar overlaps are not detected
+  // Parallel, or in the triangle's plane: coplanar overlaps are not detected. det = e1 . (d x e2) is
+  // a triple product; below 1e-12 of its largest value the segment lies in the plane to round-off
+  // (a tilted flat CAD face is many triangles coplanar only to round-off), and u, v, t below would
+  // be ratios of round-off errors: such pairs are no crossing.
+  if (std::abs(det) <= 1e-12 * d.norm() * e1.norm() * e2.norm()) return false;
   const Eigen::Vector3d t = p - a;
   const double u = t.dot(h) / det;
   if (u < 0.0 || u > 1.0) return false;

@@ -2,6 +2,7 @@
 // the built-in mesh's solid, a curved tube is meshed by the cut-and-warp path, and the sets
 // (CAVITY, FIXED, TIP, SYMMETRY, FABRIC) are the ones the engine needs.
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <set>
 
@@ -214,6 +215,48 @@ TEST(StlMesher, AnActuatorAlongXGetsTheRegionsOfOneAlongY) {
   EXPECT_TRUE(names.count("body") == 1 && names.count("roof") == 0);
 }
 
+TEST(StlMesher, AnActuatorTurnedInCadIsClampedOnItsWholeEndFace) {
+  // The 2-chamber actuator turned 20 degrees about z, as CAD would export it: written as a binary
+  // STL (float coordinates) and read back, clamped by mesh.fixed_face = "plane". Its end faces are
+  // flat only to the floats' ~1e-7 relative rounding; with the planes' tolerance at 1e-9 of the
+  // part's size the tip was "not a flat face" (and the clamp only the faces that happened to fit).
+  // Both end faces are now found: their faces' area against the end face's 22 x 18 mm, short of
+  // it by the chamfers the cut leaves along the face's edges (measured 98.5 % FIXED, 97.8 % TIP at
+  // h = 1.5; an end normal to an axis is a grid plane instead and is found to 99.7 %).
+  PneuNetParams p;
+  p.chambers = 2;
+  const double a = 20.0 * std::numbers::pi / 180.0;
+  TriSurface s = test::pneunet_surface(p);
+  for (auto& v : s.V) v = Eigen::Vector3d(std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y(), v.z());
+  const std::string file = (std::filesystem::temp_directory_path() / "pneufem_turned_actuator.stl").string();
+  write_stl(file, s, 1e-3);
+  const TriSurface read = read_closed_surface(file, 1e-3);
+  StlMeshSpec spec = default_spec(p);
+  spec.stuffing.half = false;  // turned: no longer mirror-symmetric about x = 0
+  spec.stuffing.h = 1.5e-3;
+  spec.fixed_face = "plane";
+  spec.fixed_point = Eigen::Vector3d::Zero();
+  spec.fixed_normal = Eigen::Vector3d(std::sin(a), -std::cos(a), 0.0);
+  StlMeshReport rep;
+  const Mesh m = mesh_closed_surface(read, spec, &rep);
+  std::printf("%s", describe(rep).c_str());
+  for (const char* set : {"FIXED", "TIP"}) {
+    std::vector<char> in(m.num_nodes(), 0);
+    for (int n : m.node_sets.at(set)) in[n] = 1;
+    double area = 0.0;
+    for (const FaceRef& fr : boundary_faces(m)) {
+      const int* fn = face_local_nodes(m.type, fr.local_face);
+      const int* el = m.element(fr.element);
+      if (in[el[fn[0]]] && in[el[fn[1]]] && in[el[fn[2]]])
+        area += 0.5 * (m.X[el[fn[1]]] - m.X[el[fn[0]]]).cross(m.X[el[fn[2]]] - m.X[el[fn[0]]]).norm();
+    }
+    const double end_face = p.width * (p.base_thickness + p.body_height);
+    std::printf("%s: %.2f %% of the end face\n", set, 100.0 * area / end_face);
+    EXPECT_GT(area, 0.97 * end_face) << set;
+    EXPECT_LT(area, (1.0 + 1e-6) * end_face) << set;
+  }
+}
+
 TEST(StlMesher, BadInputsAreClearErrors) {
   PneuNetParams p;
   p.chambers = 2;
@@ -250,6 +293,19 @@ TEST(StlMesher, BadInputsAreClearErrors) {
   }
   spec.fixed_face = "w+";
   EXPECT_NE(error_of([&] { mesh_closed_surface(s, spec); }).find("mesh.fixed_face must be"), std::string::npos);
+  // A tip that is no flat face normal to the length: the free end sloped (y grows with z; still
+  // planar, but only its top edge reaches the farthest y), so no face of the mesh lies on the tip plane.
+  {
+    TriSurface sloped = test::pneunet_surface(p);
+    const double L = p.length();
+    for (auto& v : sloped.V)
+      if (std::abs(v.y() - L) < 1e-12) v.y() += 0.25 * v.z();
+    const std::string tip = error_of([&] { mesh_closed_surface(closed(sloped), default_spec(p)); });
+    EXPECT_NE(tip.find("mesh.fixed_face = \"y-\": the tip (the end opposite the fixed face) is not a flat face"),
+              std::string::npos)
+        << tip;
+    EXPECT_NE(tip.find("y = 26.5 mm"), std::string::npos) << tip;  // L = 22 mm + 0.25 * 18 mm
+  }
 }
 
 }  // namespace

@@ -113,6 +113,34 @@ TEST(StlReader, SelfIntersectingSurfacesAreRefused) {
   EXPECT_EQ(error_of([&] { close_and_orient(t); }), "(no error)");
 }
 
+TEST(StlReader, TiltedFlatFacesOfManyTrianglesAreNoSelfIntersection) {
+  // A CAD face that is flat but tilted is many triangles that are coplanar only to round-off; two
+  // of them without a common corner are no crossing. Before 2026-11-29 the segment test treated only
+  // an exactly zero determinant as coplanar, and round-off determinants of ~1e-20 made crossings of
+  // such pairs (found on the 2-chamber actuator with a sloped free end: 3 "crossing" pairs). A box
+  // of 4 x 4 x 4 cells (every face 32 triangles), turned about a skew axis, and the sloped actuator.
+  std::array<std::vector<double>, 3> lines{{{0.0, 0.001, 0.002, 0.003, 0.004}, {0.0, 0.001, 0.002, 0.003, 0.004},
+                                            {0.0, 0.001, 0.002, 0.003, 0.004}}};
+  TriSurface b = test::grid_solid_surface(lines, [](const Eigen::Vector3d&) { return true; });
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  for (auto& v : b.V) v = R * v + Eigen::Vector3d(0.0123, -0.0071, 0.0042);
+  EXPECT_EQ(error_of([&] { close_and_orient(b); }), "(no error)");
+  EXPECT_NEAR(enclosed_volume(b), 0.004 * 0.004 * 0.004, 1e-12 * 0.004 * 0.004 * 0.004);
+  PneuNetParams p;
+  p.chambers = 2;
+  TriSurface sloped = test::pneunet_surface(p);
+  for (auto& v : sloped.V)
+    if (std::abs(v.y() - p.length()) < 1e-12) v.y() += 0.25 * v.z();
+  EXPECT_EQ(error_of([&] { close_and_orient(sloped); }), "(no error)");
+  // A real crossing at a small angle is still found: the second box of the test above, tilted 1 degree.
+  TriSurface a = test::grid_solid_surface(lines, [](const Eigen::Vector3d&) { return true; });
+  TriSurface c = a;
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(std::numbers::pi / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (auto& v : c.V) v = tilt * v + Eigen::Vector3d(0.0015, 0.0015, 0.0015);
+  append_surface(a, c);
+  EXPECT_NE(error_of([&] { close_and_orient(a); }).find("the surface intersects itself"), std::string::npos);
+}
+
 TEST(StlReader, InvertedNormalsAreFixedWithANote) {
   // The box written inside out, and one triangle of it turned back: both repaired.
   TriSurface b = box(0.002, 0.002, 0.002);
