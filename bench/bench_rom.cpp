@@ -146,7 +146,6 @@ int main(int argc, char** argv) {
     else if (a == "--no-hyper") ro.hyper_reduce = false;
     else if (a == "--galerkin-theta") ro.galerkin_theta_row = true;  // the theta row tested with the path tangent
     else if (a == "--tangent-free") ro.tangent_free_modes = true;  // modes orthogonal to every path tangent, no gauge
-    else if (a == "--snapshot-energy") ro.snapshot_energy_norm = true;  // the snapshots' POD in a homogeneous body's strain energy
     else if (a == "--softened") ro.softened_levels = std::stoi(next());  // softened equilibria as snapshots (levels)
     else if (a == "--softened-max") ro.softened_max = std::stod(next());
     else if (a[0] != '-') scene_path = a;
@@ -257,7 +256,6 @@ int main(int argc, char** argv) {
     if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
     if (ro.galerkin_theta_row) snap_key += "galerkin-theta";
     if (ro.tangent_free_modes) snap_key += "tangent-free";
-    if (ro.snapshot_energy_norm) snap_key += "snapshot-energy";
     if (path_steps != 40) snap_key += "path-steps:" + std::to_string(path_steps);  // the basis holds the path's operators
     const fs::path f = fs::path(work) / ("basis_" + std::to_string(fnv(ref_scene.model_toml() + opts + snap_key)) + ".bin");
     std::vector<double> d;

@@ -138,12 +138,6 @@ struct RomBasisOptions {
   /// trial 1 (0.8-0.9 deg), which needs the modes' parts along the tangents
   /// (bench/results/rom_h6_ceiling, section 5).
   bool tangent_free_modes = false;
-  /// The snapshots' POD measured in the strain energy of a homogeneous body (the reference mesh of
-  /// its soft material throughout, small strain) instead of the mass norm: which subspace of the
-  /// snapshots is kept (the modes stay mass-orthonormal). For experiments: the mass norm weights a
-  /// shape by its displacement, and a local strain concentration (where a point's stretch crosses
-  /// a damage threshold) has little displacement.
-  bool snapshot_energy_norm = false;
   bool verbose = false;
 };
 

@@ -197,11 +197,9 @@ namespace {
 /// Appends to `modes` (mass-orthonormal, unit RMS) up to `count` POD modes of `shapes` after their
 /// parts along `modes` are removed. With `normalise`, each shape is scaled to unit mass norm first,
 /// so that every shape counts alike; without, the shapes count by size. `left` is set to the relative
-/// energy of the projected shapes outside the kept modes. With `metric` (symmetric, positive
-/// semi-definite), the shapes' correlation and `left` are measured in a^T metric b instead of the
-/// mass norm (which subspace is kept); the modes appended are still made mass-orthonormal.
+/// energy of the projected shapes outside the kept modes.
 void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorXd& mass, int count, double tolerance,
-                std::vector<Eigen::VectorXd>& modes, double& left, bool normalise = true, const SparseMatrix* metric = nullptr) {
+                std::vector<Eigen::VectorXd>& modes, double& left, bool normalise = true) {
   const double m_tot = mass.sum();
   const std::size_t n = shapes.size();
   if (n == 0 || count <= 0) return;
@@ -211,15 +209,10 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
     for (const Eigen::VectorXd& m : modes) x[i] -= (mass_dot(mass, m, x[i]) / m_tot) * m;
   });
   Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
-  std::vector<Eigen::VectorXd> mx;  // metric * x[i]
-  if (metric) {
-    mx.resize(n);
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { mx[i] = (*metric) * x[i]; });
-  }
   tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
     for (std::size_t j = 0; j <= i; ++j)
       C(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = C(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) =
-          metric ? x[i].dot(mx[j]) : mass_dot(mass, x[i], x[j]) / m_tot;
+          mass_dot(mass, x[i], x[j]) / m_tot;
   });
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(C);
   const Eigen::VectorXd lam = eig.eigenvalues().reverse();
@@ -228,7 +221,7 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   // Shapes the earlier modes hold already leave only round-off of their energy: nothing to add.
   double before = 0.0;
   for (std::size_t i = 0; i < n; ++i)
-    before += metric ? shapes[i].dot((*metric) * shapes[i]) : normalise ? 1.0 : mass_dot(mass, shapes[i], shapes[i]) / m_tot;
+    before += normalise ? 1.0 : mass_dot(mass, shapes[i], shapes[i]) / m_tot;
   if (lam.sum() <= 1e-20 * before) return;
   int r = 0;
   left = total;
@@ -237,11 +230,9 @@ void pod_append(const std::vector<Eigen::VectorXd>& shapes, const Eigen::VectorX
   for (int j = 0; j < r; ++j) {
     Eigen::VectorXd m = Eigen::VectorXd::Zero(mass.size() * 3);
     for (std::size_t i = 0; i < n; ++i) m += vec(static_cast<Eigen::Index>(i), j) * x[i];
-    const double size = std::sqrt(mass_dot(mass, m, m) / m_tot);
-    // Round-off in the mass norm; in another metric, the mass-orthogonalisation of the new subspace.
-    for (const Eigen::VectorXd& prev : modes) m -= (mass_dot(mass, prev, m) / m_tot) * prev;
+    for (const Eigen::VectorXd& prev : modes) m -= (mass_dot(mass, prev, m) / m_tot) * prev;  // round-off
     const double norm = std::sqrt(mass_dot(mass, m, m) / m_tot);
-    if (!(norm > 0.0) || (metric && !(norm > 1e-6 * size))) break;
+    if (!(norm > 0.0)) break;
     modes.push_back(m / norm);
   }
 }
@@ -414,22 +405,6 @@ void pressure_second_order(const Assembler& A, ReducedBasis& B) {
     }
 }
 
-/// The small-strain stiffness of the reference's mesh made of its softest material throughout
-/// (the stiff parts take the soft parts' material), at u = 0 without load: the metric of
-/// RomBasisOptions::snapshot_energy_norm. Homogeneous, so that the fabric's 10^5 times larger
-/// modulus does not make the metric measure the fabric's strain alone.
-SparseMatrix homogeneous_stiffness(const Model& reference, const std::vector<char>& stiff) {
-  Model hom = reference;
-  MaterialPtr soft;
-  for (std::size_t i = 0; i < hom.parts.size() && !soft; ++i)
-    if (!stiff[i]) soft = hom.parts[i].material;
-  if (!soft) throw InputError("reduced model: no soft part for the snapshots' energy norm");
-  for (std::size_t i = 0; i < hom.parts.size(); ++i)
-    if (stiff[i]) hom.parts[i].material = soft;
-  const Assembler A(hom);
-  return tangent(A, Eigen::VectorXd::Zero(A.num_dofs()), 0.0);
-}
-
 void check_basis_options(const RomBasisOptions& opt) {
   if (opt.clusters < 1 || opt.mode_samples < 1 || opt.max_modes < 1 || !(opt.pod_tolerance > 0.0 && opt.pod_tolerance < 1.0) ||
       !(opt.ecsw_tolerance > 0.0 && opt.ecsw_tolerance < 1.0) || opt.training_fields < 0 ||
@@ -569,15 +544,14 @@ void add_departures(const Model& reference, const ReducedBasis& B, const Eigen::
 /// responses at equal weight, its ~20 shapes lost the POD and the fatigue drift of a 3-chamber
 /// actuator stayed 8 % short after three trials; taken first, 1 % (docs/theory.md). Sets B.Phi and
 /// B.info.pod_energy_left.
-void set_modes(const CandidateShapes& shapes, const Eigen::VectorXd& mass, const RomBasisOptions& opt, const SparseMatrix* metric,
-               ReducedBasis& B) {
+void set_modes(const CandidateShapes& shapes, const Eigen::VectorXd& mass, const RomBasisOptions& opt, ReducedBasis& B) {
   std::vector<Eigen::VectorXd> snapshot_shapes, response_shapes;
   for (std::size_t i = 0; i < shapes.shape.size(); ++i)
     (shapes.sample[i] < 0 ? snapshot_shapes : response_shapes).push_back(shapes.shape[i]);
   std::vector<Eigen::VectorXd> modes;
   double left = 0.0;
   if (!snapshot_shapes.empty())
-    pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false, metric);
+    pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false);
   pod_append(response_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left);
   if (opt.tangent_free_modes) project_out_path_tangents(B.dU, mass, modes);
   const int r = static_cast<int>(modes.size());
@@ -873,9 +847,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
     throw PhysicsError("reduced model: no tangent along the elastic path could be factorised (the path may start at a limit "
                        "point); check the model with pneufem simulate");
   B.info.responses = static_cast<int>(shapes.shape.size());
-  SparseMatrix energy;
-  if (opt.snapshot_energy_norm) energy = homogeneous_stiffness(reference, B.stiff_part);
-  set_modes(shapes, mass, opt, opt.snapshot_energy_norm ? &energy : nullptr, B);
+  set_modes(shapes, mass, opt, B);
   if (opt.verbose) {
     const auto n_snap = static_cast<std::size_t>(std::count(shapes.sample.begin(), shapes.sample.end(), -1));
     std::fprintf(stderr, "reduced basis: %d clusters, %zu responses at %zu samples, %zu snapshots, %d modes (energy left %.2e), %.1f s\n",
