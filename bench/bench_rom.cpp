@@ -26,6 +26,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <array>
 #include <map>
 #include <sstream>
 #include <string>
@@ -435,9 +436,14 @@ int main(int argc, char** argv) {
       // the loaded top: the report before the last (the last one is at the hold end, same p)
       double sd_rom = 0, sd_fem = 0, n = 0, sl_rom = 0, sl_fem = 0;
       std::vector<std::tuple<double, int, int, double, double, double, double>> rows;
+      // Per region: sums over the kept points of the damage and the viscous strain (ROM, FEM, |ROM - FEM|).
+      std::map<int, std::array<double, 6>> by_region;
       for (int k = 0; k < rom.num_points(); ++k) {
         const int e = rom.element_of_point(k), qp = k % geom.nqp;
         const double dr = rom_h[i][2 * k], df = fh[i][2 * (e * geom.nqp + qp)];
+        const double vr = rom_h[i][2 * k + 1], vf = fh[i][2 * (e * geom.nqp + qp) + 1];
+        std::array<double, 6>& reg = by_region[bm->model.mesh.region[e]];
+        reg[0] += dr, reg[1] += df, reg[2] += std::abs(dr - df), reg[3] += vr, reg[4] += vf, reg[5] += std::abs(vr - vf);
         const double lr = stretch(rom_u[i], e, qp), lf = stretch(fu[i], e, qp);
         sd_rom += dr, sd_fem += df;
         if (df > 0.01) n += 1, sl_rom += lr - 1, sl_fem += lf - 1;
@@ -445,6 +451,9 @@ int main(int argc, char** argv) {
       }
       std::printf("trial %d: kept points' damage sum ROM %.3f FEM %.3f (%+.1f %%); over %g points with FEM damage > 0.01: mean stretch-1 ROM %.4f FEM %.4f\n",
                   ftrial[i], sd_rom, sd_fem, 100 * (sd_rom / sd_fem - 1), n, sl_rom / std::max(n, 1.0), sl_fem / std::max(n, 1.0));
+      for (const auto& [r, v] : by_region)
+        std::printf("   region %-14s damage ROM %.4f FEM %.4f |diff| %.4f   viscous strain ROM %.4e FEM %.4e |diff| %.4e\n",
+                    bm->model.mesh.region_names[r].c_str(), v[0], v[1], v[2], v[3], v[4], v[5]);
       std::sort(rows.begin(), rows.end());
       for (int j = 0; j < 8 && j < static_cast<int>(rows.size()); ++j) {
         auto [dd, e, qp, dr, df, lr, lf] = rows[static_cast<std::size_t>(j)];
