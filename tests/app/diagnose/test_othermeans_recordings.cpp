@@ -53,7 +53,7 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
 
 /// The catalog's names for a hidden effect of the generator.
 std::set<std::string> names_of(const std::string& hidden) {
-  if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous"};
+  if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous", "viscoelastic_broad"};  // one or three terms
   if (hidden == "lag") return {"pressure_lag"};
   if (hidden == "fatigue") return {"fatigue", "fatigue_saturating"};  // with or without saturation
   return {hidden};
