@@ -247,6 +247,15 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // creep and lag (gamma 0.26, tau 10.1 s; its error growing over the trials), this one 0.0136 (gamma
 // 0.35, tau 10.6 s; none): the one-term creep, re-fitted, takes the fatigue's growth, and nothing is
 // left for fatigue. A creep law that can follow a power-law creep is the fix, not looser tests.
+// Since (2026-11-29, bench/notes/2026-11-29-diag3.md): the broad-spectrum creep viscoelastic_broad
+// and the swap of forms after a round (try_other_forms). With the candidates stiffness, both
+// instantaneous creeps, lag and both fatigues (max 4): round 1 one-term creep (RSS 655 deg^2; broad
+// 680), round 2 the lag, then the broad creep replaced the one-term one (RSS 20.56 -> 20.1 deg^2 with
+// the lag), and in round 3 fatigue left 12.0 deg^2 beyond a static misfit against 20.1 (fatigue_saturating
+// 12.0): fatigue now explains 40 % of what creep + lag leave (2 % beside the one-term creep). The run
+// did not end by the session's deadline: the joint re-fit of round 3 drove the lag's tau2 towards 0,
+// where scenes/pressure_lag.cpp's second-order breakpoints blow up (5-7 GB; another run was killed
+// by the OOM killer at 24 GB). Not re-run with the whole catalog (over 40 min of one thread).
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
