@@ -256,9 +256,9 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // 680), round 2 the lag, then the broad creep replaced the one-term one (RSS 20.56 -> 20.1 deg^2 with
 // the lag), and in round 3 fatigue's calibration beyond a static misfit reached 12.0 deg^2 (fatigue_saturating
 // 12.0) against the model's raw 20.1 (its own RSS beyond a static misfit, which the tests compare, was
-// not printed). The run did not reach round 3's tests: a joint re-fit drove the lag's tau2 towards 0,
-// where scenes/pressure_lag.cpp's second-order breakpoints take gigabytes (killed at 12 GB; another run
-// was killed by the OOM killer at 24 GB). Not run with the whole catalog (over 40 min of one thread).
+// not printed). The run did not reach round 3's tests: in a joint re-fit the process grew inside
+// apply_pressure_lag (the chamber's pressure history; cause not verified, the note's section E) and was
+// killed at 12 GB (another run by the OOM killer at 24 GB). Not run with the whole catalog (over 40 min).
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
