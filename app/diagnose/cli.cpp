@@ -12,7 +12,7 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   auto c = std::make_unique<DiagnoseCommand>();
   c->cmd = app.add_subcommand(
       "diagnose",
-      "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, viscoelastic_instantaneous, mullins, "
+      "Which physical effect is the model missing? Adds each candidate effect (stiffness, viscoelastic, viscoelastic_instantaneous, viscoelastic_broad, mullins, "
       "fatigue, fatigue_saturating, pressure_lag, gravity, registered effects) to the scene, calibrates it against the measurements, ranks "
       "them by the error they remove with an information criterion, and writes diagnosis.json, fitted.toml and report.md");
   c->cmd->add_option("scene", c->scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
@@ -129,6 +129,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
                 k.delta_aic, k.nrmse_beyond_static, k.significant ? "significant" : "", bound.c_str());
   }
   if (const std::string k = selected_constants_text(r); !k.empty()) std::printf("constants of the selected effects:\n%s", k.c_str());
+  for (const std::string& e : r.form_changes) std::printf("form changed: %s\n", e.c_str());
   for (const std::string& e : r.equivalents) std::printf("equally good: %s\n", e.c_str());
   for (const EquivalentModel& m : r.equivalent_models) std::printf("equivalent model: %s\n", equivalent_model_text(m, r).c_str());
   if (!r.static_note.empty()) std::printf("what is left: %s\n", r.static_note.c_str());

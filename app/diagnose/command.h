@@ -4,7 +4,7 @@
 // 1. The recording (analysis/measurements.h) is compared with the scene's model (the baseline):
 //    residual = model - measured at every kept frame (outlier frames dropped, analysis/model_vs_measured.h).
 // 2. Every candidate effect of the catalog (app/diagnose/effect_catalog.h: stiffness, viscoelastic,
-//    viscoelastic_instantaneous, mullins, fatigue, fatigue_saturating, pressure_lag, gravity and any
+//    viscoelastic_instantaneous, viscoelastic_broad, mullins, fatigue, fatigue_saturating, pressure_lag, gravity and any
 //    registered material effect) is added to the scene and its few bounded parameters are
 //    calibrated (NLopt BOBYQA in [0, 1]-scaled, log where
 //    the catalog says so, after a coarse start grid) to minimise the residual sum of squares.
@@ -244,6 +244,11 @@ struct DiagnosisResult {
   /// and fit as well (their RSS, beyond a static misfit from round 2 on, within 25 % of the chosen
   /// one's: below the reduced model's own error, so the recording cannot tell them apart), in words.
   std::vector<std::string> equivalents;
+  /// Forms swapped after a round (try_other_forms): "round R: B replaced A (...)", in words. Greedy
+  /// selection picks a form of an effect (one-term or broad creep; fatigue with or without
+  /// saturation) against the model of its round; with the effects selected after it another form
+  /// can fit better, and then takes its place.
+  std::vector<std::string> form_changes;
   /// Model equivalence of the whole selection (equivalent_models): other combinations of effects that
   /// fit as well as the final model, fewest constants first; and the final model's constant count.
   std::vector<EquivalentModel> equivalent_models;

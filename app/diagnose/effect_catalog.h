@@ -4,7 +4,7 @@
 // parameters and the scene overrides that add it to a scene.
 //
 // Built-ins: stiffness, viscoelastic (moduli = long_term), viscoelastic_instantaneous (moduli =
-// instantaneous), mullins, fatigue (integrity exponent n = 1), fatigue_saturating (n = 6), pressure_lag,
+// instantaneous), viscoelastic_broad (instantaneous, three Prony terms of one shaped spectrum), mullins, fatigue (integrity exponent n = 1), fatigue_saturating (n = 6), pressure_lag,
 // gravity; then every effect
 // of the material-effect registry (damage/registry.h) that is not a built-in, with the registry's
 // parameters and bounds (truth = initial = the registered default). Material effects apply to every
@@ -39,6 +39,11 @@ struct CandidateEffect {
   std::string description;  ///< one line, plain words
   std::string signature;    ///< residual signature it explains, plain words (diagnose's "why")
   bool history = false;     ///< the response depends on the load history (creep, damage)
+  /// Candidates of one family are forms of one effect in one scene table ("creep": the one-term creep
+  /// in either convention and the broad spectrum; "fatigue": with and without saturation): they are
+  /// not stacked, and after each round diagnose tries the other forms of a selected one in its place
+  /// (command.cpp, try_other_forms). "" = none.
+  std::string family;
   /// How diagnose may interpolate the model over this candidate's single parameter when every run
   /// costs a static FEM sweep (an elastic model with gravity); see app/diagnose/elastic_curve.h.
   ParameterInterpolation interpolation = ParameterInterpolation::none;

@@ -199,7 +199,8 @@ std::string rest_sentence(const Signature& s) {
 
 std::string evidence(const std::string& effect, const Signature& s) {
   if (effect == "fatigue" || effect == "fatigue_saturating") return growth_sentence(s) + ", and " + top_creep_sentence(s);
-  if (effect == "viscoelastic" || effect == "viscoelastic_instantaneous") return hold_creep_sentence(s);
+  if (effect == "viscoelastic" || effect == "viscoelastic_instantaneous" || effect == "viscoelastic_broad")
+    return hold_creep_sentence(s);
   if (effect == "mullins") return first_trial_sentence(s);
   if (effect == "stiffness") return proportional_sentence(s);
   if (effect == "pressure_lag") return step_lag_sentence(s);

@@ -124,6 +124,9 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     std::string eq = "[";
     for (std::size_t j = 0; j < out.equivalents.size(); ++j) eq += (j ? ", " : "") + json::quote(out.equivalents[j]);
     root.add("equivalents", eq + "]");
+    std::string fc = "[";
+    for (std::size_t j = 0; j < out.form_changes.size(); ++j) fc += (j ? ", " : "") + json::quote(out.form_changes[j]);
+    root.add("form_changes", fc + "]");
   }
   add_equivalence_and_costs(root, out);
   std::string sel = "[";

@@ -195,6 +195,7 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
     s += "\n";
   }
   if (!out.stopped.empty()) s += "Stopped " + out.stopped + ".\n\n";
+  for (const std::string& e : out.form_changes) s += "Form changed: " + e + ".\n\n";
   for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
   for (const EquivalentModel& m : out.equivalent_models) s += "Equivalent model: " + equivalent_model_text(m, out) + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";

@@ -15,7 +15,7 @@ std::unique_ptr<SynthCommand> add_synth_command(CLI::App& app) {
   sy->add_option("scene", synth.scene_path, "Scene file (TOML); omit for the built-in default pneu-net")
       ->check(CLI::ExistingFile);
   sy->add_option("--hidden", c->hidden,
-                 "EFFECT[,EFFECT...] hidden at their truth values (candidates: stiffness, viscoelastic, viscoelastic_instantaneous, mullins, "
+                 "EFFECT[,EFFECT...] hidden at their truth values (candidates: stiffness, viscoelastic, viscoelastic_instantaneous, viscoelastic_broad, mullins, "
                  "fatigue, fatigue_saturating, pressure_lag, gravity and registered material effects), or none (the control dataset)")
       ->required();
   sy->add_option("--out", synth.out_csv, "Measurement CSV to write (canonical format); truth files go beside it")

@@ -38,9 +38,9 @@ void register_test_effect_once() {
 
 TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   const auto& all = candidate_effects();
-  const std::vector<std::string> names = {"stiffness", "viscoelastic",       "viscoelastic_instantaneous",
-                                          "mullins",   "fatigue",            "fatigue_saturating",
-                                          "pressure_lag", "gravity"};
+  const std::vector<std::string> names = {"stiffness",          "viscoelastic", "viscoelastic_instantaneous",
+                                          "viscoelastic_broad", "mullins",      "fatigue",
+                                          "fatigue_saturating", "pressure_lag", "gravity"};
   ASSERT_GE(all.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   for (const CandidateEffect& c : all) {
@@ -60,8 +60,8 @@ TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   EXPECT_FALSE(candidate_effect("stiffness").history);
   const std::string e = error_of([] { candidate_effect("creep"); });
   EXPECT_NE(e.find("unknown candidate effect 'creep'"), std::string::npos) << e;
-  EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, mullins, fatigue, fatigue_saturating, "
-                   "pressure_lag, gravity"),
+  EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, viscoelastic_broad, mullins, fatigue, "
+                   "fatigue_saturating, pressure_lag, gravity"),
             std::string::npos)
       << e;
 }
@@ -161,9 +161,9 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
   register_test_effect_once();
   int checked = 0;
   for (const CandidateEffect& c : candidate_effects()) {
-    const std::string effect = c.name == "viscoelastic_instantaneous" ? "viscoelastic"
-                               : c.name == "fatigue_saturating"       ? "fatigue"
-                                                                      : c.name;
+    const std::string effect = c.name == "viscoelastic_instantaneous" || c.name == "viscoelastic_broad" ? "viscoelastic"
+                               : c.name == "fatigue_saturating"                                        ? "fatigue"
+                                                                                                       : c.name;
     const MaterialEffect* fx = find_material_effect(effect);
     if (!fx) continue;
     EXPECT_EQ(c.history, fx->history) << c.name;
@@ -181,8 +181,8 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
       ++checked;
     }
   }
-  EXPECT_GE(checked, 2 + 2 + 2 + 2 + 2 + 1);  // viscoelastic in both conventions, mullins, fatigue with and
-                                              // without saturation, the test effect
+  EXPECT_GE(checked, 2 + 2 + 2 + 2 + 2 + 2 + 1);  // viscoelastic in both conventions and broad, mullins,
+                                                  // fatigue with and without saturation, the test effect
   // Calibration start and synth truth are the catalog's own, and not defaults: Mullins starts at
   // r = 5 (near the middle of log [1.1, 20]) and hides r = 3, while a scene's default is 8.
   const CandidateEffect& m = candidate_effect("mullins");
@@ -239,6 +239,64 @@ TEST(EffectCatalog, CreepIsTriedInBothModuliConventions) {
   // A scene whose creep is switched off is free for either.
   const Scene off = with_lt.with({"materials.silicone.viscoelastic.enabled=false"});
   EXPECT_EQ(off.with(inst.sets(off, {0.3, 2.0})).string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+}
+
+// Creep with a broad relaxation spectrum (issue 35, bench/notes/2026-11-29-diag3.md): the calibrated
+// gamma and tau spread over three Prony terms of one fixed shape, tau/10, tau and 10 tau with weights
+// proportional to tau_i^(1/4) summing to gamma, in the instantaneous convention; the registry's
+// ranges; not stacked on the one-term creep (one table, a different number of terms).
+TEST(EffectCatalog, BroadCreepSpreadsItsTwoConstantsOverThreeTerms) {
+  const CandidateEffect& one = candidate_effect("viscoelastic_instantaneous");
+  const CandidateEffect& broad = candidate_effect("viscoelastic_broad");
+  EXPECT_TRUE(broad.history);
+  ASSERT_EQ(broad.params.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(broad.params[i].name, one.params[i].name);
+    EXPECT_EQ(broad.params[i].lo, one.params[i].lo);
+    EXPECT_EQ(broad.params[i].hi, one.params[i].hi);
+  }
+  const Scene base = Scene::load("", kTiny);
+  const Scene s = base.with(broad.sets(base, {0.6, 4.0}));
+  EXPECT_EQ(s.string("materials.silicone.viscoelastic.moduli"), "instantaneous");
+  const std::vector<double> g = s.numbers("materials.silicone.viscoelastic.gamma");
+  const std::vector<double> tau = s.numbers("materials.silicone.viscoelastic.tau_s");
+  ASSERT_EQ(g.size(), 3u);
+  ASSERT_EQ(tau.size(), 3u);
+  // 1e-12: the values pass through the scene's text (json::num, shortest round-trip) and a sum.
+  EXPECT_NEAR(tau[0], 0.4, 1e-12);
+  EXPECT_NEAR(tau[1], 4.0, 1e-12);
+  EXPECT_NEAR(tau[2], 40.0, 1e-12);
+  EXPECT_NEAR(g[0] + g[1] + g[2], 0.6, 1e-12);
+  EXPECT_NEAR(g[1] / g[0], std::pow(10.0, 0.25), 1e-12);
+  EXPECT_NEAR(g[2] / g[1], std::pow(10.0, 0.25), 1e-12);
+  // Built: one viscoelastic law of three terms whose long-term modulus is 1/(1 + gamma) of the base's.
+  const auto bm = build_model(s);
+  const Viscoelastic* v = nullptr;
+  for (const Part& p : bm->model.parts)
+    if (const auto* w = dynamic_cast<const Viscoelastic*>(p.material.get())) v = w;
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(v->terms(), 3);
+  EXPECT_EQ(v->moduli(), ViscoModuli::instantaneous);
+  EXPECT_NEAR(v->long_term_shear_modulus() * 1.6, v->initial_shear_modulus(), 1e-9 * v->initial_shear_modulus());
+  // What the constants mean, in the diagnosis's words.
+  ASSERT_TRUE(broad.reading);
+  const std::string r = broad.reading({0.6, 4.0});
+  EXPECT_NE(r.find("at 0.4 s"), std::string::npos) << r;
+  EXPECT_NE(r.find("at 40 s"), std::string::npos) << r;
+  EXPECT_NE(r.find("long-term response 0.625 of the instantaneous one"), std::string::npos) << r;
+  // Not on top of the one-term creep, nor the other way round; a re-fit of itself replaces its terms.
+  const std::string e = error_of([&] { broad.sets(base.with(one.sets(base, {0.3, 2.0})), {0.6, 4.0}); });
+  EXPECT_NE(e.find("candidate 'viscoelastic_broad': materials.silicone.viscoelastic is already enabled with 1 "
+                   "term(s); this candidate would switch it to 3"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(error_of([&] { one.sets(s, {0.3, 2.0}); }).find("already enabled with 3 term(s)"), std::string::npos);
+  EXPECT_NEAR(s.with(broad.sets(s, {0.2, 1.0})).numbers("materials.silicone.viscoelastic.tau_s")[2], 10.0, 1e-12);
+  // One family: forms of one effect, which diagnose swaps after a round (try_other_forms) instead of stacking.
+  for (const char* n : {"viscoelastic", "viscoelastic_instantaneous", "viscoelastic_broad"})
+    EXPECT_EQ(candidate_effect(n).family, "creep") << n;
+  for (const char* n : {"fatigue", "fatigue_saturating"}) EXPECT_EQ(candidate_effect(n).family, "fatigue") << n;
+  for (const char* n : {"stiffness", "mullins", "pressure_lag", "gravity"}) EXPECT_EQ(candidate_effect(n).family, "") << n;
 }
 
 // Fatigue with and without saturation (issue 35 item 5): the same law at its integrity exponent's two

@@ -53,7 +53,7 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
 
 /// The catalog's names for a hidden effect of the generator.
 std::set<std::string> names_of(const std::string& hidden) {
-  if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous"};
+  if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous", "viscoelastic_broad"};  // one or three terms
   if (hidden == "lag") return {"pressure_lag"};
   if (hidden == "fatigue") return {"fatigue", "fatigue_saturating"};  // with or without saturation
   return {hidden};
@@ -147,9 +147,15 @@ TEST(OtherMeansRecording, FirstOrderLagIsNamedWithItsTimeConstant) {
 // Measured: viscoelastic_instantaneous alone, NRMSE 0.1162 -> 0.0192 (0.17x) at a 0.0075 floor; gamma
 // 0.19, tau 3.8 s for a KWW creep g 0.35, tau 1.5 s, beta 0.6 (different laws: no like-for-like
 // constants). Round 2 named nothing (Mullins and gravity passed raw tests only, not beyond the static
-// misfit). 210 s of one core (with main's max_effects 2).
+// misfit). 210 s of one core (with main's max_effects 2). Passes with the broad creep in the catalog
+// (2026-11-29, 971 s of one thread at load 6; bench/notes/2026-11-29-diag3.md): the one-term creep named
+// alone, 0.1162 -> 0.0192 (0.17x), the broad creep second in round 1 (0.0251, gamma 0.21, tau 2.0 s)
+// and not swapped in; round 2 nothing (Mullins 0.0179, gravity 0.0185 not beyond the static misfit).
 TEST(OtherMeansRecording, DISABLED_StretchedExponentialCreepIsNamed) { expect_found(diagnose("creep_kww"), {"creep"}); }
-// Measured: viscoelastic_instantaneous alone, 0.1049 -> 0.0250 (0.24x), floor 0.0042; 319 s.
+// Measured: viscoelastic_instantaneous alone, 0.1049 -> 0.0250 (0.24x), floor 0.0042; 319 s. Passes
+// with the broad creep in the catalog (2026-11-29, 1 264 s of one thread at load 6): the same selection;
+// the broad creep 0.0306 in round 1 (0.0149 beyond a static misfit against the one-term's 0.0157), with
+// tau at its 30 s bound, and not swapped in; round 2 nothing (gravity 0.0230, stiffness 0.0243).
 TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose("creep_powerlaw"), {"creep"}); }
 // Not measured in time (10 trials: ~15 min of one core with two rounds).
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
@@ -247,6 +253,15 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // creep and lag (gamma 0.26, tau 10.1 s; its error growing over the trials), this one 0.0136 (gamma
 // 0.35, tau 10.6 s; none): the one-term creep, re-fitted, takes the fatigue's growth, and nothing is
 // left for fatigue. A creep law that can follow a power-law creep is the fix, not looser tests.
+// Since (2026-11-29, bench/notes/2026-11-29-diag3.md): the broad-spectrum creep viscoelastic_broad
+// and the swap of forms after a round (try_other_forms). With the candidates stiffness, both
+// instantaneous creeps, lag and both fatigues (max 4): round 1 one-term creep (RSS 655 deg^2; broad
+// 680), round 2 the lag, then the broad creep replaced the one-term one (RSS 20.56 -> 20.1 deg^2 with
+// the lag), and in round 3 fatigue's calibration beyond a static misfit reached 12.0 deg^2 (fatigue_saturating
+// 12.0) against the model's raw 20.1 (its own RSS beyond a static misfit, which the tests compare, was
+// not printed). The run did not reach round 3's tests: in a joint re-fit the process grew inside
+// apply_pressure_lag (the chamber's pressure history; cause not verified, the note's section E) and was
+// killed at 12 GB (another run by the OOM killer at 24 GB). Not run with the whole catalog (over 40 min).
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
