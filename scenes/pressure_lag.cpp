@@ -29,12 +29,15 @@ void for_each_segment(const TrialLoad& tl, double tau, Visit&& visit) {
 /// s = 0 in steps step(s) (the largest step whose chord stays within the tolerance, from the
 /// transient's size at s), each at least 1e-9 of the segment (the staircase's jumps are 1e-9 of a
 /// hold long; keeps the loop finite whatever the transient), the last landing on the segment's end.
+/// Returns false, with the breakpoints so far, when `ts` would grow past `limit` (see
+/// breakpoint_limit): the caller reports it instead of filling the memory.
 template <class Step, class PressureAt>
-void append_breakpoints(double ta, double tb, Step&& step, PressureAt&& p_at, std::vector<double>& ts,
-                        std::vector<double>& ps) {
+bool append_breakpoints(double ta, double tb, Step&& step, PressureAt&& p_at, std::vector<double>& ts,
+                        std::vector<double>& ps, std::size_t limit) {
   const double len = tb - ta, h_min = 1e-9 * len;
   double s = 0.0;
   while (s < len) {
+    if (ts.size() >= limit) return false;
     double h = std::max(step(s), h_min);
     if (s + h >= len * (1.0 - 1e-12)) h = len - s;
     s += h;
@@ -45,6 +48,23 @@ void append_breakpoints(double ta, double tb, Step&& step, PressureAt&& p_at, st
   }
   ts.push_back(tb);
   ps.push_back(p_at(len));
+  return true;
+}
+
+/// The most breakpoints one trial's chamber history may take: 64 per inlet point and 10^5 more.
+/// A lag the tolerance resolves takes a few per inlet point (a staircase's jumps some hundreds);
+/// a second-order lag whose fast stage is many decades below the inlet's sampling (tau2 -> 0, as a
+/// calibration may try) asked for ~10^9 through the step's floor and filled the memory (24 GB in a
+/// diagnosis); past this bound it is an error the caller (or the calibration) sees.
+std::size_t breakpoint_limit(const TrialLoad& tl) { return 64 * tl.time_s.size() + 100000; }
+
+[[noreturn]] void too_many_breakpoints(const TrialLoad& tl, double tau_s, double tau2_s, double tol) {
+  std::ostringstream m;
+  m << "pressure lag (load.pressure_lag_s = " << tau_s << " s, load.pressure_lag2_s = " << tau2_s
+    << " s): the chamber history needs more than " << breakpoint_limit(tl) << " breakpoints for "
+    << tl.time_s.size() << " inlet points to stay within " << tol << " Pa; a lag this fast against the inlet's "
+    << "sampling is not resolved: use a first-order lag (load.pressure_lag2_s = 0) or a longer load.pressure_lag2_s";
+  throw PhysicsError(m.str());
 }
 
 }  // namespace
@@ -83,7 +103,7 @@ LoadHistory apply_pressure_lag(const LoadHistory& inlet, double tau, double tol)
         const double amp = std::abs(C) * std::exp(-s / tau);
         return amp <= tol ? len - s : tau * std::sqrt(8.0 * tol / amp);
       };
-      append_breakpoints(ta, tb, step, p_at, ts, ps);
+      if (!append_breakpoints(ta, tb, step, p_at, ts, ps, breakpoint_limit(tl))) too_many_breakpoints(tl, tau, 0.0, tol);
       return true;
     });
     tl.time_s = std::move(ts);
@@ -190,7 +210,8 @@ void lag_trial2(TrialLoad& tl, const PressureLag& lag, double tol) {
       const double e2 = -(T.tau() * de + e) / b2, e3 = -(T.tau() * e2 + de) / b2;  // from the equation
       return std::sqrt(8.0 * tol / std::sqrt(e2 * e2 + b2 * e3 * e3));
     };
-    append_breakpoints(ta, tb, step, p_at, ts, ps);
+    if (!append_breakpoints(ta, tb, step, p_at, ts, ps, breakpoint_limit(tl)))
+      too_many_breakpoints(tl, lag.tau_s, lag.tau2_s, tol);
     return true;
   });
   tl.time_s = std::move(ts);

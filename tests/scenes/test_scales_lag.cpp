@@ -347,6 +347,34 @@ TEST(PressureLag2, BreakpointsMeetTheToleranceWithoutWaste) {
   }
 }
 
+// A second-order constant far below the inlet's sampling (tau2 -> 0, as a calibration may try: a
+// diagnosis once grew to 24 GB here) either gives a history within the breakpoint bound (64 per
+// inlet point + 1e5, scenes/pressure_lag.cpp) or a PhysicsError naming both keys; never more, and
+// quickly. tau2 = 1e-4 s is still resolved (its fast stage, tau2^2 / tau = 3e-8 s, is passed in a
+// bounded number of steps); at 1e-7 s and below the step's round-off asked for ~1e9 points.
+TEST(PressureLag2, AVanishingSecondConstantIsBoundedOrAClearError) {
+  const double P = 5e3, tol = 0.005 * P;
+  const LoadHistory h = ramp_and_step(P);
+  int errors = 0;
+  for (double tau2 : {1e-4, 1e-6, 1e-7, 1e-9}) {
+    try {
+      const LoadHistory lag = apply_pressure_lag(h, PressureLag{0.3, tau2}, tol);
+      for (const TrialLoad& tl : lag.trials) EXPECT_LE(tl.time_s.size(), 64u * 3u + 100000u) << "tau2 " << tau2;
+      // Resolved: the history is the first-order lag's within the tolerance (the fast stage is gone).
+      const LoadHistory first = apply_pressure_lag(h, PressureLag{0.3, 0.0}, tol);
+      for (std::size_t k = 0; k < 2; ++k)
+        for (double t = 0.5; t <= 9.0; t += 0.5)
+          EXPECT_NEAR(lag.trials[k].pressure(t), first.trials[k].pressure(t), 2.0 * tol) << "tau2 " << tau2 << " t " << t;
+    } catch (const PhysicsError& e) {
+      ++errors;
+      std::printf("tau2 %g s refused: %s\n", tau2, e.what());
+      EXPECT_NE(std::string(e.what()).find("load.pressure_lag2_s"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("breakpoints"), std::string::npos) << e.what();
+    }
+  }
+  std::printf("vanishing tau2: %d of 4 refused\n", errors);
+}
+
 // tau2 = 0 is the first-order lag bit for bit: the same breakpoints and pressures, the same exact
 // values, and a scene with load.pressure_lag2_s = 0 builds the load of one without the key set.
 TEST(PressureLag2, ZeroSecondConstantIsTheFirstOrderLagBitForBit) {
