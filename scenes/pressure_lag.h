@@ -75,7 +75,9 @@ PressureLag scene_pressure_lag(const Scene& scene);
 LoadHistory apply_pressure_lag(const LoadHistory& inlet, double tau_s, double tolerance_Pa);
 
 /// The chamber history of `inlet` through the lag (2) (tau_s > 0, tau2_s >= 0), within
-/// tolerance_Pa (> 0); tau2_s = 0 is the first-order overload, bit for bit.
+/// tolerance_Pa (> 0); tau2_s = 0 is the first-order overload, bit for bit. A history that would
+/// need more than 64 breakpoints per inlet point (+ 10^5) per trial (a tau2_s many decades below
+/// the inlet's sampling) is a PhysicsError naming both keys, not a runaway allocation.
 LoadHistory apply_pressure_lag(const LoadHistory& inlet, const PressureLag& lag, double tolerance_Pa);
 
 /// Exact chamber pressure (1) of one trial at time t (for tests and synthetic data).
