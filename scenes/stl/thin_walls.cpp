@@ -71,7 +71,15 @@ struct AxisBins {
 };
 
 std::string mm_point(const Eigen::Vector3d& p) {
-  return "(" + short_num(p.x() * 1e3) + ", " + short_num(p.y() * 1e3) + ", " + short_num(p.z() * 1e3) + ") mm";
+  // Appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict false positive (GCC bug 105329).
+  std::string s = "(";
+  s += short_num(p.x() * 1e3);
+  s += ", ";
+  s += short_num(p.y() * 1e3);
+  s += ", ";
+  s += short_num(p.z() * 1e3);
+  s += ") mm";
+  return s;
 }
 
 }  // namespace
