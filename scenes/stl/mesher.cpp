@@ -22,10 +22,6 @@ namespace pneufem {
 
 namespace {
 
-std::string mm_point(const Eigen::Vector3d& p) {
-  return "(" + short_num(p.x() * 1e3) + ", " + short_num(p.y() * 1e3) + ", " + short_num(p.z() * 1e3) + ") mm";
-}
-
 /// The shells whose boundary faces are the cavity (see mesher.h).
 std::vector<char> cavity_shells(const TriSurface& s, const StlMeshSpec& spec) {
   std::vector<char> cav(s.shells(), 0);

@@ -19,6 +19,18 @@
 
 namespace pneufem {
 
+std::string mm_point(const Eigen::Vector3d& p_m) {
+  // Appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict false positive (GCC bug 105329).
+  std::string s = "(";
+  s += short_num(p_m.x() * 1e3);
+  s += ", ";
+  s += short_num(p_m.y() * 1e3);
+  s += ", ";
+  s += short_num(p_m.z() * 1e3);
+  s += ") mm";
+  return s;
+}
+
 namespace {
 
 constexpr const char* kRepairHint =

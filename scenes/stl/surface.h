@@ -54,6 +54,9 @@ TriSurface read_closed_surface(const std::string& path, double unit_m);
 /// Whether shell `shell` encloses p (parity of a ray's crossings with it).
 bool shell_encloses(const TriSurface& s, int shell, const Eigen::Vector3d& p);
 
+/// A point (metres) for messages, in millimetres: "(x, y, z) mm", each coordinate as short_num.
+std::string mm_point(const Eigen::Vector3d& p_m);
+
 /// Writes `s` as a binary STL, coordinates divided by `unit_m` (1e-3: the file in mm).
 void write_stl(const std::string& path, const TriSurface& s, double unit_m);
 

@@ -70,18 +70,6 @@ struct AxisBins {
   }
 };
 
-std::string mm_point(const Eigen::Vector3d& p) {
-  // Appended piece by piece: "(" + std::string trips GCC 12's -Wrestrict false positive (GCC bug 105329).
-  std::string s = "(";
-  s += short_num(p.x() * 1e3);
-  s += ", ";
-  s += short_num(p.y() * 1e3);
-  s += ", ";
-  s += short_num(p.z() * 1e3);
-  s += ") mm";
-  return s;
-}
-
 }  // namespace
 
 std::optional<double> ray_thickness(const SurfaceDistance& dist, const Eigen::Vector3d& p, const Eigen::Vector3d& dir,

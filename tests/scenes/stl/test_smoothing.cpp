@@ -63,7 +63,9 @@ TEST(StlSmoothing, RaisesTheWorstAngleAndKeepsTheSurface) {
       ASSERT_TRUE(dist.nearest(smooth.X[n], sp));
       EXPECT_LE(std::abs(sp.distance), 1e-9 * opt.h) << n;
     }
-    if (raw.X[n].z() == opt.slab_z0 || raw.X[n].z() == opt.slab_z1) EXPECT_EQ(smooth.X[n].z(), raw.X[n].z()) << n;
+    if (raw.X[n].z() == opt.slab_z0 || raw.X[n].z() == opt.slab_z1) {
+      EXPECT_EQ(smooth.X[n].z(), raw.X[n].z()) << n;
+    }
   }
 }
 
