@@ -755,18 +755,26 @@ void try_other_forms(Selection& s, int round) {
         joint.params.insert(joint.params.end(), e->params.begin(), e->params.end());
         if (j != k) start.insert(start.end(), s.chosen[j].second.begin(), s.chosen[j].second.end());
       }
-      const auto sets_of = [&](const std::vector<double>& v, const std::vector<double>* alt_values) {
+      // The joint vector with `alt_values` as the k-th effect's constants and the others' from `start`.
+      const auto with_alt = [&](const std::vector<double>& alt_values) {
+        const std::size_t before = [&] {
+          std::size_t n = 0;
+          for (std::size_t j = 0; j < k; ++j) n += effects[j]->params.size();
+          return n;
+        }();
+        std::vector<double> v(start.begin(), start.begin() + static_cast<std::ptrdiff_t>(before));
+        v.insert(v.end(), alt_values.begin(), alt_values.end());
+        v.insert(v.end(), start.begin() + static_cast<std::ptrdiff_t>(before), start.end());
+        return v;
+      };
+      const auto sets_of = [&](const std::vector<double>& v) {
         std::vector<std::string> sets;
         std::size_t o = 0;
-        for (std::size_t j = 0; j < effects.size(); ++j) {
-          std::vector<double> sub;
-          if (alt_values && j == k) {
-            sub = *alt_values;
-          } else {
-            sub.assign(v.begin() + static_cast<std::ptrdiff_t>(o), v.begin() + static_cast<std::ptrdiff_t>(o + effects[j]->params.size()));
-            o += effects[j]->params.size();
-          }
-          const std::vector<std::string> es = effects[j]->sets(s.cal_scene.with(sets), sub);
+        for (const CandidateEffect* e : effects) {
+          const std::vector<double> sub(v.begin() + static_cast<std::ptrdiff_t>(o),
+                                        v.begin() + static_cast<std::ptrdiff_t>(o + e->params.size()));
+          o += e->params.size();
+          const std::vector<std::string> es = e->sets(s.cal_scene.with(sets), sub);
           sets.insert(sets.end(), es.begin(), es.end());
         }
         return sets;
@@ -774,25 +782,15 @@ void try_other_forms(Selection& s, int round) {
       const auto raw_rss = [&](const std::vector<std::string>& sets) { return rss_of(s.rom.at_frames(s.cal_scene.with(sets)), s.frames); };
       long runs = 0;
       // 1. alt alone, the others at their constants.
-      const Calibration own_cal = calibrate(*alt, [&](const std::vector<double>& v) { return raw_rss(sets_of(start, &v)); },
+      const Calibration own_cal = calibrate(*alt, [&](const std::vector<double>& v) { return raw_rss(sets_of(with_alt(v))); },
                                             opt.max_evaluations);
       runs += own_cal.evaluations;
       double rss = own_cal.rss;
       std::vector<double> values;
       if (std::isfinite(own_cal.rss)) {
         // 2. all together, from there.
-        std::vector<double> from;
-        std::size_t o = 0;
-        for (std::size_t j = 0; j < effects.size(); ++j) {
-          if (j == k) {
-            from.insert(from.end(), own_cal.values.begin(), own_cal.values.end());
-          } else {
-            from.insert(from.end(), start.begin() + static_cast<std::ptrdiff_t>(o),
-                        start.begin() + static_cast<std::ptrdiff_t>(o + effects[j]->params.size()));
-            o += effects[j]->params.size();
-          }
-        }
-        const Calibration jc = calibrate(joint, [&](const std::vector<double>& v) { return raw_rss(sets_of(v, nullptr)); },
+        const std::vector<double> from = with_alt(own_cal.values);
+        const Calibration jc = calibrate(joint, [&](const std::vector<double>& v) { return raw_rss(sets_of(v)); },
                                          opt.max_evaluations, &from);
         runs += jc.evaluations;
         if (std::isfinite(jc.rss) && jc.rss < own_cal.rss) {
@@ -822,7 +820,7 @@ void try_other_forms(Selection& s, int round) {
       s.out.selected[k] = alt->name;
       if (s.out.missing_effect == before) s.out.missing_effect = alt->name;
       if (s.out.missing_history_effect == before) s.out.missing_history_effect = alt->name;
-      s.selected_sets = sets_of(values, nullptr);
+      s.selected_sets = sets_of(values);
       s.current = s.metrics(s.cal_scene.with(s.selected_sets));
       s.current_rss = s.current.rss_deg2;
       s.current_static = fit_static_discrepancy(s.current.frames);
