@@ -53,6 +53,7 @@
 
 #include "analysis/model_vs_measured.h"
 #include "app/compare/history.h"
+#include "app/compare/result.h"
 #include "app/simulate/drive.h"
 #include "scenes/scene.h"
 
@@ -73,21 +74,6 @@ struct CompareRunOptions {
   /// The reduced model's cached offline part (solver.model = "reduced"; app/simulate/drive.h);
   /// "" = computed on every run.
   std::string cache_dir;
-};
-
-struct RegionSensitivity {
-  std::string region;
-  long elements = 0;
-  double best_scale = 1.0, variance_fraction = 0.0;
-  double nrmse = 0.0;  ///< pooled NRMSE of the perturbed model
-};
-
-struct CompareRunResult {
-  Comparison comparison;
-  DriveResult drive;
-  std::vector<RegionSensitivity> regions;
-  std::vector<std::string> warnings;
-  double wall_s = 0.0;
 };
 
 /// Runs the comparison and writes the directory (see above). InputError for bad data or scene.

@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "app/compare/command.h"
+#include "app/compare/history.h"
+#include "app/compare/result.h"
 
 namespace pneufem {
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "app/sweep/command.h"
+#include "app/sweep/point.h"
 #include "viz/svg_plot.h"
 
 namespace pneufem {

@@ -21,7 +21,7 @@
 #include <Eigen/Core>
 
 #include "scenes/stl/distance.h"
-#include "scenes/stl/stuffing.h"
+#include "scenes/stl/stuffed_tets.h"
 
 namespace pneufem {
 

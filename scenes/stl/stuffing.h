@@ -46,6 +46,7 @@
 #include <Eigen/Core>
 
 #include "scenes/stl/distance.h"
+#include "scenes/stl/stuffed_tets.h"
 
 namespace pneufem {
 
@@ -80,21 +81,6 @@ struct StuffingOptions {
   /// Step 7: tetrahedra the cut made with a dihedral angle below this are improved by vertex
   /// smoothing (scenes/stl/smoothing.h); 0 = none.
   double smooth_target_deg = 15.0;
-};
-
-struct StuffedTets {
-  std::vector<Eigen::Vector3d> X;            ///< nodes (m)
-  std::vector<std::array<int, 4>> tets;      ///< positive volume
-  std::vector<char> on_surface;              ///< per node: phi = 0 (a cut point or a warped vertex)
-  std::vector<char> on_symmetry;             ///< per node: on the plane x = 0 (half)
-  std::vector<char> from_cut;                ///< per node: a cut point, or a grid vertex the cut moved
-  std::array<std::vector<double>, 3> lines;  ///< the grid lines
-  int warped = 0;                            ///< vertices moved onto the surface
-  int cut_points = 0;
-  int on_sharp_edges = 0;                    ///< surface nodes moved onto a sharp edge (step 6)
-  int creased = 0;                           ///< surface vertices moved onto a crease (step 4b)
-  int flat_dropped = 0;                      ///< stencil tetrahedra of no volume, left out
-  int smoothed = 0;                          ///< vertex moves of step 7
 };
 
 /// Steps 1-5 above. `dist` must answer within a band of at least max_cell_diagonal(opt, surface).
