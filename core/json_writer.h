@@ -51,6 +51,13 @@ inline std::string array(const std::vector<double>& v) {
   return s + "]";
 }
 
+/// An array of strings, each quoted: ["a", "b"].
+inline std::string strings(const std::vector<std::string>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + quote(v[i]);
+  return s + "]";
+}
+
 /// Ordered object builder: obj.add("key", raw_json_value).
 class Object {
  public:

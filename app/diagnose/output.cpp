@@ -69,38 +69,20 @@ void add_equivalence_and_costs(json::Object& root, const DiagnosisResult& out) {
   root.add("round_costs", rc + "]");
 }
 
-}  // namespace
-
-void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
-                     const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out) {
-  fs::create_directories(opt.out_dir);
-  json::Object root;
-  root.add_str("version", version_string());
-  root.add_str("command", opt.command_line);
-  root.add_str("data", opt.data_path);
-  // A failed diagnosis (run_diagnosis's failure path) writes what it had done, saying so here.
-  root.add_str("status", out.failure.empty() ? std::string("ok") : "failed: " + out.failure);
-  json::Object b;
-  b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
-  b.add("rmse_deg_per_trial", json::array(out.baseline_rmse_deg_per_trial));
-  if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
-  root.add("baseline", b.str(2));
+/// diagnosis.json's "candidates": one object per candidate and round.
+std::string candidates_json(const std::vector<CandidateResult>& candidates) {
   std::string cs = "[";
-  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
-    const CandidateResult& c = out.candidates[i];
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const CandidateResult& c = candidates[i];
     json::Object p;
     for (std::size_t j = 0; j < c.params.size(); ++j) p.add(c.param_names[j], c.params[j]);
     json::Object o;
     o.add_str("effect", c.effect).add("round", c.round).add("nrmse", c.nrmse);
     o.add("nrmse_per_trial", json::array(c.nrmse_per_trial)).add("params", c.params.empty() ? "{}" : p.str(6));
-    std::string sets = "[";
-    for (std::size_t j = 0; j < c.sets.size(); ++j) sets += (j ? ", " : "") + json::quote(c.sets[j]);
-    o.add("sets", sets + "]").add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
+    o.add("sets", json::strings(c.sets)).add("delta_aic", c.delta_aic).add("removed_fraction", c.removed);
     o.add("significant", c.significant ? "true" : "false").add("evaluations", c.evaluations).add("wall_s", c.wall_s);
     o.add_str("why", c.why);
-    std::string ab = "[";
-    for (std::size_t j = 0; j < c.at_bound.size(); ++j) ab += (j ? ", " : "") + json::quote(c.at_bound[j]);
-    o.add("at_bound", ab + "]");
+    o.add("at_bound", json::strings(c.at_bound));
     o.add("nrmse_beyond_static", c.nrmse_beyond_static).add("delta_aic_beyond_static", c.delta_aic_beyond_static);
     o.add("removed_fraction_beyond_static", c.removed_beyond_static).add("beyond_static", c.beyond_static ? "true" : "false");
     if (c.static_change_nrmse >= 0.0) o.add("static_change_nrmse", c.static_change_nrmse);
@@ -116,37 +98,82 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     if (!c.error.empty()) o.add_str("error", c.error);
     cs += (i ? ",\n    " : "\n    ") + o.str(4);
   }
-  root.add("candidates", cs + "\n  ]");
+  return cs + "\n  ]";
+}
+
+/// diagnosis.json's method.calibration_mesh: the calibration mesh and its correction, so a reader
+/// can judge its size against the effects'.
+std::string calibration_mesh_json(const PathModelEvaluator& rom, const DiagnoseOptions& opt) {
+  json::Object cm;
+  const std::vector<double>& f = rom.fine_curve();
+  const std::vector<double>& c = rom.coarse_curve();
+  std::vector<double> p;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    p.push_back(rom.reference_peak_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
+  cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
+  std::vector<double> m;
+  for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
+  cm.add("pressure_kPa", json::array(p)).add("scene_mesh_angle_deg", json::array(f)).add("calibration_mesh_angle_deg", json::array(c));
+  cm.add("mapped_pressure_kPa", json::array(m));
+  cm.add_str("scene_mesh_sweep_source", rom.fine_source());
+  return cm.str(4);
+}
+
+/// diagnosis.json's "method": the evaluator, its elastic path and cache, the calibration mesh and
+/// the selection's settings and cost.
+std::string method_json(const PathModelEvaluator& rom, const DiagnoseOptions& opt, const DiagnosisResult& out) {
+  json::Object method;
+  method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
+                                  " material points, elastic path to " +
+                                  fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
+  method.add("reference_peak_kPa", rom.reference_peak_Pa() * 1e-3);
+  method.add_str("elastic_path_source", rom.path_source());
+  method.add("static_curves_from_cache", rom.curves_from_cache()).add("static_curves_computed", rom.curves_computed());
+  if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
+  if (opt.calibration_h_mm > 0.0) method.add("calibration_mesh", calibration_mesh_json(rom, opt));
+  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects)
+      .add("min_static_change", opt.min_static_change);
+  method.add("trust_elastic_model", opt.trust_elastic_model ? "true" : "false");
+  method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
+  return method.str(2);
+}
+
+/// diagnosis.json's "refined_params": the constants the accurate model refined, per effect.
+std::string refined_params_json(const ChosenEffects& chosen) {
+  std::string rp = "{";
+  for (std::size_t j = 0; j < chosen.size(); ++j) {
+    json::Object p;
+    for (std::size_t i = 0; i < chosen[j].first->params.size(); ++i) p.add(chosen[j].first->params[i].name, chosen[j].second[i]);
+    rp += (j ? ", " : "") + json::quote(chosen[j].first->name) + ": " + p.str(4);
+  }
+  return rp + "}";
+}
+
+/// diagnosis.json, whole (schema in the README).
+std::string diagnosis_json(const Scene& scene, const PathModelEvaluator& rom, const ChosenEffects& chosen,
+                           const DiagnoseOptions& opt, const DiagnosisResult& out) {
+  json::Object root;
+  root.add_str("version", version_string());
+  root.add_str("command", opt.command_line);
+  root.add_str("data", opt.data_path);
+  // A failed diagnosis (run_diagnosis's failure path) writes what it had done, saying so here.
+  root.add_str("status", out.failure.empty() ? std::string("ok") : "failed: " + out.failure);
+  json::Object b;
+  b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
+  b.add("rmse_deg_per_trial", json::array(out.baseline_rmse_deg_per_trial));
+  if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
+  root.add("baseline", b.str(2));
+  root.add("candidates", candidates_json(out.candidates));
   root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
   root.add("missing_history_effect", out.missing_history_effect.empty() ? "null" : json::quote(out.missing_history_effect));
   if (!out.stopped.empty()) root.add("stopped", json::quote(out.stopped));
-  {
-    std::string eq = "[";
-    for (std::size_t j = 0; j < out.equivalents.size(); ++j) eq += (j ? ", " : "") + json::quote(out.equivalents[j]);
-    root.add("equivalents", eq + "]");
-    std::string fc = "[";
-    for (std::size_t j = 0; j < out.form_changes.size(); ++j) fc += (j ? ", " : "") + json::quote(out.form_changes[j]);
-    root.add("form_changes", fc + "]");
-  }
+  root.add("equivalents", json::strings(out.equivalents));
+  root.add("form_changes", json::strings(out.form_changes));
   add_equivalence_and_costs(root, out);
-  std::string sel = "[";
-  for (std::size_t j = 0; j < out.selected.size(); ++j) sel += (j ? ", " : "") + json::quote(out.selected[j]);
-  root.add("selected", sel + "]");
+  root.add("selected", json::strings(out.selected));
   root.add("intervals", intervals_json(out.intervals));
-  {
-    std::string notes = "[";
-    for (std::size_t j = 0; j < out.interval_notes.size(); ++j) notes += (j ? ", " : "") + json::quote(out.interval_notes[j]);
-    root.add("interval_notes", notes + "]");
-  }
-  if (!out.refined_params.empty()) {
-    std::string rp = "{";
-    for (std::size_t j = 0; j < chosen.size(); ++j) {
-      json::Object p;
-      for (std::size_t i = 0; i < chosen[j].first->params.size(); ++i) p.add(chosen[j].first->params[i].name, chosen[j].second[i]);
-      rp += (j ? ", " : "") + json::quote(chosen[j].first->name) + ": " + p.str(4);
-    }
-    root.add("refined_params", rp + "}");
-  }
+  root.add("interval_notes", json::strings(out.interval_notes));
+  if (!out.refined_params.empty()) root.add("refined_params", refined_params_json(chosen));
   if (!out.refined_model.empty()) {
     root.add_str("refined_model", out.refined_model);
     root.add("refined_nrmse", out.refined_nrmse);
@@ -161,48 +188,28 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
   sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
   root.add("static_remainder", sr.str(2));
   if (!out.fem_error.empty()) root.add_str("fem_error", out.fem_error);
-  json::Object method;
-  method.add_str("evaluator", "reduced path model (engine/path_model.h), " + std::to_string(rom.path().num_points()) +
-                                  " material points, elastic path to " +
-                                  fmt("%.1f", rom.path().path_pressure_Pa().back() * 1e-3) + " kPa");
-  method.add("reference_peak_kPa", rom.reference_peak_Pa() * 1e-3);
-  method.add_str("elastic_path_source", rom.path_source());
-  method.add("static_curves_from_cache", rom.curves_from_cache()).add("static_curves_computed", rom.curves_computed());
-  if (!opt.cache_dir.empty()) method.add_str("cache_dir", opt.cache_dir);
-  if (opt.calibration_h_mm > 0.0) {
-    // The calibration mesh and its correction, so a reader can judge its size against the effects'.
-    json::Object cm;
-    const std::vector<double>& f = rom.fine_curve();
-    const std::vector<double>& c = rom.coarse_curve();
-    std::vector<double> p;
-    for (std::size_t i = 0; i < f.size(); ++i) p.push_back(rom.reference_peak_Pa() * 1e-3 * static_cast<double>(i) / static_cast<double>(f.size() - 1));
-    cm.add("h_mm", opt.calibration_h_mm).add("dofs", static_cast<double>(rom.dofs())).add("scene_dofs", static_cast<double>(rom.fine_dofs()));
-    std::vector<double> m;
-    for (double v : rom.pressure_map_Pa()) m.push_back(v * 1e-3);
-    cm.add("pressure_kPa", json::array(p)).add("scene_mesh_angle_deg", json::array(f)).add("calibration_mesh_angle_deg", json::array(c));
-    cm.add("mapped_pressure_kPa", json::array(m));
-    cm.add_str("scene_mesh_sweep_source", rom.fine_source());
-    method.add("calibration_mesh", cm.str(4));
-  }
-  method.add("aic_threshold", opt.aic_threshold).add("min_removed", opt.min_removed).add("max_effects", opt.max_effects)
-      .add("min_static_change", opt.min_static_change);
-  method.add("trust_elastic_model", opt.trust_elastic_model ? "true" : "false");
-  method.add("reduced_model_runs", static_cast<double>(out.rom_runs)).add("wall_s", out.wall_s);
-  root.add("method", method.str(2));
+  root.add("method", method_json(rom, opt, out));
   root.add("scene", scene.to_json());
-  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
-  write_file_atomic((fs::path(opt.out_dir) / "fitted.toml").string(), out.fitted_toml);
+  return root.str() + "\n";
+}
+
+/// diagnosis.csv: one row per candidate and round.
+std::string candidates_csv(const std::vector<CandidateResult>& candidates) {
   std::string csv = "round,effect,nrmse,delta_aic,removed_fraction,significant,evaluations,params,nrmse_beyond_static,beyond_static\n";
-  for (const CandidateResult& c : out.candidates) {
+  for (const CandidateResult& c : candidates) {
     std::string p;
     for (std::size_t j = 0; j < c.params.size(); ++j) p += (j ? ";" : "") + c.param_names[j] + "=" + json::num(c.params[j]);
     csv += std::to_string(c.round) + "," + c.effect + "," + json::num(c.nrmse) + "," + json::num(c.delta_aic) + "," +
            json::num(c.removed) + "," + (c.significant ? "1" : "0") + "," + std::to_string(c.evaluations) + "," + p + "," +
            json::num(c.nrmse_beyond_static) + "," + (c.beyond_static ? "1" : "0") + "\n";
   }
-  write_file_atomic((fs::path(opt.out_dir) / "diagnosis.csv").string(), csv);
+  return csv;
+}
+
+/// calibration.csv: every evaluation of every calibration.
+std::string calibration_csv(const std::vector<CandidateResult>& candidates) {
   std::string tr = "round,effect,evaluation,params,rss_deg2,error\n";
-  for (const CandidateResult& c : out.candidates)
+  for (const CandidateResult& c : candidates)
     for (std::size_t i = 0; i < c.trace.size(); ++i) {
       std::string p;
       for (std::size_t j = 0; j < c.trace[i].params.size(); ++j)
@@ -212,17 +219,13 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
       tr += std::to_string(c.round) + "," + c.effect + "," + std::to_string(i + 1) + "," + p + "," +
             (std::isfinite(c.trace[i].rss_deg2) ? json::num(c.trace[i].rss_deg2) : std::string("inf")) + ",\"" + e + "\"\n";
     }
-  write_file_atomic((fs::path(opt.out_dir) / "calibration.csv").string(), tr);
-  const std::string failed =
-      out.failure.empty() ? std::string()
-                          : "> **This diagnosis failed** after " + std::to_string(out.after_round.size()) +
-                                " selected effect(s): " + out.failure +
-                                ". What follows is what it had done before; the missing effect and fitted.toml are those "
-                                "of the rounds that finished, not a result.\n\n";
-  write_file_atomic((fs::path(opt.out_dir) / "report.md").string(), failed + diagnosis_report(scene, rec, rom, opt, out));
-  // History: the baseline, then the model after each round (the path model's errors; the last
-  // round carries fitted.toml's hash only without a refinement), then the refined model by the
-  // model that refined it, each with the error per trial, so the fall shows trial by trial.
+  return tr;
+}
+
+/// The history lines: the baseline, then the model after each round (the path model's errors; the
+/// last round carries fitted.toml's hash only without a refinement), then the refined model by the
+/// model that refined it, each with the error per trial, so the fall shows trial by trial.
+void append_diagnosis_history(const Scene& scene, const Scene& fitted, const DiagnoseOptions& opt, const DiagnosisResult& out) {
   HistoryEntry h;
   h.time_utc = utc_now();
   h.source = "diagnose";
@@ -252,6 +255,26 @@ void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& r
     h.trial_rmse_deg.clear();
     append_history(opt.out_dir, h);
   }
+}
+
+}  // namespace
+
+void write_diagnosis(const Scene& scene, const Scene& fitted, const Recording& rec, const PathModelEvaluator& rom,
+                     const ChosenEffects& chosen, const DiagnoseOptions& opt, const DiagnosisResult& out) {
+  fs::create_directories(opt.out_dir);
+  const fs::path dir(opt.out_dir);
+  write_file_atomic((dir / "diagnosis.json").string(), diagnosis_json(scene, rom, chosen, opt, out));
+  write_file_atomic((dir / "fitted.toml").string(), out.fitted_toml);
+  write_file_atomic((dir / "diagnosis.csv").string(), candidates_csv(out.candidates));
+  write_file_atomic((dir / "calibration.csv").string(), calibration_csv(out.candidates));
+  const std::string failed =
+      out.failure.empty() ? std::string()
+                          : "> **This diagnosis failed** after " + std::to_string(out.after_round.size()) +
+                                " selected effect(s): " + out.failure +
+                                ". What follows is what it had done before; the missing effect and fitted.toml are those "
+                                "of the rounds that finished, not a result.\n\n";
+  write_file_atomic((dir / "report.md").string(), failed + diagnosis_report(scene, rec, rom, opt, out));
+  append_diagnosis_history(scene, fitted, opt, out);
 }
 
 }  // namespace pneufem::diagnose_detail
