@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
+  bool dump_every = false;
   bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
   double rom_time_tol = 0.0;
@@ -136,7 +137,8 @@ int main(int argc, char** argv) {
     else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
-    else if (a == "--dump-points") dump = true;  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
+    else if (a == "--dump-points") dump = true;
+    else if (a == "--dump-every") dump = dump_every = true;  // as --dump-points, plus per-region viscous strain at every report  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
     else if (a == "--fabric-strain") fabric_strain = true;  // largest Green strain of the stiff parts per report, ROM vs the snapshot
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
@@ -431,6 +433,25 @@ int main(int argc, char** argv) {
       for (int a = 0; a < geom.npe; ++a) F += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
       return std::sqrt(Eigen::SelfAdjointEigenSolver<Mat3>(F.transpose() * F).eigenvalues().maxCoeff());
     };
+    if (dump_every) {
+      // Where the reduced history parts from the FEM's: per region, the kept points' viscous strain sum,
+      // ROM / FEM - 1 in %, at every report (climb, hold end, release), then the damage sum's.
+      std::printf("viscous strain per region at every report, ROM/FEM - 1 %% (trial, p kPa, then region: %%):\n");
+      for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
+        std::map<int, std::array<double, 2>> reg;
+        double dr_sum = 0, df_sum = 0;
+        for (int k = 0; k < rom.num_points(); ++k) {
+          const int e = rom.element_of_point(k), qp = k % geom.nqp;
+          reg[bm->model.mesh.region[e]][0] += rom_h[i][2 * k + 1];
+          reg[bm->model.mesh.region[e]][1] += fh[i][2 * (e * geom.nqp + qp) + 1];
+          dr_sum += rom_h[i][2 * k], df_sum += fh[i][2 * (e * geom.nqp + qp)];
+        }
+        std::printf("  %2d %6.2f", ftrial[i], red.p[i] * 1e-3);
+        for (const auto& [r, v] : reg)
+          std::printf("  %s %+6.1f (%.2e)", bm->model.mesh.region_names[r].substr(0, 6).c_str(), 100 * (v[0] / v[1] - 1), v[1]);
+        std::printf("  damage %+5.1f\n", 100 * (dr_sum / std::max(df_sum, 1e-300) - 1));
+      }
+    }
     for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
       if (i + 1 < fu.size() && ftrial[i + 1] == ftrial[i]) continue;  // last report of a trial
       // the loaded top: the report before the last (the last one is at the hold end, same p)
