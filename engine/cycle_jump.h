@@ -30,7 +30,7 @@
 // exact when z is quadratic in the cycle count (a steadily changing increment), built from two
 // applications of each law's linear rule (1) (an affine combination in z composes; jump_point),
 // and with each law's clips of (1) on both: damage never heals, so a settling history whose
-// increment falls by more than half per cycle (D_k < (N + 1) / (N + 3) D_(k-1)) is held where it is.
+// increment falls fast, D_k < (N + 1) / (N + 3) D_(k-1) (by more than half at N = 1), is held where it is.
 // For increments that change geometrically, D_(k+m) = r^m D_k, the clipped (1') is closer than (1)
 // for any r > 0 at N = 1 (error D_k (1 - r)^2 / r, or r D_k when clipped, against |1 - r| D_k), the
 // case the control below allows.
