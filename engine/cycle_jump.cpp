@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace pneufem {
@@ -40,6 +41,30 @@ std::vector<double> jump_history(const Assembler& asmb, std::span<const double> 
   std::vector<double> out(after.begin(), after.end());
   for_each_point(asmb, [&](const Material& mat, std::size_t, std::size_t o, std::size_t ss) {
     mat.jump_cycles(before.subspan(o, ss), after.subspan(o, ss), cycles, std::span<double>(out).subspan(o, ss));
+  });
+  return out;
+}
+
+void jump_point(const Material& mat, std::span<const double> first, std::span<const double> before,
+                std::span<const double> after, double cycles, std::span<double> out) {
+  if (!(cycles >= 0.0)) throw std::invalid_argument("jump_point: the number of cycles must be >= 0");
+  if (first.size() != after.size() || before.size() != after.size() || out.size() != after.size())
+    throw std::invalid_argument("jump_point: the three cycle ends and the output must be one point's state");
+  // jump(x, y, c) = (1 + c) y - c x in z. P = jump(first, before, c1), then jump(P, after, c2) =
+  // (1 + c2) z_k - c2 (1 + c1) z_(k-1) + c2 c1 z_(k-2); with c2 = N (N + 3) / 2, c1 = (N + 1) / (N + 3)
+  // the weights are (N + 1)(N + 2) / 2, -N (N + 2), N (N + 1) / 2: (1') of cycle_jump.h.
+  const double c1 = (cycles + 1.0) / (cycles + 3.0), c2 = 0.5 * cycles * (cycles + 3.0);
+  std::vector<double> p(after.size());
+  mat.jump_cycles(first, before, c1, p);
+  mat.jump_cycles(p, after, c2, out);
+}
+
+std::vector<double> jump_history(const Assembler& asmb, std::span<const double> first, std::span<const double> before,
+                                 std::span<const double> after, double cycles) {
+  std::vector<double> out(after.begin(), after.end());
+  for_each_point(asmb, [&](const Material& mat, std::size_t, std::size_t o, std::size_t ss) {
+    jump_point(mat, first.subspan(o, ss), before.subspan(o, ss), after.subspan(o, ss), cycles,
+               std::span<double>(out).subspan(o, ss));
   });
   return out;
 }

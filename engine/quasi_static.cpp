@@ -179,6 +179,9 @@ QuasiStaticRun::QuasiStaticRun(const Assembler& assembler, QuasiStaticOptions op
   if (opt_.cycle_jump.on) {
     if (!(opt_.cycle_jump.tol > 0.0) || !(opt_.cycle_jump.change > 0.0))
       throw InputError("quasi-static run: cycle jumping needs tol > 0 and change > 0");
+    if (opt_.cycle_jump.order != 1 && opt_.cycle_jump.order != 2)
+      throw InputError("quasi-static run: cycle jumping's order must be 1 (linear) or 2 (three-point), got " +
+                       std::to_string(opt_.cycle_jump.order));
     std::string law;
     if (!model_jumps_cycles(asm_, law))
       throw InputError("cycle jumping: the material '" + law + "' does not say how its history extrapolates over "
@@ -593,7 +596,12 @@ std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::
     std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g (reported angles %.3g), change %.3g -> skip %d trials\n",
                  trial + 1, e1, ea, c1, n);
   if (n < 1) return i;
-  state_ = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
+  // (1') through the three trial ends, controlled by the linear rule's estimate (local extrapolation).
+  const std::vector<double> linear = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
+  state_ = opt_.cycle_jump.order == 2 ? jump_history(asm_, cycle_ends_[0], cycle_ends_[1], cycle_ends_[2], n) : linear;
+  if (opt_.newton.verbose && opt_.cycle_jump.order == 2)
+    std::fprintf(stderr, "  cycle jump: the three-point rule differs from the linear one by %.3g (weighted as (2))\n",
+                 history_jump_error(asm_, share, linear, state_));
   // The skipped trials' reports, extrapolated linearly in the trial count from the last two trials.
   const std::vector<StateRecord>& a = cycle_reports_[cycle_reports_.size() - 2];
   const std::vector<StateRecord>& b = cycle_reports_.back();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,107 @@ TEST(CycleJump, MullinsExtrapolatesThePeakEnergyAndBoundsItsEffect) {
     largest = std::max(largest, std::abs(ogden_roxburgh(W, 1100.0, mp).eta - ogden_roxburgh(W, 1150.0, mp).eta));
   EXPECT_GE(bound, largest);
   EXPECT_LE(bound, 2.0 * largest) << "the bound should be close, not just safe";
+}
+
+// (1') of cycle_jump.h, the three-point rule composed of two linear jumps (jump_point): exact when
+// each law's measure is quadratic in the cycle count. Fatigue (n = 10): z = s^(-9) = 1 + 0.1 j +
+// 0.02 j^2; Mullins: W_max = 1000 + 50 j + 4 j^2 (Pa). Both come back at j = 2 + N to round-off
+// (1e-12 relative: a few ulps through pow over z up to ~4), while the linear rule (1) misses by
+// the quadratic term N (N + 1) / 2 times the second difference, which the test also checks.
+TEST(CycleJump, ThreePointRuleIsExactForAQuadraticHistory) {
+  FatigueParams p;
+  p.W_th_Pa = 5.7e3;
+  p.tau_s = 2000.0;
+  p.n = 10.0;
+  const MaterialPtr stack = make_fatigue(make_mullins(neo_hookean(kMu, 100 * kMu), MullinsParams{2.0, 500.0, 0.1}), p);
+  const int own = static_cast<const FatigueDamage&>(*stack).own_state_size();  // [s, rho], then Mullins [W_max, eta]
+  const auto z = [](double j) { return 1.0 + 0.1 * j + 0.02 * j * j; };
+  const auto W = [](double j) { return 1000.0 + 50.0 * j + 4.0 * j * j; };
+  const auto state_at = [&](double j) {
+    std::vector<double> st(static_cast<std::size_t>(stack->state_size()));
+    stack->init_state(st);
+    st[0] = std::pow(z(j), -1.0 / 9.0);
+    st[own] = W(j);
+    return st;
+  };
+  const std::vector<double> h0 = state_at(0), h1 = state_at(1), h2 = state_at(2);
+  for (const double N : {1.0, 2.0, 5.0}) {
+    std::vector<double> quad(h2.size()), lin(h2.size());
+    jump_point(*stack, h0, h1, h2, N, quad);
+    stack->jump_cycles(h1, h2, N, lin);
+    const std::vector<double> exact = state_at(2 + N);
+    EXPECT_NEAR(quad[0], exact[0], 1e-12 * exact[0]) << "N = " << N;
+    EXPECT_NEAR(quad[own], exact[own], 1e-12 * exact[own]) << "N = " << N;
+    // The linear rule misses W's quadratic term: N (N + 1) / 2 * (2 * 4 Pa).
+    EXPECT_NEAR(exact[own] - lin[own], 0.5 * N * (N + 1) * 8.0, 1e-9 * exact[own]) << "N = " << N;
+    EXPECT_EQ(quad[own + 1], h2[own + 1]);  // eta_last: the last cycle's
+  }
+}
+
+// For increments that change geometrically, D_(k+1) = r D_k, the clipped (1') at N = 1 errs by
+// D_k (1 - r)^2 / r where 2 D_k - D_(k-1) >= 0 (r >= 1/2) and by r D_k where the clip holds the
+// history (r < 1/2); (1) errs by |1 - r| D_k: the three-point rule is never the worse one, whether
+// the history settles (r < 1) or accelerates (r > 1), as cycle_jump.h states. On the Mullins peak
+// energy, W_max,k = 1000 Pa + D_0 (1 + r + ... + r^(k-1)), D_0 = 100 Pa.
+TEST(CycleJump, ThreePointRuleBeatsTheLinearOneForGeometricIncrements) {
+  const MaterialPtr mul = make_mullins(neo_hookean(kMu, 100 * kMu), MullinsParams{2.0, 500.0, 0.1});
+  for (const double r : {0.2, 0.45, 0.55, 0.8, 0.95, 1.05, 1.3, 2.0, 3.0}) {
+    std::vector<std::vector<double>> h(4, std::vector<double>{0.0, 1.0});
+    double d = 100.0, w = 1000.0;
+    for (auto& st : h) st[0] = w, w += d, d *= r;
+    std::vector<double> quad(2), lin(2);
+    jump_point(*mul, h[0], h[1], h[2], 1.0, quad);
+    mul->jump_cycles(h[1], h[2], 1.0, lin);
+    const double Dk = h[2][0] - h[1][0];
+    const double quad_err = std::abs(quad[0] - h[3][0]), lin_err = std::abs(lin[0] - h[3][0]);
+    const double expected = r >= 0.5 ? Dk * (1 - r) * (1 - r) / r : r * Dk;
+    EXPECT_NEAR(quad_err, expected, 1e-9 * h[3][0]) << "r = " << r;
+    EXPECT_NEAR(lin_err, std::abs(1 - r) * Dk, 1e-9 * h[3][0]) << "r = " << r;
+    EXPECT_LT(quad_err, lin_err) << "r = " << r;
+  }
+}
+
+// Against cycles computed one by one: a fatigue point whose stretch grows by 0.004 per cycle (a
+// structure that softens under a repeated load) damages faster each cycle; the linear rule (1)
+// under-predicts the damage 10 cycles on by about N (N + 1) / 2 times the second difference of z,
+// always with the same sign (the bias the three-point rule removes), and (1') is several times
+// closer: what remains is the third difference's N (N + 1) (N + 2) / 6 term, which the test bounds
+// by that term computed from the same cycles (x 2: the third difference itself changes a little).
+TEST(CycleJump, ThreePointRuleFollowsAnAcceleratingFatigueHistory) {
+  FatigueParams p;
+  p.driver = FatigueDriver::max_principal_stretch;
+  p.lambda_th = 1.2;
+  p.tau_s = 400.0;
+  p.n = 10.0;
+  const MaterialPtr mat = make_fatigue(neo_hookean(kMu, 100 * kMu), p);
+  std::vector<double> s(static_cast<std::size_t>(mat->state_size())), t(s.size());
+  mat->init_state(s);
+  std::vector<std::vector<double>> ends;
+  PointResponse resp;
+  double time = 0.0;
+  for (int k = 0; k < 16; ++k) {
+    const Mat3 F = stretch(1.25 + 0.004 * k), I = Mat3::Identity();
+    for (const auto& [Fk, dt] : {std::pair{I, 5.0}, std::pair{F, 0.0}, std::pair{F, 10.0}}) {
+      time += dt;
+      mat->evaluate(std::span<const Mat3>(&Fk, 1), TimeStep{time, dt}, s, t, std::span<PointResponse>(&resp, 1), false);
+      s = t;
+    }
+    ends.push_back(s);
+  }
+  const auto z = [&](int j) { return std::pow(ends[static_cast<std::size_t>(j)][0], -9.0); };
+  const int k = 4, N = 10;
+  std::vector<double> quad(s.size()), lin(s.size());
+  jump_point(*mat, ends[k - 2], ends[k - 1], ends[k], N, quad);
+  mat->jump_cycles(ends[k - 1], ends[k], N, lin);
+  const double exact = z(k + N), zq = std::pow(quad[0], -9.0), zl = std::pow(lin[0], -9.0);
+  const double second = z(k) - 2 * z(k - 1) + z(k - 2), third = z(k + 1) - 3 * z(k) + 3 * z(k - 1) - z(k - 2);
+  std::printf("z(k + N) %.6g: linear %.6g, three-point %.6g; second difference %.3g, third %.3g\n", exact, zl, zq,
+              second, third);
+  ASSERT_GT(second, 0.0) << "the test needs an accelerating history";
+  EXPECT_LT(zl, exact);  // the linear rule's one-signed bias
+  EXPECT_NEAR(exact - zl, 0.5 * N * (N + 1) * second, 0.5 * (exact - zl)) << "the missed quadratic term";
+  EXPECT_LE(std::abs(zq - exact), 2.0 * N * (N + 1) * (N + 2) / 6.0 * std::abs(third));
+  EXPECT_LT(std::abs(zq - exact), 0.5 * (exact - zl));
 }
 
 // (3) of cycle_jump.h: N (N + 1) / 2 e1 <= tol and N c1 <= change, within the cycles left.
@@ -260,6 +362,16 @@ TEST_F(CycleJumpBlock, SkipsTrialsAndEndsCloseToTheEveryTrialRun) {
               jumped_->stats.cycle_jumps, jumped_->stats.trials_extrapolated, jumped_->stats.states,
               every_->stats.states, e, drift);
   EXPECT_LE(e, 2.0 * CycleJumpOptions{}.tol);
+  // The same jump with the linear rule (1): its end history is farther from the every-trial run's
+  // (the damage per trial grows as the block softens under its constant force, a curvature (1) misses).
+  CycleJumpOptions linear;
+  linear.on = true;
+  linear.order = 1;
+  const BlockRun lin = run_block(*asmb_, linear, kTrials);
+  ASSERT_EQ(lin.stats.trials_extrapolated, jumped_->stats.trials_extrapolated);
+  const double e_lin = history_jump_error(*asmb_, {}, lin.state, every_->state);
+  std::printf("block, linear rule: end history error %.3g\n", e_lin);
+  EXPECT_LT(e, e_lin);
 }
 
 // Damage that accelerates (the fast block: 2-6 % of stiffness per trial at its points, growing):
@@ -313,6 +425,18 @@ TEST_F(CycleJumpBlock, DifferentTrialsAreRefusedWithAnInputError) {
   EXPECT_THROW(run.run(load, nullptr), InputError);
 }
 
+// Bad input to the three-point rule and the run: clear errors, not a silent linear jump.
+TEST_F(CycleJumpBlock, BadOrderOrStatesAreRefused) {
+  QuasiStaticOptions opt;
+  opt.cycle_jump.on = true;
+  opt.cycle_jump.order = 3;
+  EXPECT_THROW(QuasiStaticRun(*asmb_, opt), InputError);
+  const Material& mat = asmb_->model().material_of(0);
+  std::vector<double> a(static_cast<std::size_t>(mat.state_size()), 0.5), shorter(a.size() - 1), out(a.size());
+  EXPECT_THROW(jump_point(mat, shorter, a, a, 1.0, out), std::invalid_argument);
+  EXPECT_THROW(jump_point(mat, a, a, a, -1.0, out), std::invalid_argument);
+}
+
 // ------------------------------------------------------------------ the pneu-net
 
 // The 3-chamber pneu-net of tests/app/test_story.cpp (h = 6 mm, the story's Mullins and fatigue
@@ -329,10 +453,11 @@ struct PneunetRun {
   QuasiStaticStats stats;
 };
 
-PneunetRun run_pneunet(const std::vector<std::string>& extra) {
+PneunetRun run_pneunet(const std::vector<std::string>& extra, int order = CycleJumpOptions{}.order) {
   std::vector<std::string> sets = kPneunet;
   sets.insert(sets.end(), extra.begin(), extra.end());
   const std::unique_ptr<BuiltModel> bm = build_model(Scene::load(kStoryScene, sets));
+  bm->solver.quasi_static.cycle_jump.order = order;
   const Assembler asmb(bm->model);
   QuasiStaticRun run(asmb, bm->solver.quasi_static);
   PneunetRun out;
@@ -359,12 +484,15 @@ std::pair<double, double> angle_errors(const PneunetRun& every, const PneunetRun
 TEST(CycleJumpPneunet, LastTrialWithinTrackingNoiseOfTheEveryTrialRun) {
   const PneunetRun every = run_pneunet({});
   const PneunetRun jumped = run_pneunet({"solver.cycle_jump=true"});
-  const PneunetRun loose = run_pneunet({"solver.cycle_jump=true", "solver.cycle_jump_tol=0.02", "solver.cycle_jump_change=0.2"});
+  const std::vector<std::string> loose_sets = {"solver.cycle_jump=true", "solver.cycle_jump_tol=0.02",
+                                               "solver.cycle_jump_change=0.2"};
+  const PneunetRun loose = run_pneunet(loose_sets);
+  const PneunetRun loose_linear = run_pneunet(loose_sets, 1);
   // The drift the jumps extrapolate: the top angle (the last report) of the last trial against trial 3's.
   double top3 = 0.0;
   for (std::size_t i = 0; i + 1 < every.records.size(); ++i)
     if (every.records[i].trial == 3 && every.records[i + 1].trial == 4) top3 = every.records[i].angle_deg;
-  for (const PneunetRun* r : {&jumped, &loose}) {
+  for (const PneunetRun* r : {&jumped, &loose, &loose_linear}) {
     ASSERT_EQ(every.records.size(), r->records.size());
     const auto [last, skipped] = angle_errors(every, *r);
     std::printf("pneu-net: %ld jumps, %ld of %d trials skipped; states %ld vs %ld; last trial |d angle| <= %.4f deg, "
@@ -377,6 +505,11 @@ TEST(CycleJumpPneunet, LastTrialWithinTrackingNoiseOfTheEveryTrialRun) {
     EXPECT_LE(skipped, 0.3);
   }
   EXPECT_GT(loose.stats.trials_extrapolated, jumped.stats.trials_extrapolated);
+  // The linear rule (order 1) under-predicts the accelerating damage and leaves the last trial off
+  // by a bias of one sign; the three-point rule (the default) removes the history's curvature, so
+  // with the same jumps its last trial is closer.
+  ASSERT_EQ(loose_linear.stats.trials_extrapolated, loose.stats.trials_extrapolated);
+  EXPECT_LT(angle_errors(every, loose).first, angle_errors(every, loose_linear).first);
 }
 
 }  // namespace
