@@ -808,8 +808,9 @@ TEST(HiddenEffect, CreepAndFatigueTogetherAreBothFound) {
 // fatigue_saturating 0.0271, fatigue 0.0325, creep 0.0378; after round 1 fatigue in its place 93.5
 // against 65.1 deg^2 (kept); round 2 the creep (0.0209); then "round 2: fatigue replaced
 // fatigue_saturating", RSS 38.64 -> 20.91 deg^2 (NRMSE 0.0154); fatigue W_th 7.9 kPa, tau 34 s,
-// creep gamma 0.054, tau 1.7 s. 79 s CPU of one thread with the elastic path from the cache (+40 s
-// to trace it). Without the swap, form_changes is empty and fatigue_saturating stays selected.
+// creep gamma 0.054, tau 1.7 s. 93 s CPU of one thread with the elastic path traced (an empty
+// cache; 79 s with it cached). Without the swap, form_changes is empty and fatigue_saturating stays
+// selected.
 TEST(HiddenEffect, AFormPreferredInRoundOneIsSwappedWhenALaterEffectJoins) {
   DiagnoseOptions o = hidden_options("viscoelastic_instantaneous_fatigue", "form_swap", 2,
                                      {"viscoelastic_instantaneous", "fatigue", "fatigue_saturating"});
