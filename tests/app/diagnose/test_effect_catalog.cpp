@@ -1,6 +1,7 @@
 // The candidate-effect catalog (app/diagnose/effect_catalog.h): bounds are sane, every candidate's overrides
 // build on the default scene and land on the right keys, registered material effects appear, and the
 // creep candidate in both moduli conventions names the one a recording shows (one diagnosis, ~1 min).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -170,13 +171,20 @@ TEST(EffectCatalog, MaterialCandidatesTakeUnitsAndRangesFromTheRegistry) {
     for (const CandidateParameter& p : c.params) {
       const EffectParameter& r = fx->param(p.name);
       EXPECT_EQ(p.unit, r.unit) << c.name << "." << p.name;
-      // The one range the catalog narrows the registry's for: the saturating fatigue's tau, whose
-      // lower bound is 10 s (effect_catalog.cpp: with n = 6, tau sets the knee, not the damage).
-      if (c.name == "fatigue_saturating" && p.name == "tau_s")
+      // The two ranges the catalog derives from the registry's: the saturating fatigue's tau, whose
+      // lower bound is 10 s (effect_catalog.cpp: with n = 6, tau sets the knee, not the damage), and
+      // the broad creep's tau, the registry's range of one term widened by the spectrum's decade each
+      // way (BroadCreepSpreadsItsTwoConstantsOverThreeTerms checks what that range means).
+      if (c.name == "fatigue_saturating" && p.name == "tau_s") {
         EXPECT_EQ(p.lo, 10.0);
-      else
+        EXPECT_EQ(p.hi, r.hi);
+      } else if (c.name == "viscoelastic_broad" && p.name == "tau_s") {
+        EXPECT_DOUBLE_EQ(p.lo, r.lo / 10.0);
+        EXPECT_DOUBLE_EQ(p.hi, r.hi * 10.0);
+      } else {
         EXPECT_EQ(p.lo, r.lo) << c.name << "." << p.name;
-      EXPECT_EQ(p.hi, r.hi) << c.name << "." << p.name;
+        EXPECT_EQ(p.hi, r.hi) << c.name << "." << p.name;
+      }
       EXPECT_EQ(p.log, r.log) << c.name << "." << p.name;
       ++checked;
     }
@@ -243,8 +251,10 @@ TEST(EffectCatalog, CreepIsTriedInBothModuliConventions) {
 
 // Creep with a broad relaxation spectrum (issue 35, bench/notes/2026-11-29-diag3.md): the calibrated
 // gamma and tau spread over three Prony terms of one fixed shape, tau/10, tau and 10 tau with weights
-// proportional to tau_i^(1/4) summing to gamma, in the instantaneous convention; the registry's
-// ranges; not stacked on the one-term creep (one table, a different number of terms).
+// proportional to tau_i^(1/4) summing to gamma, in the instantaneous convention; gamma with the
+// registry's range, tau with the range where one of the terms lies in the registry's range of a
+// term (bench/notes/2026-11-29-diag4.md); not stacked on the one-term creep (one table, a different
+// number of terms).
 TEST(EffectCatalog, BroadCreepSpreadsItsTwoConstantsOverThreeTerms) {
   const CandidateEffect& one = candidate_effect("viscoelastic_instantaneous");
   const CandidateEffect& broad = candidate_effect("viscoelastic_broad");
@@ -252,10 +262,30 @@ TEST(EffectCatalog, BroadCreepSpreadsItsTwoConstantsOverThreeTerms) {
   ASSERT_EQ(broad.params.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(broad.params[i].name, one.params[i].name);
-    EXPECT_EQ(broad.params[i].lo, one.params[i].lo);
-    EXPECT_EQ(broad.params[i].hi, one.params[i].hi);
+    EXPECT_EQ(broad.params[i].unit, one.params[i].unit);
+    EXPECT_EQ(broad.params[i].log, one.params[i].log);
   }
+  EXPECT_EQ(broad.params[0].lo, one.params[0].lo);  // gamma: the registry's
+  EXPECT_EQ(broad.params[0].hi, one.params[0].hi);
   const Scene base = Scene::load("", kTiny);
+  // tau's range, read through the terms it writes: at its lower bound the SLOWEST term sits at the
+  // registry's lowest relaxation time of a term, at its upper bound the FASTEST at the highest, so
+  // the spectrum can sit wherever one of its terms can (and extend a decade beyond each end).
+  // 1e-12 relative: the values pass through the scene's text (json::num, shortest round-trip).
+  const EffectParameter& term = find_material_effect("viscoelastic")->param("tau_s");
+  const auto terms_at = [&](double tau) {
+    return base.with(broad.sets(base, {0.6, tau})).numbers("materials.silicone.viscoelastic.tau_s");
+  };
+  const std::vector<double> at_lo = terms_at(broad.params[1].lo), at_hi = terms_at(broad.params[1].hi);
+  ASSERT_EQ(at_lo.size(), 3u);
+  ASSERT_EQ(at_hi.size(), 3u);
+  EXPECT_NEAR(*std::max_element(at_lo.begin(), at_lo.end()), term.lo, 1e-12 * term.lo);
+  EXPECT_NEAR(*std::min_element(at_hi.begin(), at_hi.end()), term.hi, 1e-12 * term.hi);
+  // ... a wider range than one term's on both sides (the point of it: the slow spectrum is reachable).
+  EXPECT_LT(broad.params[1].lo, one.params[1].lo);
+  EXPECT_GT(broad.params[1].hi, one.params[1].hi);
+  EXPECT_GE(broad.params[1].initial, broad.params[1].lo);
+  EXPECT_LE(broad.params[1].initial, broad.params[1].hi);
   const Scene s = base.with(broad.sets(base, {0.6, 4.0}));
   EXPECT_EQ(s.string("materials.silicone.viscoelastic.moduli"), "instantaneous");
   const std::vector<double> g = s.numbers("materials.silicone.viscoelastic.gamma");
