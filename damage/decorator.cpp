@@ -2,9 +2,6 @@
 
 #include <cassert>
 
-#include "damage/fatigue.h"
-#include "damage/viscoelastic.h"
-
 namespace pneufem::detail {
 
 bool stress_base(const Material& base, StressBatch& b, const TimeStep& step, std::span<const double> state_old,
@@ -41,7 +38,7 @@ bool stress_base(const Material& base, StressBatch& b, const TimeStep& step, std
 }
 
 void require_potential_base(const MaterialPtr& base, const std::string& effect) {
-  if (dynamic_cast<const FatigueDamage*>(base.get()) || dynamic_cast<const Viscoelastic*>(base.get()))
+  if (!base->isochoric_energy_is_potential())
     throw InputError(effect + ": cannot wrap '" + base->name() + "': " + effect +
                      " is driven by the base's isochoric energy, which must be a potential of its stress; "
                      "apply the effects in the order viscoelastic(fatigue(mullins(base)))");

@@ -90,7 +90,8 @@ inline void require_split_base(const MaterialPtr& base, const std::string& effec
 /// Throws InputError unless d(base psi_iso)/dF = base P_iso at a fixed committed state, which the
 /// energy-driven effects (mullins, fatigue) rely on for their consistent tangent. Fatigue (whose damage
 /// grows within the increment) and viscoelastic (overstress) laws do not satisfy it, so they must be
-/// applied outside: the canonical order is viscoelastic(fatigue(mullins(base))). Defined in decorator.cpp.
+/// applied outside: the canonical order is viscoelastic(fatigue(mullins(base))). Asks the base
+/// (Material::isochoric_energy_is_potential), so this layer names no effect.
 void require_potential_base(const MaterialPtr& base, const std::string& effect);
 
 inline void require(bool ok, const std::string& effect, const std::string& msg) {

@@ -101,6 +101,7 @@ class FatigueDamage final : public Material {
   FatigueDamage(MaterialPtr base, const FatigueParams& p);
 
   std::string name() const override { return "fatigue(" + base_->name() + ")"; }
+  bool isochoric_energy_is_potential() const override { return false; }
   /// [1 - d] or, with a non-local driver, [1 - d, rho].
   int own_state_size() const { return p_.nonlocal_radius_m > 0.0 ? 2 : 1; }
   int state_size() const override { return own_state_size() + base_->state_size(); }

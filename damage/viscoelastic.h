@@ -95,6 +95,7 @@ class Viscoelastic final : public Material {
   Viscoelastic(MaterialPtr base, const ViscoParams& p);
 
   std::string name() const override { return "viscoelastic(" + base_->name() + ")"; }
+  bool isochoric_energy_is_potential() const override { return false; }
   int own_state_size() const { return 6 * (1 + n_); }
   int state_size() const override { return own_state_size() + base_->state_size(); }
   void init_state(std::span<double> state) const override;

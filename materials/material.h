@@ -134,6 +134,11 @@ class Material {
   virtual double initial_bulk_modulus() const = 0;
   /// True when the response is split as P_iso (isochoric) + P_vol (volumetric).
   virtual bool is_split() const { return true; }
+  /// True when d(psi_iso)/dF = P_iso at a fixed committed state (the reported isochoric energy is a
+  /// potential of the isochoric stress). The energy-driven effects (damage/mullins.h,
+  /// damage/fatigue.h) need it of the law they wrap; a law whose history moves within the increment
+  /// (fatigue) or whose stress has an overstress part (viscoelastic) says false.
+  virtual bool isochoric_energy_is_potential() const { return true; }
 
   /// Non-local regularisation (engine/nonlocal.h). A law whose history is driven by a local quantity
   /// (the fatigue law's stretch or energy) may have it averaged over a ball of radius radius_m > 0
