@@ -68,7 +68,8 @@ toml::table material_table(const InpMaterial& d, DeckInfo::Material& m, DeckInfo
       d.density ? d.density_where : d.where);
   if (d.mullins) {
     toml::table mu;
-    DeckInfo::Material sub{m.table + ".mullins"};
+    DeckInfo::Material sub;
+    sub.table = m.table + ".mullins";
     put(mu, sub, info, "enabled", true, d.mullins->where);
     put(mu, sub, info, "r", d.mullins->r, d.mullins->where);
     put(mu, sub, info, "m_MPa", d.mullins->m_MPa, d.mullins->where);
@@ -79,7 +80,8 @@ toml::table material_table(const InpMaterial& d, DeckInfo::Material& m, DeckInfo
   if (d.prony || !d.moduli.empty()) {
     // MODULI= without *VISCOELASTIC: the convention is kept for a scene that switches it on.
     toml::table v;
-    DeckInfo::Material sub{m.table + ".viscoelastic"};
+    DeckInfo::Material sub;
+    sub.table = m.table + ".viscoelastic";
     put(v, sub, info, "enabled", d.prony.has_value(), d.prony ? d.prony->where : d.moduli_where);
     if (d.prony) {
       put(v, sub, info, "gamma", array_of(gamma_from_abaqus_g(d.prony->g)), d.prony->where);
@@ -110,7 +112,10 @@ DeckLayer deck_layer(const std::string& path, const std::string& length_unit, co
   if (deck.materials.empty() && deck.sections.empty()) return out;
   toml::table materials;
   for (const InpMaterial& d : deck.materials) {
-    DeckInfo::Material m{"materials." + table_name(d), d.name, d.where};
+    DeckInfo::Material m;
+    m.table = "materials." + table_name(d);
+    m.deck_name = d.name;
+    m.where = d.where;
     m.law_where = d.law_where;
     materials.insert_or_assign(table_name(d), material_table(d, m, out.info, length_unit, defaults));
     out.info.materials.push_back(std::move(m));

@@ -53,8 +53,11 @@ TEST(RegionBoxes, ElementsWhoseCentroidLiesInABoxTakeItsTagALaterBoxWins) {
   // Box A: the upper half in z; box B: the far half in y of box A's z range (overlaps A).
   const Eigen::Vector3d a_lo(lo.x() - 1, lo.y() - 1, 0.5 * (lo.z() + hi.z())), a_hi(hi.x() + 1, hi.y() + 1, hi.z() + 1);
   const Eigen::Vector3d b_lo(lo.x() - 1, 0.5 * (lo.y() + hi.y()), a_lo.z()), b_hi = a_hi;
-  auto v = [](const Eigen::Vector3d& x) {
-    return "[" + std::to_string(x.x()) + ", " + std::to_string(x.y()) + ", " + std::to_string(x.z()) + "]";
+  auto v = [](const Eigen::Vector3d& x) {  // piece by piece: GCC 12's -Wrestrict false positive on "[" + std::string
+    std::string s = "[";
+    s += std::to_string(x.x()) + ", " + std::to_string(x.y()) + ", " + std::to_string(x.z());
+    s += "]";
+    return s;
   };
   const std::string boxes = "mesh.region_boxes=[{region = \"upper\", min_mm = " + v(a_lo) + ", max_mm = " + v(a_hi) +
                             "}, {region = \"upper_far\", min_mm = " + v(b_lo) + ", max_mm = " + v(b_hi) + "}]";
