@@ -3,13 +3,14 @@
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--dump-points]
-//             [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
+//             [--dump-every] [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --corrected reports|tops adds the
 // corrected history's estimate (ReplayOptions), corrected at every loaded report or at the top
 // level's reports only (as simulate's check); --dump-points runs the FEM beside
-// the reduced model and compares damage and largest stretch at the kept points at every trial's end;
+// the reduced model and compares damage and largest stretch at the kept points at every trial's end
+// (--dump-every: also each region's viscous strain at every report);
 // --galerkin-theta tests the theta row with the path tangent (RomBasisOptions::galerkin_theta_row);
 // --fabric-strain prints, per report, the stiff parts' largest Green and small strain of the reduced
 // state and of the FEM snapshot at the same report, and the reduced coordinates (theta, |q|, the
@@ -112,8 +113,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
-  bool dump_every = false;
-  bool fem = false, check = false, dump = false, corrected = false, corrected_tops = false, fabric_strain = false;
+  bool fem = false, check = false, dump = false, dump_every = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
   double rom_time_tol = 0.0;
   int path_steps = 40;  // the elastic path's pressure step is p_max / path_steps (its samples' density)  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
@@ -137,8 +137,8 @@ int main(int argc, char** argv) {
     else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
-    else if (a == "--dump-points") dump = true;
-    else if (a == "--dump-every") dump = dump_every = true;  // as --dump-points, plus per-region viscous strain at every report  // kept points: ROM vs FEM damage and stretch at trial tops  // replay the run and print the indicators at every report
+    else if (a == "--dump-points") dump = true;  // kept points, ROM vs FEM: damage, viscous strain and stretch at every trial's end
+    else if (a == "--dump-every") dump = dump_every = true;  // as --dump-points, plus the per-region viscous strain at every report
     else if (a == "--fabric-strain") fabric_strain = true;  // largest Green strain of the stiff parts per report, ROM vs the snapshot
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--modes") ro.max_modes = std::stoi(next());
@@ -433,31 +433,8 @@ int main(int argc, char** argv) {
       for (int a = 0; a < geom.npe; ++a) F += u.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
       return std::sqrt(Eigen::SelfAdjointEigenSolver<Mat3>(F.transpose() * F).eigenvalues().maxCoeff());
     };
-    if (dump_every) {
-      // Where the reduced history parts from the FEM's: per region, the kept points' viscous strain sum,
-      // ROM / FEM - 1 in %, at every report (climb, hold end, release), then the damage sum's.
-      std::printf("viscous strain per region at every report, ROM/FEM - 1 %% (trial, p kPa, then region: %%):\n");
-      for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
-        std::map<int, std::array<double, 2>> reg;
-        double dr_sum = 0, df_sum = 0;
-        for (int k = 0; k < rom.num_points(); ++k) {
-          const int e = rom.element_of_point(k), qp = k % geom.nqp;
-          reg[bm->model.mesh.region[e]][0] += rom_h[i][2 * k + 1];
-          reg[bm->model.mesh.region[e]][1] += fh[i][2 * (e * geom.nqp + qp) + 1];
-          dr_sum += rom_h[i][2 * k], df_sum += fh[i][2 * (e * geom.nqp + qp)];
-        }
-        std::printf("  %2d %6.2f", ftrial[i], red.p[i] * 1e-3);
-        for (const auto& [r, v] : reg)
-          std::printf("  %s %+6.1f (%.2e)", bm->model.mesh.region_names[r].substr(0, 6).c_str(), 100 * (v[0] / v[1] - 1), v[1]);
-        std::printf("  damage %+5.1f\n", 100 * (dr_sum / std::max(df_sum, 1e-300) - 1));
-      }
-    }
-    for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
-      if (i + 1 < fu.size() && ftrial[i + 1] == ftrial[i]) continue;  // last report of a trial
-      // the loaded top: the report before the last (the last one is at the hold end, same p)
-      double sd_rom = 0, sd_fem = 0, n = 0, sl_rom = 0, sl_fem = 0;
-      std::vector<std::tuple<double, int, int, double, double, double, double>> rows;
-      // Per region: sums over the kept points of the damage and the viscous strain (ROM, FEM, |ROM - FEM|).
+    // Per region: sums over the kept points of the damage and the viscous strain (ROM, FEM, |ROM - FEM|) at report i.
+    auto region_sums = [&](std::size_t i) {
       std::map<int, std::array<double, 6>> by_region;
       for (int k = 0; k < rom.num_points(); ++k) {
         const int e = rom.element_of_point(k), qp = k % geom.nqp;
@@ -465,13 +442,43 @@ int main(int argc, char** argv) {
         const double vr = rom_h[i][2 * k + 1], vf = fh[i][2 * (e * geom.nqp + qp) + 1];
         std::array<double, 6>& reg = by_region[bm->model.mesh.region[e]];
         reg[0] += dr, reg[1] += df, reg[2] += std::abs(dr - df), reg[3] += vr, reg[4] += vf, reg[5] += std::abs(vr - vf);
+      }
+      return by_region;
+    };
+    // ROM / FEM - 1 in %; 0 where both sums are 0 (no such history), NaN where only the FEM's is.
+    auto percent_off = [](double rom_sum, double fem_sum) {
+      return fem_sum != 0.0 ? 100.0 * (rom_sum / fem_sum - 1.0) : rom_sum == 0.0 ? 0.0 : std::nan("");
+    };
+    if (dump_every) {
+      // Where the reduced history parts from the FEM's: per region, the kept points' viscous strain sum,
+      // ROM / FEM - 1 in %, at every report (climb, hold end, release), then the damage sum's.
+      std::printf("viscous strain per region at every report, ROM/FEM - 1 %% (trial, p kPa, then region: %%):\n");
+      for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
+        double dr_sum = 0, df_sum = 0;
+        std::printf("  %2d %6.2f", ftrial[i], red.p[i] * 1e-3);
+        for (const auto& [r, v] : region_sums(i)) {
+          std::printf("  %s %+6.1f (%.2e)", bm->model.mesh.region_names[r].substr(0, 6).c_str(), percent_off(v[3], v[4]), v[4]);
+          dr_sum += v[0], df_sum += v[1];
+        }
+        std::printf("  damage %+5.1f\n", percent_off(dr_sum, df_sum));
+      }
+    }
+    for (std::size_t i = 0; i < fu.size() && i < rom_u.size(); ++i) {
+      if (i + 1 < fu.size() && ftrial[i + 1] == ftrial[i]) continue;  // last report of a trial
+      // the loaded top: the report before the last (the last one is at the hold end, same p)
+      double sd_rom = 0, sd_fem = 0, n = 0, sl_rom = 0, sl_fem = 0;
+      std::vector<std::tuple<double, int, int, double, double, double, double>> rows;
+      const std::map<int, std::array<double, 6>> by_region = region_sums(i);
+      for (int k = 0; k < rom.num_points(); ++k) {
+        const int e = rom.element_of_point(k), qp = k % geom.nqp;
+        const double dr = rom_h[i][2 * k], df = fh[i][2 * (e * geom.nqp + qp)];
         const double lr = stretch(rom_u[i], e, qp), lf = stretch(fu[i], e, qp);
         sd_rom += dr, sd_fem += df;
         if (df > 0.01) n += 1, sl_rom += lr - 1, sl_fem += lf - 1;
         rows.emplace_back(dr - df, e, qp, dr, df, lr, lf);
       }
       std::printf("trial %d: kept points' damage sum ROM %.3f FEM %.3f (%+.1f %%); over %g points with FEM damage > 0.01: mean stretch-1 ROM %.4f FEM %.4f\n",
-                  ftrial[i], sd_rom, sd_fem, 100 * (sd_rom / sd_fem - 1), n, sl_rom / std::max(n, 1.0), sl_fem / std::max(n, 1.0));
+                  ftrial[i], sd_rom, sd_fem, percent_off(sd_rom, sd_fem), n, sl_rom / std::max(n, 1.0), sl_fem / std::max(n, 1.0));
       for (const auto& [r, v] : by_region)
         std::printf("   region %-14s damage ROM %.4f FEM %.4f |diff| %.4f   viscous strain ROM %.4e FEM %.4e |diff| %.4e\n",
                     bm->model.mesh.region_names[r].c_str(), v[0], v[1], v[2], v[3], v[4], v[5]);

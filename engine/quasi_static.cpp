@@ -596,12 +596,16 @@ std::size_t QuasiStaticRun::end_of_trial(const std::vector<Segment>& segs, std::
     std::fprintf(stderr, "  cycle jump after trial %d: one-cycle error %.3g (reported angles %.3g), change %.3g -> skip %d trials\n",
                  trial + 1, e1, ea, c1, n);
   if (n < 1) return i;
-  // (1') through the three trial ends, controlled by the linear rule's estimate (local extrapolation).
-  const std::vector<double> linear = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
-  state_ = opt_.cycle_jump.order == 2 ? jump_history(asm_, cycle_ends_[0], cycle_ends_[1], cycle_ends_[2], n) : linear;
-  if (opt_.newton.verbose && opt_.cycle_jump.order == 2)
-    std::fprintf(stderr, "  cycle jump: the three-point rule differs from the linear one by %.3g (weighted as (2))\n",
-                 history_jump_error(asm_, share, linear, state_));
+  // (1') through the three trial ends, controlled by the linear rule's estimate (local extrapolation);
+  // the linear jump itself is made only when it is the rule or is printed beside (1').
+  if (opt_.cycle_jump.order == 1) {
+    state_ = jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n);
+  } else {
+    state_ = jump_history(asm_, cycle_ends_[0], cycle_ends_[1], cycle_ends_[2], n);
+    if (opt_.newton.verbose)
+      std::fprintf(stderr, "  cycle jump: the three-point rule differs from the linear one by %.3g (weighted as (2))\n",
+                   history_jump_error(asm_, share, jump_history(asm_, cycle_ends_[1], cycle_ends_[2], n), state_));
+  }
   // The skipped trials' reports, extrapolated linearly in the trial count from the last two trials.
   const std::vector<StateRecord>& a = cycle_reports_[cycle_reports_.size() - 2];
   const std::vector<StateRecord>& b = cycle_reports_.back();

@@ -749,22 +749,19 @@ void try_other_forms(Selection& s, int round) {
       joint.name = alt->name;
       std::vector<const CandidateEffect*> effects;
       std::vector<double> start;
+      std::ptrdiff_t alt_offset = 0;  // where the k-th effect's constants sit in the joint vector
       for (std::size_t j = 0; j < s.chosen.size(); ++j) {
         const CandidateEffect* e = j == k ? alt : s.chosen[j].first;
         effects.push_back(e);
         joint.params.insert(joint.params.end(), e->params.begin(), e->params.end());
         if (j != k) start.insert(start.end(), s.chosen[j].second.begin(), s.chosen[j].second.end());
+        if (j < k) alt_offset += static_cast<std::ptrdiff_t>(e->params.size());
       }
       // The joint vector with `alt_values` as the k-th effect's constants and the others' from `start`.
       const auto with_alt = [&](const std::vector<double>& alt_values) {
-        const std::size_t before = [&] {
-          std::size_t n = 0;
-          for (std::size_t j = 0; j < k; ++j) n += effects[j]->params.size();
-          return n;
-        }();
-        std::vector<double> v(start.begin(), start.begin() + static_cast<std::ptrdiff_t>(before));
+        std::vector<double> v(start.begin(), start.begin() + alt_offset);
         v.insert(v.end(), alt_values.begin(), alt_values.end());
-        v.insert(v.end(), start.begin() + static_cast<std::ptrdiff_t>(before), start.end());
+        v.insert(v.end(), start.begin() + alt_offset, start.end());
         return v;
       };
       const auto sets_of = [&](const std::vector<double>& v) {
