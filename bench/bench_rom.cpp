@@ -2,7 +2,7 @@
 // engine/rom.h against the full quasi-static FEM on a scene's protocol.
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
-//             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--dump-points]
+//             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--corrected-in-run reports|tops] [--dump-points]
 //             [--dump-every] [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
   int snap_trials = 0, enrich = 0;
   double rom_time_tol = 0.0;
   int path_steps = 40;  // the elastic path's pressure step is p_max / path_steps (its samples' density)  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
-  std::string save_corrected, extra_snapshots;
+  std::string save_corrected, extra_snapshots, in_run;
   int threads = 0;
   RomBasisOptions ro;
   ro.verbose = true;
@@ -137,6 +137,7 @@ int main(int argc, char** argv) {
     else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
+    else if (a == "--corrected-in-run") in_run = next();  // tops | reports: the corrected history fed back into the run
     else if (a == "--dump-points") dump = true;  // kept points, ROM vs FEM: damage, viscous strain and stretch at every trial's end
     else if (a == "--dump-every") dump = dump_every = true;  // as --dump-points, plus the per-region viscous strain at every report
     else if (a == "--fabric-strain") fabric_strain = true;  // largest Green strain of the stiff parts per report, ROM vs the snapshot
@@ -309,6 +310,12 @@ int main(int argc, char** argv) {
   QuasiStaticOptions rom_steps = bm->solver.quasi_static;
   if (rom_time_tol > 0.0) rom_steps.time_tol = rom_time_tol;
   ReducedRun run(rom, rom_steps);
+  if (!in_run.empty()) {
+    const double p_top = in_run == "tops" ? 0.99 * p_max : 0.0;
+    run.set_history_corrector(corrected_history_in_run(
+        rom, [p_top](const ReducedStep& s) { return s.report >= 0 && s.pressure_Pa > p_top; }, bm->solver.quasi_static.newton,
+        [](const ReducedStep& s, bool ok) { std::printf("  in-run check at t %.2f s, %.1f kPa: %s\n", s.time_s, s.pressure_Pa * 1e-3, ok ? "corrected" : "NO EQUILIBRIUM"); }));
+  }
   std::vector<Eigen::VectorXd> rom_u, strain_u;
   std::vector<double> strain_lambda, strain_q, strain_theta;
   std::vector<std::vector<double>> rom_h;

@@ -95,6 +95,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,7 @@
 #include "engine/model.h"
 #include "engine/path_model.h"
 #include "engine/quasi_static.h"
+#include "engine/reduced_basis.h"
 #include "engine/static_solver.h"
 
 namespace pneufem {
@@ -141,57 +143,6 @@ struct RomBasisOptions {
   bool verbose = false;
 };
 
-/// The offline part of a reduced model: everything computed from the elastic reference model and its
-/// path. Plain data; to_doubles / from_doubles store it with its exact bits (app/result_cache.h).
-struct ReducedBasis {
-  // The path: samples theta_k (deg), p_k (Pa), displacements U (dofs x ns) and their spline slopes dU.
-  std::vector<double> theta, p;
-  Eigen::MatrixXd U, dU;
-  Eigen::MatrixXd Phi;            ///< correction modes (dofs x r)
-  // Reference operators per path sample (see the header comment).
-  Eigen::MatrixXd W;              ///< dofs x ns: the theta row's test vector w (below), per sample
-  std::vector<double> V, dV;      ///< cavity volume (m^3) and V' = u_el'^T g
-  std::vector<double> wg;         ///< w^T g (1 where w is the angle's influence vector)
-  std::vector<double> wa;         ///< g^T K_T^-1 grad(angle) (deg/m^3): K_T^-1 grad(angle) = wa w; 0 where w is u_el'/V'
-  Eigen::MatrixXd b, db, c, h;    ///< r x ns: b = Phi^T g, db = Phi^T H_V u_el' (= b'), c = Phi^T K_T w, h = Phi^T H_V w
-  std::vector<Eigen::MatrixXd> K, H;  ///< r x r per sample
-  Eigen::MatrixXd gt;             ///< 3 x ns: w^T f_g per unit acceleration along x, y, z
-  Eigen::MatrixXd gq;             ///< r x 3: Phi^T f_g per unit acceleration
-  Eigen::MatrixXd gauge;          ///< r x ns: Phi^T M u_el' (q is kept orthogonal to it); all zero: no gauge (tangent_free_modes)
-  // Hyper-reduction: sampled elements and their ECSW weights; the reference's hyper-reduced force at
-  // q = 0 on a fine grid of every segment (kRefSub + 1 points each) and its q-Jacobian per sample.
-  std::vector<int> elements;
-  std::vector<double> weights;
-  static constexpr int kRefSub = 64;
-  Eigen::MatrixXd Gref;           ///< (r + 1) x (segments * (kRefSub + 1))
-  std::vector<Eigen::MatrixXd> Kref;  ///< (r + 1) x (r + 1) per sample: d G_hat_ref / d(theta, q) at q = 0
-  // The follower load's second order in q (constant: the load is quadratic in the positions):
-  // pq(i, j + r l) = Phi_i^T g2[Phi_j, Phi_l] and pw(j + r l, k) = w_k^T g2[Phi_j, Phi_l], g2 the
-  // second derivative of g = dV/du (see the header comment).
-  Eigen::MatrixXd pq;             ///< r x r^2
-  Eigen::MatrixXd pw;             ///< r^2 x ns
-  std::vector<char> stiff_part;   ///< per part of the reference: 1 = stiff (linear reference only)
-  double mesh_fingerprint = 0.0;  ///< mesh_fingerprint() of the reference's mesh
-  // What the construction saw (reported in summaries).
-  struct Info {
-    int clusters = 0, responses = 0, soft_elements = 0;
-    double pod_energy_left = 0.0;     ///< relative energy of the responses outside the kept modes
-    double ecsw_worst_residual = 0.0; ///< largest relative residual of a cluster's training fit
-    double build_s = 0.0;
-  } info;
-
-  int num_modes() const { return static_cast<int>(Phi.cols()); }
-  int num_samples() const { return static_cast<int>(theta.size()); }
-  long dofs() const { return static_cast<long>(U.rows()); }
-
-  std::vector<double> to_doubles() const;
-  /// Throws InputError when the data are not a basis (damaged, or of another format version).
-  static ReducedBasis from_doubles(const std::vector<double>& d);
-};
-
-/// A 52-bit hash of a mesh's node coordinates and connectivity (exact in a double): a basis is
-/// only used with the mesh it was built on.
-double mesh_fingerprint(const Mesh& mesh);
 
 /// Builds the basis of `reference` (elastic: materials without history, no gravity) from its traced
 /// path (engine/path_model.h). Throws InputError for a reference with history or a trace that does
@@ -277,6 +228,9 @@ class ReducedOrderModel {
   /// Per kept point (2 values: fatigue damage, viscous strain), as Assembler::history_scalars.
   std::vector<double> history_scalars(const std::vector<double>& history) const;
   int element_of_point(int i) const;           ///< mesh element of kept point i
+  /// The kept points' history taken from a history of every element (laid out by `full`, an
+  /// Assembler of this model's mesh and materials).
+  void gather_history(const Assembler& full, std::span<const double> full_state, std::vector<double>& kept) const;
 
  private:
   struct Impl;
@@ -298,6 +252,10 @@ class ReducedRun {
   void run(const LoadHistory& load, const Observer& observer);
   /// Off: a fresh Jacobian at every Newton iteration (plain Newton; for verification of the kept one).
   void set_jacobian_reuse(bool on) { reuse_jacobian_ = on; }
+  /// Called after every committed step with the step and the committed history of the kept
+  /// points, which it may replace (corrected_history_in_run); the next step starts from it.
+  using HistoryCorrector = std::function<void(const ReducedStep&, std::vector<double>& history)>;
+  void set_history_corrector(HistoryCorrector c) { corrector_ = std::move(c); }
 
   const std::vector<ReducedStep>& trajectory() const { return steps_; }
   const ReducedRunStats& stats() const { return stats_; }
@@ -328,6 +286,9 @@ class ReducedRun {
   std::vector<double> hist_prev_, hist_cur_;
   double h_prev_ = 0.0, rate_prev_ = 0.0;
   bool rate_dependent_ = false;
+  HistoryCorrector corrector_;
+  /// Records a committed step and lets the corrector replace its history.
+  void record_step(const ReducedStep& step);
 };
 
 /// What the full model says about a reduced state (replay_reduced_run).
@@ -395,5 +356,17 @@ using ReplayObserver =
 /// observer's `state` is the reduced run's replayed history either way.
 void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedStep>& trajectory, const ReplayObserver& at_report,
                         const ReplayOptions& options = {});
+
+/// The corrected history of ReplayOptions fed back into the run (ReducedRun::set_history_corrector):
+/// every element's history is integrated along u(z) + (p / p_c) du_c, du_c set by the full model's
+/// solve at the committed steps `correct_at` picks (its ReducedStep::report is 0 at a report, -1
+/// elsewhere), and the kept points take that history after every step, so the reduced equations see
+/// the history the full model would build rather than the one their own trajectory builds (a defect
+/// correction fed back, Kerfriden et al. 2011). `on_check(step, converged)` hears each check.
+/// Cost: one full force evaluation per step and a full Newton solve per check: the online cost
+/// then grows with the mesh.
+ReducedRun::HistoryCorrector corrected_history_in_run(const ReducedOrderModel& rom, std::function<bool(const ReducedStep&)> correct_at,
+                                                      const StaticOptions& newton,
+                                                      std::function<void(const ReducedStep&, bool converged)> on_check = {});
 
 }  // namespace pneufem

@@ -17,8 +17,9 @@
 
 #include <Eigen/Core>
 
+#include "engine/assembly.h"
 #include "engine/model.h"
-#include "engine/rom.h"
+#include "engine/reduced_basis.h"
 #include "materials/material.h"
 
 namespace pneufem::rom_detail {
@@ -37,6 +38,9 @@ class KeptPoints {
   std::vector<double> initial_history() const;
   /// Per point: (fatigue damage, viscous strain) from its committed history (2 values per point).
   std::vector<double> history_scalars(const std::vector<double>& history) const;
+  /// The kept points' history (this class's layout) copied from a full history laid out as
+  /// `full`'s (Assembler::element_state): point i of element e, quadrature point q.
+  void gather_history(const Assembler& full, std::span<const double> full_state, std::span<double> kept) const;
 
   /// Hyper-reduced Galerkin force g (r + 1: theta, q) at (theta, q) and, with `jac`, its Jacobian
   /// (r + 1) x (r + 1). History: reads `old`, writes the trial state to `trial` (both may be empty
@@ -54,7 +58,7 @@ class KeptPoints {
     int state_size;             ///< per point
   };
   const ReducedBasis& basis_;
-  int r_ = 0, ns_ = 0;
+  int r_ = 0, ns_ = 0, nqp_ = 0;
   std::vector<int> element_;      ///< per point
   std::vector<double> weight_;    ///< per point: ECSW weight x quadrature weight (m^3)
   std::vector<Mat3> F_, dF_;      ///< [sample][point]: path F and its spline slope

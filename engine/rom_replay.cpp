@@ -60,6 +60,7 @@ class CorrectedHistory {
     du_ = Eigen::VectorXd::Zero(A.num_dofs());
     u_converged_ = du_;
   }
+  const std::vector<double>& state() const { return state_; }
   /// Advances the history by `step` from u + du_c (u the reduced state), du_c scaled by the
   /// pressure since the last correction (a release takes it to zero with the load). With `correct`,
   /// the step is solved as the full model solves it: Newton from there with the step's own tangent
@@ -165,6 +166,25 @@ void replay_reduced_run(const ReducedOrderModel& rom, const std::vector<ReducedS
     }
     at_report(step, u, state, check);
   }
+}
+
+ReducedRun::HistoryCorrector corrected_history_in_run(const ReducedOrderModel& rom, std::function<bool(const ReducedStep&)> correct_at,
+                                                      const StaticOptions& newton,
+                                                      std::function<void(const ReducedStep&, bool converged)> on_check) {
+  struct Shared {
+    Shared(const Model& m, const StaticOptions& o) : A(m), history(A, o) {}
+    Assembler A;
+    CorrectedHistory history;
+  };
+  auto shared = std::make_shared<Shared>(rom.model(), newton);
+  return [&rom, shared, correct_at = std::move(correct_at), on_check = std::move(on_check)](const ReducedStep& step,
+                                                                                              std::vector<double>& kept) {
+    const bool correct = correct_at && correct_at(step);
+    bool converged = false;
+    shared->history.advance(step, rom.displacement(step.z), correct, converged);
+    if (correct && on_check) on_check(step, converged);
+    rom.gather_history(shared->A, shared->history.state(), kept);
+  };
 }
 
 }  // namespace pneufem
