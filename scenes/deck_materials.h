@@ -81,8 +81,9 @@ struct MergedScene {
   std::function<int(const std::string&)> array_size;
   std::function<std::string(const std::string&)> string;
   std::function<double(const std::string&)> number;
-  std::function<std::string(const std::string&)> origin;     ///< "scene.toml:12", "--set", "default scene"
-  std::function<std::string(const std::string&)> origin_of;  ///< the exact origin ("" when no layer above the default scene set it)
+  std::function<std::string(const std::string&)> origin;  ///< "scene.toml:12", "--set", "default scene"
+  /// The exact origin of a key: "" when no layer above the default scene set it.
+  std::function<std::string(const std::string&)> origin_of;
 };
 
 /// The notes on what the deck gave the merged `scene`, and the check that no part's material is
