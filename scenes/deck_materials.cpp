@@ -7,7 +7,6 @@
 #include "core/errors.h"
 #include "core/message_text.h"
 #include "core/number_text.h"
-#include "scenes/scene.h"
 
 namespace pneufem {
 
@@ -135,12 +134,11 @@ DeckLayer deck_layer(const std::string& path, const std::string& length_unit, co
   return out;
 }
 
-std::vector<std::string> deck_notes(const DeckInfo& info, const Scene& s,
-                                    const std::function<std::string(const std::string&)>& origin_of) {
+std::vector<std::string> deck_notes(const DeckInfo& info, const MergedScene& s) {
   std::vector<std::string> notes;
   const auto from_deck = [&](const std::string& key) {
     const auto it = info.origins.find(key);
-    return it != info.origins.end() && s.has(key) && origin_of(key) == it->second;
+    return it != info.origins.end() && s.has(key) && s.origin_of(key) == it->second;
   };
   std::vector<std::string> used;  // the materials of the scene's parts
   for (int i = 0; i < s.array_size("parts"); ++i) {

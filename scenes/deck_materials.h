@@ -38,8 +38,6 @@
 
 namespace pneufem {
 
-class Scene;
-
 /// What a deck gave, kept with the scene for its notes.
 struct DeckInfo {
   struct Material {
@@ -75,10 +73,21 @@ struct DeckDefaults {
 /// read_inp_materials refuses and for material names that cannot be a scene table.
 DeckLayer deck_layer(const std::string& path, const std::string& length_unit, const DeckDefaults& defaults);
 
+/// The merged scene as deck_notes reads it: Scene's accessors of the same names, bound by scene.cpp.
+/// Functions rather than the Scene itself, so that this file and scenes/scene do not include each
+/// other (no loop in the include graph: tests/docs/check_includes.py).
+struct MergedScene {
+  std::function<bool(const std::string&)> has;
+  std::function<int(const std::string&)> array_size;
+  std::function<std::string(const std::string&)> string;
+  std::function<double(const std::string&)> number;
+  std::function<std::string(const std::string&)> origin;  ///< "scene.toml:12", "--set", "default scene"
+  /// The exact origin of a key: "" when no layer above the default scene set it.
+  std::function<std::string(const std::string&)> origin_of;
+};
+
 /// The notes on what the deck gave the merged `scene`, and the check that no part's material is
-/// TEST DATA INPUT without a law from the scene. `origin_of(key)` is the exact origin of a key ("" when
-/// no layer above the default scene set it).
-std::vector<std::string> deck_notes(const DeckInfo& info, const Scene& scene,
-                                    const std::function<std::string(const std::string&)>& origin_of);
+/// TEST DATA INPUT without a law from the scene.
+std::vector<std::string> deck_notes(const DeckInfo& info, const MergedScene& scene);
 
 }  // namespace pneufem

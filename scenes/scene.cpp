@@ -260,11 +260,19 @@ void Scene::settle_deck() {
     impl.deck_id = id;
   }
   impl.notes.clear();
-  if (impl.deck)
-    impl.notes = deck_notes(*impl.deck, *this, [&impl](const std::string& key) {
+  if (impl.deck) {
+    MergedScene merged;
+    merged.has = [this](const std::string& key) { return has(key); };
+    merged.array_size = [this](const std::string& key) { return array_size(key); };
+    merged.string = [this](const std::string& key) { return string(key); };
+    merged.number = [this](const std::string& key) { return number(key); };
+    merged.origin = [this](const std::string& key) { return origin(key); };
+    merged.origin_of = [&impl](const std::string& key) {
       const auto it = impl.origins.find(key);
       return it == impl.origins.end() ? std::string() : it->second;
-    });
+    };
+    impl.notes = deck_notes(*impl.deck, merged);
+  }
 }
 
 const std::vector<std::string>& Scene::notes() const { return impl_->notes; }
