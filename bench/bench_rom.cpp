@@ -35,6 +35,7 @@
 
 #include <tbb/global_control.h>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <tuple>
 
 #include "analysis/paper_metrics.h"
@@ -113,6 +114,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::string scene_path, work = "rom_work";
   std::vector<std::string> sets, model_sets, snap_sets;
+  bool root_test = false;
   bool fem = false, check = false, dump = false, dump_every = false, corrected = false, corrected_tops = false, fabric_strain = false;
   int snap_trials = 0, enrich = 0;
   double rom_time_tol = 0.0;
@@ -138,6 +140,7 @@ int main(int argc, char** argv) {
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
     else if (a == "--corrected-in-run") in_run = next();  // tops | reports: the corrected history fed back into the run
+    else if (a == "--root-test") root_test = true;  // the FEM's loaded states with their history: roots of the reduced equations?
     else if (a == "--dump-points") dump = true;  // kept points, ROM vs FEM: damage, viscous strain and stretch at every trial's end
     else if (a == "--dump-every") dump = dump_every = true;  // as --dump-points, plus the per-region viscous strain at every report
     else if (a == "--fabric-strain") fabric_strain = true;  // largest Green strain of the stiff parts per report, ROM vs the snapshot
@@ -307,6 +310,74 @@ int main(int argc, char** argv) {
   }
   const auto t_on = Clock::now();
   const ReducedOrderModel rom(ref->model, basis, bm->model);
+  if (root_test) {
+    // Are the FEM's states roots of the reduced equations when the kept points carry the FEM's own
+    // history? At every loaded report of the FEM run (upper levels): project the state onto the
+    // manifold (theta = its angle, q the mass-weighted least squares of the departure), give the kept
+    // points the FEM's history, and solve the reduced equations with that history frozen (dt = 0).
+    // The root's angle minus the FEM's is what the reduced equations alone make of the right history.
+    Assembler A(bm->model);
+    QuasiStaticRun q(A, bm->solver.quasi_static);
+    const Eigen::VectorXd& mass = A.lumped_mass();
+    const Eigen::MatrixXd& Phi = basis.Phi;
+    const int r = basis.num_modes(), n = r + 2;
+    Eigen::MatrixXd MPhi = Phi;
+    for (Eigen::Index i = 0; i < MPhi.rows(); ++i) MPhi.row(i) *= mass[i / 3];
+    const Eigen::MatrixXd G = Phi.transpose() * MPhi;
+    const Eigen::LDLT<Eigen::MatrixXd> Gf(G);
+    std::printf("root test (trial, t, p kPa, fem, projection - fem, root - fem, Newton its, |q0| mm):\n");
+    q.run(bm->load, [&](const StateRecord& rec, const Eigen::VectorXd& u, const std::vector<double>& h) {
+      if (rec.pressure_Pa < 0.6 * p_max) return;
+      ReducedCoordinates z;
+      z.theta = rec.angle_deg;
+      z.q = Eigen::VectorXd::Zero(r);
+      const Eigen::VectorXd du = u - rom.displacement(z);
+      z.q = Gf.solve(MPhi.transpose() * du);
+      const double a_proj = rom.angle_deg(z, rec.angle_deg);
+      std::vector<double> kept, trial;
+      rom.gather_history(A, h, kept);
+      trial = kept;
+      const TimeStep ts{rec.global_time_s, 0.0};
+      int it = 0;
+      bool ok = false;
+      try {
+        // Damped Newton: the step halved until the residual, rows scaled by the Jacobian's row norms,
+        // falls (as ReducedRun::equilibrium), and at most 1 deg in theta.
+        for (; it < 60; ++it) {
+          Eigen::MatrixXd J;
+          const Eigen::VectorXd R = rom.residual(z, rec.pressure_Pa, ts, kept, trial, &J);
+          const Eigen::VectorXd scale = J.rowwise().norm().cwiseMax(1e-300).cwiseInverse();
+          const Eigen::VectorXd dz = -J.partialPivLu().solve(R);
+          if (!dz.allFinite()) break;
+          if (std::abs(dz[0]) < 1e-7 && dz.segment(1, r).norm() < 1e-12) {
+            ok = true;
+            break;
+          }
+          const double f0 = R.cwiseProduct(scale).norm();
+          double s = std::abs(dz[0]) > 1.0 ? 1.0 / std::abs(dz[0]) : 1.0;
+          bool moved = false;
+          for (int ls = 0; ls < 20 && !moved; ++ls, s *= 0.5) {
+            ReducedCoordinates y = z;
+            y.theta += s * dz[0];
+            y.q += s * dz.segment(1, r);
+            y.lambda += s * dz[n - 1];
+            try {
+              std::vector<double> tr = kept;
+              if (rom.residual(y, rec.pressure_Pa, ts, kept, tr, nullptr).cwiseProduct(scale).norm() < f0) z = y, moved = true;
+            } catch (const PhysicsError&) {
+            }
+          }
+          if (!moved) break;
+        }
+      } catch (const std::exception& e) {
+        std::printf("   (failed: %s)\n", e.what());
+      }
+      const double a_root = rom.angle_deg(z, rec.angle_deg);
+      std::printf("  %2d %7.2f %6.2f %9.3f %+8.3f %+8.3f %3d%s %.3g\n", rec.trial, rec.time_s, rec.pressure_Pa * 1e-3, rec.angle_deg,
+                  a_proj - rec.angle_deg, a_root - rec.angle_deg, it, ok ? "" : " NOT CONVERGED", 1e3 * std::sqrt(G.trace() > 0 ? (z.q.squaredNorm() / r) : 0.0));
+    });
+    return 0;
+  }
   QuasiStaticOptions rom_steps = bm->solver.quasi_static;
   if (rom_time_tol > 0.0) rom_steps.time_tol = rom_time_tol;
   ReducedRun run(rom, rom_steps);

@@ -265,6 +265,9 @@ class ReducedRun {
  private:
   struct Segment;
   void solve_segment(const Segment& s);
+  /// A segment without time (a load or release in zero time) or of a model without rate laws:
+  /// pressure continuation with the history frozen.
+  void solve_instantaneous(const Segment& s);
   /// Equilibrium at (p, t) after a step dt from the committed state; on success commits and
   /// records the step. Throws PhysicsError when Newton fails.
   void equilibrium(double p_Pa, double t_s, double dt_s);
@@ -287,6 +290,8 @@ class ReducedRun {
   double h_prev_ = 0.0, rate_prev_ = 0.0;
   bool rate_dependent_ = false;
   HistoryCorrector corrector_;
+  /// Commits the trial history of the state z_ reached at (t, p) after a step dt, and records it.
+  void commit(double t, double dt, double p, bool report);
   /// Records a committed step and lets the corrector replace its history.
   void record_step(const ReducedStep& step);
 };

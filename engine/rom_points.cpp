@@ -116,6 +116,9 @@ std::vector<double> KeptPoints::history_scalars(const std::vector<double>& histo
   return out;
 }
 
+// One function (~110 lines) on purpose: the chunked, deterministic parallel loop (evaluate the
+// material in batches, accumulate each chunk's force and Jacobian, sum the chunks in order) is read
+// as one piece; its per-point algebra is the header's.
 void KeptPoints::force(double theta, const Eigen::VectorXd& q, const TimeStep& ts, std::span<const double> old,
                        std::span<double> trial, Eigen::VectorXd& g, Eigen::MatrixXd* jac) const {
   const int n1 = r_ + 1, np = size();
