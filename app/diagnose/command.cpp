@@ -1080,7 +1080,11 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
     }
     describe_static_remainder(s.current, s.current_static, opt, out);
     out.final_parameters = 0;
-    for (const auto& [e, v] : s.chosen) out.final_parameters += static_cast<int>(v.size());
+    out.final_constants.clear();
+    for (const auto& [e, v] : s.chosen) {
+      out.final_parameters += static_cast<int>(v.size());
+      out.final_constants.push_back(v);
+    }
     out.equivalent_models = equivalent_models(out);
   };
   auto fitted_toml = [&](const Scene& fitted) {

@@ -253,6 +253,10 @@ struct DiagnosisResult {
   /// fit as well as the final model, fewest constants first; and the final model's constant count.
   std::vector<EquivalentModel> equivalent_models;
   int final_parameters = 0;
+  /// The final model's constants, per selected effect in selection order (the selection's own
+  /// record: after every joint re-fit and form change). selected_constants_text prints these; the
+  /// candidates' rows hold the values of their round, which a later swap of forms can leave stale.
+  std::vector<std::vector<double>> final_constants;
   /// Constants with honest uncertainty: after each round, the joint intervals of all constants
   /// selected so far (DiagnoseOptions::intervals), and in words every constant that a later round's
   /// joint re-fit moved outside the interval it had after the round before.

@@ -305,6 +305,16 @@ std::string selected_constants_text(const DiagnosisResult& r) {
         if (o < it->refit_selected.size()) v = it->refit_selected[o++], before.how = "re-fitted with " + it->effect;
     e.push_back({&*it, it->params, ""});
   }
+  // The selection's own record of the final constants wins over the rounds' rows: after a swap of
+  // forms (try_other_forms) the effect's row is its own round's calibration and the re-fits read
+  // from later rows were those of the form it replaced (measured on creep_fatigue_lag: the broad
+  // creep printed with the one-term creep's gamma 0.351, tau 10.6 s, the model's being 1.15, 30 s).
+  if (r.final_constants.size() == e.size())
+    for (std::size_t i = 0; i < e.size(); ++i)
+      if (r.final_constants[i].size() == e[i].values.size() && r.final_constants[i] != e[i].values) {
+        e[i].values = r.final_constants[i];
+        if (e[i].how.empty() || !r.form_changes.empty()) e[i].how = "re-fitted jointly with the other selected effects";
+      }
   if (r.refined_params.size() == e.size())
     for (std::size_t i = 0; i < e.size(); ++i) e[i].values = r.refined_params[i], e[i].how = r.refined_model == "reduced" ? "refined with the reduced-order model" : "refined with the FEM";
   std::string out;

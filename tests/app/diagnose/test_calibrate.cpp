@@ -229,5 +229,27 @@ TEST(DiagnoseSummary, ListsTheSelectedConstantsWithTheirTradeOffRanges) {
                                         "  fatigue: W_th_MPa 0.008, tau_s 200 (refined with the FEM)\n");
 }
 
+// After a swap of forms (try_other_forms) the selected effect's row is its own round's calibration
+// and a later row's re-fit belongs to the form it replaced: the selection's final constants win.
+// Measured before the fix on creep_fatigue_lag: the broad creep printed with the one-term creep's
+// re-fitted gamma 0.351, tau 10.6 s while the model (fitted.toml) had 1.15, 30 s.
+TEST(DiagnoseSummary, PrintsTheFinalConstantsAfterASwapOfForms) {
+  DiagnosisResult r;
+  CandidateResult broad = selected_candidate("viscoelastic_broad", 1, {"gamma", "tau_s"}, {0.44, 7.9});
+  broad.trade_lo = {0.3, 4.0}, broad.trade_hi = {0.6, 20.0}, broad.trade_rss_tol = 0.25;
+  CandidateResult lag = selected_candidate("pressure_lag", 2, {"tau_s", "tau2_s"}, {0.31, 0.0});
+  lag.refit_selected = {0.351, 10.6};  // the one-term creep's, re-fitted with the lag before the swap
+  r.candidates = {broad, lag};
+  r.selected = {"viscoelastic_broad", "pressure_lag"};
+  r.form_changes = {"round 2: viscoelastic_broad replaced viscoelastic_instantaneous"};
+  r.final_constants = {{1.15, 30.0}, {0.3025, 0.005}};
+  EXPECT_EQ(selected_constants_text(r),
+            "  viscoelastic_broad: gamma 1.15, tau_s 30 (re-fitted jointly with the other selected effects)\n"
+            "  pressure_lag: tau_s 0.3025, tau2_s 0.005 (re-fitted jointly with the other selected effects)\n");
+  r.final_constants = {{0.351, 10.6}, {0.31, 0.0}};  // no change: the rows' values and words stay
+  EXPECT_EQ(selected_constants_text(r), "  viscoelastic_broad: gamma 0.351, tau_s 10.6 (re-fitted with pressure_lag)\n"
+                                        "  pressure_lag: tau_s 0.31, tau2_s 0\n");
+}
+
 }  // namespace
 }  // namespace pneufem
