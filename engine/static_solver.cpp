@@ -156,6 +156,7 @@ NewtonReport StaticSolver::solve(double p, const TimeStep& ts, std::span<const d
   const bool energy_search = has_potential_ && opt_.energy_line_search;
   last_step_krylov_ = false;
   force_factor_ = false;
+  solve_give_ups_ = 0;
   for (int it = 0; it <= opt_.max_iterations; ++it) {
     // Residual and tangent at u.
     auto t0 = std::chrono::steady_clock::now();
@@ -366,6 +367,8 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
   // iterations more than a factorisation per Newton iteration:
   //  * CG is abandoned as soon as its observed mean contraction per iteration, continued over the
   //    remaining allowance, would not reach the tolerance (instead of running out the allowance);
+  //  * after one abandoned CG the rest of the Newton solve factorises (the tangent changes too fast
+  //    between iterates for an older factor: a lagged factor of the same solve fails as well);
   //  * a Krylov step after which the Newton residual did not halve forces a factorisation in the
   //    next iteration (solve());
   //  * negative curvature p.Kp <= 0 met by CG proves the tangent is not positive definite, so its
@@ -374,7 +377,8 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
   // The converged answer is the same: the Newton residual test does not change, only the iterates.
   const bool ramp_rules = ramp_rules_;
   last_step_krylov_ = false;
-  if (krylov_allowed_ && !force_factor_ && opt_.krylov_max_iterations > 0 && linear_->has_factor()) {
+  if (krylov_allowed_ && !force_factor_ && !(ramp_rules && solve_give_ups_ > 0) && opt_.krylov_max_iterations > 0 &&
+      linear_->has_factor()) {
     const Eigen::VectorXd b = -R;
     du = Eigen::VectorXd::Zero(b.size());
     Eigen::VectorXd r = b, z = linear_->solve(r), pdir = z, Kp;
@@ -415,7 +419,10 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
       pdir = z + (rz_new / rz) * pdir;
       rz = rz_new;
     }
-    if (ramp_rules) ++stats_.krylov_give_ups;
+    if (ramp_rules) {
+      ++stats_.krylov_give_ups;
+      ++solve_give_ups_;
+    }
   }
   force_factor_ = false;
   if (!factorize_current(rep)) return false;

@@ -198,6 +198,7 @@ class StaticSolver {
   bool ramp_rules_ = false;         ///< solving a load increment with krylov_on_ramps: linear_step's give-ups apply
   bool last_step_krylov_ = false;   ///< the last linear_step of solve() was a CG step with an old factor
   bool force_factor_ = false;       ///< the next linear_step factorises (a Krylov step did not contract |R|)
+  int solve_give_ups_ = 0;          ///< CG attempts of this solve() abandoned (ramps: one ends Krylov for the solve)
   // Two factorisation buffers: a new factorisation goes into spare_ and becomes linear_ only when
   // it succeeds, so linear_ always holds the last positive-definite factor (Indefinite::LastFactor).
   std::unique_ptr<LinearSolver> linear_ = std::make_unique<LinearSolver>();
