@@ -363,8 +363,8 @@ bool StaticSolver::linear_step(const Eigen::VectorXd& R, Eigen::VectorXd& du, Ne
   // superlinear Newton convergence; on breakdown or slow convergence we re-factorise.
   //
   // With krylov_on_ramps (load increments too, where the old factor is one of another pressure)
-  // three give-ups bound the cost of a poor preconditioner, so that the worst case is a few CG
-  // iterations more than a factorisation per Newton iteration:
+  // four rules bound the cost of a poor preconditioner (at most one abandoned, short CG attempt per
+  // load increment, and one Newton iteration per Krylov step that does not pay):
   //  * CG is abandoned as soon as its observed mean contraction per iteration, continued over the
   //    remaining allowance, would not reach the tolerance (instead of running out the allowance);
   //  * after one abandoned CG the rest of the Newton solve factorises (the tangent changes too fast
