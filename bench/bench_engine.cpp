@@ -324,6 +324,10 @@ void print_totals(const QuasiStaticRun& run, double wall) {
               st.factorizations, st.krylov_iterations);
   std::printf("  per Newton iteration %.3f s (assembly %.1f s, factorisation + solves %.1f s in all); per state %.3f s\n",
               wall / std::max(1.0, its), st.assembly_s, st.factor_s, wall / std::max(1.0, states));
+  std::printf("  Krylov steps %ld, CG give-ups %ld, factorisations forced by a Krylov step that did not halve |R| %ld, "
+              "last-factor steps %ld (of which after negative curvature in CG, no factorisation %ld), chord steps %ld\n",
+              st.krylov_steps, st.krylov_give_ups, st.contraction_refactors, st.last_factor_steps, st.indefinite_by_cg,
+              st.chord_steps);
 }
 
 /// The protocol's header line: the model's size and the options.

@@ -30,6 +30,11 @@ struct StaticOptions {
   /// re-factorising (0 = factorise every Newton iteration).
   int krylov_max_iterations = 10;
   double krylov_rel_tol = 1e-3;   ///< CG stopping criterion, relative to |R|
+  /// Newton-Krylov also on pressure ramps (load increments), not only at constant pressure, with
+  /// the give-ups of StaticSolver::linear_step (a CG that cannot reach its tolerance in time, a
+  /// Newton residual that does not contract after a Krylov step, a tangent CG proves indefinite).
+  /// Off: the ramps factorise every Newton iteration, as before (scene key solver.krylov_ramps).
+  bool krylov_on_ramps = false;
   int chord_steps = 3;            ///< back-substitutions with the current factor per iteration
   /// Stiff-layer elimination (see StaticSolver): relaxation steps of the stiff dofs after every
   /// trial update (0 = off), and the shear-modulus ratio above which a part counts as stiff.
@@ -64,6 +69,10 @@ struct StaticStats {
   long factorizations = 0;
   long residual_evaluations = 0;
   long krylov_iterations = 0;
+  long krylov_steps = 0;          ///< Newton iterations stepped by CG with an old factor (no factorisation)
+  long krylov_give_ups = 0;       ///< CG attempts abandoned for a factorisation (slow or stalled CG)
+  long contraction_refactors = 0; ///< factorisations forced because a Krylov step did not contract |R|
+  long indefinite_by_cg = 0;      ///< last-factor steps taken because CG met negative curvature (no failed factorisation)
   long chord_steps = 0;
   long stiff_relaxations = 0;     ///< accepted stiff-layer relaxation steps
   long stiff_factorizations = 0;  ///< factorisations of the stiff-layer block
@@ -185,7 +194,11 @@ class StaticSolver {
 
   const Assembler& asm_;
   StaticOptions opt_;
-  bool krylov_allowed_ = false;  ///< CG with the old factor: only for pure time increments
+  bool krylov_allowed_ = false;  ///< CG with the old factor: pure time increments (and ramps with krylov_on_ramps)
+  bool ramp_rules_ = false;         ///< solving a load increment with krylov_on_ramps: linear_step's give-ups apply
+  bool last_step_krylov_ = false;   ///< the last linear_step of solve() was a CG step with an old factor
+  bool force_factor_ = false;       ///< the next linear_step factorises (a Krylov step did not contract |R|)
+  int solve_give_ups_ = 0;          ///< CG attempts of this solve() abandoned (ramps: one ends Krylov for the solve)
   // Two factorisation buffers: a new factorisation goes into spare_ and becomes linear_ only when
   // it succeeds, so linear_ always holds the last positive-definite factor (Indefinite::LastFactor).
   std::unique_ptr<LinearSolver> linear_ = std::make_unique<LinearSolver>();

@@ -123,6 +123,7 @@ SolverSettings solver_settings(const Scene& s) {
   sv.quasi_static.cycle_jump.change = positive(s, "solver.cycle_jump_change");
   sv.quasi_static.newton.krylov_max_iterations = s.integer("solver.krylov_max_iterations");
   if (sv.quasi_static.newton.krylov_max_iterations < 0) s.fail("solver.krylov_max_iterations", "must be >= 0");
+  sv.quasi_static.newton.krylov_on_ramps = s.boolean("solver.krylov_ramps");
   sv.explicit_dynamics.dt_safety = positive(s, "solver.dt_safety");
   if (sv.explicit_dynamics.dt_safety > 1.0) s.fail("solver.dt_safety", "must be <= 1 (fraction of the stable step)");
   sv.explicit_dynamics.target_dt_s = s.number("solver.target_dt_s");

@@ -251,5 +251,85 @@ TEST(Globalisation, LastFactorAndEnergySearchGiveTheSameEquilibriaWithFewerFacto
   EXPECT_GT(now.stats.energy_cuts, 0);
 }
 
+// Newton-Krylov on pressure ramps (StaticOptions::krylov_on_ramps, StaticSolver::linear_step): CG
+// preconditioned by the factor of an earlier tangent replaces factorisations on the load increments,
+// with give-ups. The Newton residual test is unchanged, so every equilibrium must be the one plain
+// Newton (a factorisation every iteration) finds, within the solver tolerance: rel_tol 1e-8 on the
+// residual, ~1e-8 of the angle (another branch differs by ~1e-2, FollowsTheLoadPathOfSmallIncrements).
+TEST(NewtonKrylovOnRamps, SameEquilibriaAsPlainNewtonWithFewerFactorisations) {
+  const std::vector<std::string> sets = {"geometry.chambers=5", "mesh.h_mm=6.0"};
+  const PathRun plain = run_path(sets, 40.0, 3, 5e3);
+  const PathRun krylov = run_path(sets, 40.0, 3, 5e3, [](StaticOptions& o) { o.krylov_on_ramps = true; });
+  ASSERT_EQ(krylov.angles_deg.size(), plain.angles_deg.size());
+  for (size_t i = 0; i < plain.angles_deg.size(); ++i) {
+    std::printf("  %4.0f kPa: plain Newton %.9f deg, Newton-Krylov %.9f deg\n", 5.0 * (i + 1), plain.angles_deg[i],
+                krylov.angles_deg[i]);
+    EXPECT_NEAR(krylov.angles_deg[i], plain.angles_deg[i], 1e-6 * std::abs(plain.angles_deg[i])) << 5.0 * (i + 1) << " kPa";
+  }
+  const StaticStats &a = plain.stats, &b = krylov.stats;
+  std::printf("  factorisations %ld -> %ld, Newton iterations %ld -> %ld, Krylov steps %ld (%ld CG iterations), "
+              "give-ups %ld, forced by contraction %ld, indefinite found by CG %ld\n",
+              a.factorizations, b.factorizations, a.iterations, b.iterations, b.krylov_steps, b.krylov_iterations,
+              b.krylov_give_ups, b.contraction_refactors, b.indefinite_by_cg);
+  EXPECT_EQ(a.krylov_iterations, 0);  // off: the ramps factorise every iteration, as before
+  EXPECT_GT(b.krylov_steps, 0);
+  EXPECT_LT(b.factorizations, a.factorizations);
+}
+
+// The give-up: a solver whose stored factor belongs to a far-away state (the 5-chamber actuator bent
+// at 40 kPa) is sent back to the unloaded actuator and ramped to 10 kPa; and one whose CG can never
+// reach its tolerance (one CG iteration allowed, tolerance 1e-14). Both must converge to the
+// equilibria of a fresh plain-Newton solver, and the second must have abandoned every CG attempt
+// for a factorisation.
+TEST(NewtonKrylovOnRamps, GiveUpRefactorisesWhenTheOldFactorIsUseless) {
+  const std::vector<std::string> sets = {"geometry.chambers=5", "mesh.h_mm=6.0"};
+  auto bm = build_model(Scene::load("", sets));
+  Assembler A(bm->model);
+  const int n = bm->model.num_dofs();
+  auto climb = [&](StaticSolver& solver, double top_kPa) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+    std::vector<double> state(A.state_size(), 0.0);
+    std::vector<double> angles;
+    for (double p = 5.0; p <= top_kPa + 1e-9; p += 5.0) {
+      solver.advance((p - 5.0) * 1e3, p * 1e3, 0.0, 0.0, state, u);
+      angles.push_back(bending_angle(bm->model, u).angle_deg);
+    }
+    return angles;
+  };
+  StaticSolver plain(A, bm->solver.quasi_static.newton);
+  const std::vector<double> ref = climb(plain, 10.0);
+
+  StaticOptions o = bm->solver.quasi_static.newton;
+  o.krylov_on_ramps = true;
+  StaticSolver far(A, o);
+  climb(far, 40.0);  // leaves the factor of a tangent at 40 kPa
+  StaticSolver::Path empty;
+  far.set_path(empty);  // no predictor from the 40 kPa path
+  const StaticStats before = far.stats();
+  const std::vector<double> back = climb(far, 10.0);
+  StaticOptions hopeless = o;
+  hopeless.krylov_max_iterations = 1;
+  hopeless.krylov_rel_tol = 1e-14;
+  StaticSolver never(A, hopeless);
+  const std::vector<double> none = climb(never, 10.0);
+  ASSERT_EQ(back.size(), ref.size());
+  ASSERT_EQ(none.size(), ref.size());
+  for (size_t i = 0; i < ref.size(); ++i) {
+    std::printf("  %4.0f kPa: fresh plain Newton %.9f deg, after 40 kPa %.9f deg, CG never converging %.9f deg\n",
+                5.0 * (i + 1), ref[i], back[i], none[i]);
+    EXPECT_NEAR(back[i], ref[i], 1e-6 * std::abs(ref[i]));
+    EXPECT_NEAR(none[i], ref[i], 1e-6 * std::abs(ref[i]));
+  }
+  const StaticStats& s = far.stats();
+  std::printf("  after 40 kPa: %ld factorisations, %ld Krylov steps, %ld give-ups, %ld forced by contraction\n",
+              s.factorizations - before.factorizations, s.krylov_steps - before.krylov_steps,
+              s.krylov_give_ups - before.krylov_give_ups, s.contraction_refactors - before.contraction_refactors);
+  const StaticStats& t = never.stats();
+  std::printf("  CG never converging: %ld factorisations (plain %ld), %ld give-ups, %ld Krylov steps\n", t.factorizations,
+              plain.stats().factorizations, t.krylov_give_ups, t.krylov_steps);
+  EXPECT_EQ(t.krylov_steps, 0);
+  EXPECT_GT(t.krylov_give_ups, 0);
+}
+
 }  // namespace
 }  // namespace pneufem
