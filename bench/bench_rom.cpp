@@ -211,6 +211,7 @@ int main(int argc, char** argv) {
     // Cached in the work directory (keyed by the snapshot run's scene): an A/B of basis options
     // does not pay the FEM run again.
     const fs::path f = fs::path(work) / ("snapshots_" + std::to_string(fnv(snap_scene.model_toml())) + ".bin");
+    std::printf("snapshots file: %s\n", f.c_str());
     std::vector<double> d;
     const long nd = sm->model.num_dofs();
     if (read_doubles(f, d) && d.size() % static_cast<std::size_t>(nd) == 0) {

@@ -49,8 +49,8 @@ LAYERS = [
 # Loops left on purpose: the units of each loop exactly as the check finds them, with the reason.
 ALLOWED_LOOPS = [
     ({"app/diagnose/command", "app/diagnose/detail", "app/diagnose/evaluator"},
-     "command.cpp -> evaluator.h, evaluator.cpp -> detail.h, detail.h -> command.h; app/diagnose is being "
-     "edited (issue 34)"),
+     "command.cpp -> evaluator.h, evaluator.cpp -> detail.h, detail.h -> command.h; detail.h needs the "
+     "command's option types in a header of their own (issue 34, left for a later stop)"),
 ]
 
 # Upward or sideways includes left on purpose: ("file", "included file") -> reason. None today.
