@@ -161,6 +161,10 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (!in_run.empty() && in_run != "tops" && in_run != "reports") {
+    std::fprintf(stderr, "--corrected-in-run takes tops or reports, not '%s'\n", in_run.c_str());
+    return 2;
+  }
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   fs::create_directories(work);
@@ -326,7 +330,7 @@ int main(int argc, char** argv) {
     for (Eigen::Index i = 0; i < MPhi.rows(); ++i) MPhi.row(i) *= mass[i / 3];
     const Eigen::MatrixXd G = Phi.transpose() * MPhi;
     const Eigen::LDLT<Eigen::MatrixXd> Gf(G);
-    std::printf("root test (trial, t, p kPa, fem, projection - fem, root - fem, Newton its, |q0| mm):\n");
+    std::printf("root test (trial, t, p kPa, fem, projection - fem, root - fem, Newton its, RMS of the root's q in mm):\n");
     q.run(bm->load, [&](const StateRecord& rec, const Eigen::VectorXd& u, const std::vector<double>& h) {
       if (rec.pressure_Pa < 0.6 * p_max) return;
       ReducedCoordinates z;
@@ -375,7 +379,7 @@ int main(int argc, char** argv) {
       }
       const double a_root = rom.angle_deg(z, rec.angle_deg);
       std::printf("  %2d %7.2f %6.2f %9.3f %+8.3f %+8.3f %3d%s %.3g\n", rec.trial, rec.time_s, rec.pressure_Pa * 1e-3, rec.angle_deg,
-                  a_proj - rec.angle_deg, a_root - rec.angle_deg, it, ok ? "" : " NOT CONVERGED", 1e3 * std::sqrt(G.trace() > 0 ? (z.q.squaredNorm() / r) : 0.0));
+                  a_proj - rec.angle_deg, a_root - rec.angle_deg, it, ok ? "" : " NOT CONVERGED", 1e3 * std::sqrt(z.q.squaredNorm() / std::max(r, 1)));
     });
     return 0;
   }

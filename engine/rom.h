@@ -143,7 +143,6 @@ struct RomBasisOptions {
   bool verbose = false;
 };
 
-
 /// Builds the basis of `reference` (elastic: materials without history, no gravity) from its traced
 /// path (engine/path_model.h). Throws InputError for a reference with history or a trace that does
 /// not fit it, PhysicsError when no sample's tangent could be factorised.
