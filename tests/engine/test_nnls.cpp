@@ -1,0 +1,116 @@
+// engine/nnls.h: Lawson-Hanson non-negative least squares (the reduced model's element sampling)
+// against its truths: a case solved by hand, the exact optimum of an enumeration of every active
+// set, the recovery of a sparse non-negative solution, and the early stop at rel_tol.
+#include "engine/nnls.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/QR>
+#include <gtest/gtest.h>
+
+namespace pneufem {
+namespace {
+
+Eigen::MatrixXd random_matrix(int rows, int cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd A(rows, cols);
+  for (int j = 0; j < cols; ++j)
+    for (int i = 0; i < rows; ++i) A(i, j) = u(rng);
+  return A;
+}
+
+TEST(Nnls, ACaseSolvedByHand) {
+  // A = I: x_j = max(b_j, 0), and the residual is the norm of the negative part of b.
+  const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(3, 3);
+  const Eigen::Vector3d b(1.0, -2.0, 3.0);
+  const NnlsResult r = nnls(A, b, 0.0);
+  EXPECT_TRUE(r.converged);
+  EXPECT_NEAR(r.x[0], 1.0, 1e-14);
+  EXPECT_EQ(r.x[1], 0.0);
+  EXPECT_NEAR(r.x[2], 3.0, 1e-14);
+  EXPECT_NEAR(r.residual, 2.0, 1e-14);
+  EXPECT_EQ(r.iterations, 2);  // two columns brought in
+}
+
+TEST(Nnls, TheOptimumOfEveryActiveSet) {
+  // 25 x 9: the NNLS optimum is the least-squares solution on one set of columns with all weights
+  // > 0; enumerating the 2^9 sets gives the smallest such residual, which nnls must reach.
+  const int m = 25, n = 9;
+  const Eigen::MatrixXd A = random_matrix(m, n, 7);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd b(m);
+  for (int i = 0; i < m; ++i) b[i] = u(rng);
+
+  double best = b.norm();
+  for (int mask = 1; mask < (1 << n); ++mask) {
+    std::vector<int> cols;
+    for (int j = 0; j < n; ++j)
+      if (mask & (1 << j)) cols.push_back(j);
+    Eigen::MatrixXd As(m, static_cast<int>(cols.size()));
+    for (std::size_t c = 0; c < cols.size(); ++c) As.col(static_cast<int>(c)) = A.col(cols[c]);
+    const Eigen::VectorXd z = As.colPivHouseholderQr().solve(b);
+    if (z.minCoeff() > 0.0) best = std::min(best, (As * z - b).norm());
+  }
+
+  const NnlsResult r = nnls(A, b, 0.0);
+  EXPECT_TRUE(r.converged);
+  EXPECT_GE(r.x.minCoeff(), 0.0);
+  // Both are QR solutions of the same subproblem: agreement to rounding of O(1) numbers.
+  EXPECT_NEAR(r.residual, best, 1e-12);
+  EXPECT_NEAR(r.residual, (A * r.x - b).norm(), 1e-12);
+  // Kuhn-Tucker: the gradient A^T (b - A x) is zero on the weights > 0 and <= 0 on the others.
+  const Eigen::VectorXd w = A.transpose() * (b - A * r.x);
+  for (int j = 0; j < n; ++j) {
+    if (r.x[j] > 0.0)
+      EXPECT_NEAR(w[j], 0.0, 1e-11) << j;  // nnls's own threshold is 1e-12 max|A| ||b||
+    else
+      EXPECT_LE(w[j], 1e-11) << j;
+  }
+}
+
+TEST(Nnls, RecoversASparseNonNegativeSolution) {
+  // b = A x* with x* >= 0 on three of eight columns of a full-rank 20 x 8 A: x* is the unique
+  // optimum (residual 0), found to rounding (the QR of a well-conditioned 20 x 3 system).
+  const Eigen::MatrixXd A = random_matrix(20, 8, 11);
+  Eigen::VectorXd xs = Eigen::VectorXd::Zero(8);
+  xs[1] = 2.0;
+  xs[3] = 0.5;
+  xs[6] = 1.0;
+  const NnlsResult r = nnls(A, A * xs, 0.0);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT((r.x - xs).norm(), 1e-12);
+  EXPECT_LT(r.residual, 1e-12);
+}
+
+TEST(Nnls, StopsEarlyAtTheRelativeTolerance) {
+  const Eigen::MatrixXd A = random_matrix(40, 30, 3);
+  Eigen::VectorXd xs = Eigen::VectorXd::Zero(30);
+  for (int j = 0; j < 30; j += 2) xs[j] = 1.0 + 0.1 * j;
+  const Eigen::VectorXd b = A * xs;
+  const NnlsResult full = nnls(A, b, 0.0);
+  const NnlsResult early = nnls(A, b, 0.3);
+  EXPECT_TRUE(early.converged);
+  EXPECT_LE(early.residual, 0.3 * b.norm());
+  EXPECT_LT(early.iterations, full.iterations);
+  EXPECT_LT((early.x.array() > 0.0).count(), (full.x.array() > 0.0).count());  // fewer sampled elements
+
+  const NnlsResult one = nnls(A, b, 0.0, 1);  // max_iterations = 1: one column, not converged
+  EXPECT_EQ(one.iterations, 1);
+  EXPECT_EQ((one.x.array() > 0.0).count(), 1);
+  EXPECT_FALSE(one.converged);
+}
+
+TEST(Nnls, AZeroRightHandSideIsSolvedByZero) {
+  const NnlsResult r = nnls(random_matrix(5, 4, 1), Eigen::VectorXd::Zero(5), 0.0);
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.x, Eigen::VectorXd::Zero(4));
+  EXPECT_EQ(r.iterations, 0);
+}
+
+}  // namespace
+}  // namespace pneufem
