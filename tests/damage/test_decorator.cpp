@@ -1,0 +1,97 @@
+// damage/decorator.h: the plumbing the decorators share - the layout of a point's state block
+// [own | base], the batched call of the base (stress_base: the base's slices gathered into consecutive
+// blocks and scattered back), the check that a base's energy is a potential, and the two scalar
+// helpers. The decorators' physics is tested by their own files and the derivative battery.
+#include "damage/decorator.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "damage/effects.h"
+#include "materials/hyperelastic.h"
+#include "tests/support/input_error.h"
+
+namespace pneufem {
+namespace {
+
+MaterialPtr yeoh() { return std::make_shared<InvariantMaterial<Yeoh>>(Yeoh(0.02e6, 0.001e6, 0.0, 2e6)); }
+
+TEST(Decorator, PointStateIsOwnThenBaseInConsecutiveBlocks) {
+  std::vector<double> old(15), fresh(15);
+  for (int i = 0; i < 15; ++i) old[i] = i;
+  // 3 points of [own 2 | base 3]: point 1 is old[5..9].
+  const detail::PointState p = detail::point_state(old, fresh, 1, 2, 3);
+  ASSERT_EQ(p.own_old.size(), 2u);
+  ASSERT_EQ(p.base_old.size(), 3u);
+  EXPECT_EQ(p.own_old[0], 5.0);
+  EXPECT_EQ(p.base_old[0], 7.0);
+  EXPECT_EQ(p.base_old[2], 9.0);
+  EXPECT_EQ(p.own_new.data(), fresh.data() + 5);
+  EXPECT_EQ(p.base_new.data(), fresh.data() + 7);
+  // Empty spans stay empty: the virgin state, and no trial state wanted.
+  const detail::PointState v = detail::point_state({}, {}, 2, 2, 3);
+  EXPECT_TRUE(v.own_old.empty() && v.base_old.empty() && v.own_new.empty() && v.base_new.empty());
+}
+
+TEST(Decorator, StressBaseGathersAndScattersTheBaseState) {
+  // The base is a Mullins-softened Yeoh (2 doubles per point); the pretend decorator owns 3 more.
+  const MaterialPtr base = make_mullins(yeoh(), {2.0, 1e3, 0.1});
+  const std::size_t own = 3, nb = static_cast<std::size_t>(base->state_size()), ss = own + nb;
+  ASSERT_EQ(nb, 2u);
+  const int n = 5;
+  StressBatch b, ref;
+  b.n = ref.n = n;
+  for (int l = 0; l < n; ++l) {
+    Mat3 F = Mat3::Identity();
+    F(0, 0) = 1.1 + 0.05 * l;
+    F(0, 1) = 0.02 * l;
+    b.set_F(l, F);
+    ref.set_F(l, F);
+  }
+  b.pad();
+  ref.pad();
+  const TimeStep step{1.0, 1.0};
+  // From the virgin state: the base's trial blocks land in the base slots, the own slots keep their values.
+  std::vector<double> state_new(n * ss, -7.0), ref_new(n * nb, 0.0);
+  ASSERT_TRUE(detail::stress_base(*base, b, step, {}, state_new, own));
+  base->stress(ref, step, {}, ref_new);
+  for (int l = 0; l < n; ++l) {
+    EXPECT_EQ(b.psi_iso[l], ref.psi_iso[l]) << l;  // the same call of the base: bit for bit
+    EXPECT_EQ(b.P_iso[0][l], ref.P_iso[0][l]) << l;
+    for (std::size_t i = 0; i < own; ++i) EXPECT_EQ(state_new[l * ss + i], -7.0) << l;
+    for (std::size_t i = 0; i < nb; ++i) EXPECT_EQ(state_new[l * ss + own + i], ref_new[l * nb + i]) << l;
+  }
+  // From a committed state: the base sees its own slices of it (consecutive), not the decorator's.
+  std::vector<double> state_old = state_new, again(n * ss, 0.0), ref_again(n * nb, 0.0);
+  for (int l = 0; l < n; ++l) state_old[l * ss + own] *= 1.5;  // a larger W_max than the trial wrote
+  std::vector<double> ref_old(n * nb);
+  for (int l = 0; l < n; ++l)
+    for (std::size_t i = 0; i < nb; ++i) ref_old[l * nb + i] = state_old[l * ss + own + i];
+  ASSERT_TRUE(detail::stress_base(*base, b, step, state_old, again, own));
+  base->stress(ref, step, ref_old, ref_again);
+  for (int l = 0; l < n; ++l) {
+    EXPECT_EQ(b.psi_iso[l], ref.psi_iso[l]) << l;
+    for (std::size_t i = 0; i < nb; ++i) EXPECT_EQ(again[l * ss + own + i], ref_again[l * nb + i]) << l;
+  }
+}
+
+TEST(Decorator, AnEffectOfTheEnergyNeedsABaseWhoseEnergyIsAPotential) {
+  EXPECT_EQ(pneufem::test::error_of([] { detail::require_potential_base(yeoh(), "mullins"); }), "(no error)");
+  const MaterialPtr visco = make_viscoelastic(yeoh(), {{0.5}, {10.0}, ViscoModuli::long_term});
+  const std::string e = pneufem::test::error_of([&] { detail::require_potential_base(visco, "mullins"); });
+  EXPECT_NE(e.find("mullins: cannot wrap '" + visco->name() + "'"), std::string::npos) << e;
+  EXPECT_NE(e.find("viscoelastic(fatigue(mullins(base)))"), std::string::npos) << e;
+}
+
+TEST(Decorator, CombinedDamageAndMacaulayBracket) {
+  EXPECT_DOUBLE_EQ(detail::combine_damage(0.2, 0.5), 0.6);  // 1 - 0.8 * 0.5
+  EXPECT_EQ(detail::combine_damage(0.0, 0.3), 0.3);
+  EXPECT_EQ(detail::combine_damage(0.3, 0.0), 0.3);
+  EXPECT_EQ(detail::macaulay(-1.0), 0.0);
+  EXPECT_EQ(detail::macaulay(2.5), 2.5);
+}
+
+}  // namespace
+}  // namespace pneufem
