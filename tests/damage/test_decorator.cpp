@@ -87,8 +87,11 @@ TEST(Decorator, AnEffectOfTheEnergyNeedsABaseWhoseEnergyIsAPotential) {
 
 TEST(Decorator, CombinedDamageAndMacaulayBracket) {
   EXPECT_DOUBLE_EQ(detail::combine_damage(0.2, 0.5), 0.6);  // 1 - 0.8 * 0.5
-  EXPECT_EQ(detail::combine_damage(0.0, 0.3), 0.3);
-  EXPECT_EQ(detail::combine_damage(0.3, 0.0), 0.3);
+  // No damage is the identity, to the rounding of 1 - (1 - d) (0.3 comes back as 0.30000000000000004).
+  EXPECT_DOUBLE_EQ(detail::combine_damage(0.0, 0.3), 0.3);
+  EXPECT_DOUBLE_EQ(detail::combine_damage(0.3, 0.0), 0.3);
+  EXPECT_EQ(detail::combine_damage(0.0, 0.0), 0.0);
+  EXPECT_EQ(detail::combine_damage(1.0, 0.4), 1.0);  // a failed point stays failed
   EXPECT_EQ(detail::macaulay(-1.0), 0.0);
   EXPECT_EQ(detail::macaulay(2.5), 2.5);
 }
