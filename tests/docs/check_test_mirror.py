@@ -81,10 +81,7 @@ MAPPED = {
     "app/simulate/cli.cpp": runs(["tests/app/test_cli.cpp"], _CLI + "tests/app/test_cli.cpp"),
     "app/sweep/cli.cpp": runs(["tests/app/sweep/test_command.cpp"], _CLI + "tests/app/sweep/test_command.cpp"),
     "app/synth/cli.cpp": runs(["tests/app/synth/test_command.cpp"], _CLI + "tests/app/synth/test_command.cpp"),
-    # app/compare, app/fit_material, app/simulate
-    "app/compare/dlc_map.cpp": by(["tests/app/compare/test_command.cpp"],
-                                  "the DeepLabCut keypoint map is tested with the command that reads it; "
-                                  "to split out into test_dlc_map.cpp"),
+    # app/fit_material, app/simulate
     "app/fit_material/command.cpp": by(["tests/app/fit_material/test_fit_material.cpp"],
                                        "fit-material's three files share one test file; to split along them "
                                        "(test_command.cpp, test_test_data.cpp, test_deck_test_data.cpp)"),
@@ -112,9 +109,6 @@ MAPPED = {
     "damage/material_point.cpp": by(["tests/damage/test_mullins.cpp", "tests/damage/test_fatigue.cpp"],
                                     "a point's committed/trial state: the history tests of each decorator drive it"),
     # engine/
-    "engine/angle.cpp": by(["tests/engine/test_assembly.cpp"], "the bending angle (BendingAngle.*: rigid "
-                           "rotations, the half model's mirror) shares the assembly's test file; to split out "
-                           "into test_angle.cpp"),
     "engine/explicit.cpp": by(["tests/engine/test_solvers.cpp"],
                               "the solvers share one test file of analytic truths (Explicit.*); to split into "
                               "test_static_solver.cpp, test_relaxation.cpp, test_explicit.cpp"),
@@ -141,10 +135,9 @@ MAPPED = {
     "engine/rom_replay.cpp": by(["tests/engine/test_rom.cpp"], "implements rom.h (see reduced_basis.cpp)",
                                 through="engine/rom.h"),
     # fit/, materials/
-    "fit/stability.cpp": by(["tests/fit/test_fit.cpp"], "Drucker stability of a fitted law is checked with the "
-                            "fits it constrains; to split out into test_stability.cpp"),
-    "fit/volumetric.cpp": by(["tests/fit/test_fit.cpp"], "the volumetric fit is tested with the fits; to split "
-                             "out into test_volumetric.cpp"),
+    "fit/stability.cpp": by(["tests/fit/test_incompressible.cpp"], "the Drucker tangent and stability "
+                            "(DruckerTangent.*, DruckerStability.*) share the incompressible responses' laws and "
+                            "finite differences; to split out into test_stability.cpp"),
     "materials/hyperelastic.cpp": by(["tests/materials/test_materials.cpp", "tests/materials/test_material_truth.cpp"],
                                      "the laws share the derivative battery (test_materials.cpp) and the analytic "
                                      "truths (test_material_truth.cpp), parametrised over the laws"),
