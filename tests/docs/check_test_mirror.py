@@ -109,14 +109,6 @@ MAPPED = {
     "damage/material_point.cpp": by(["tests/damage/test_mullins.cpp", "tests/damage/test_fatigue.cpp"],
                                     "a point's committed/trial state: the history tests of each decorator drive it"),
     # engine/
-    "engine/explicit.cpp": by(["tests/engine/test_solvers.cpp"],
-                              "the solvers share one test file of analytic truths (Explicit.*); to split into "
-                              "test_static_solver.cpp, test_relaxation.cpp, test_explicit.cpp"),
-    "engine/relaxation.cpp": by(["tests/engine/test_solvers.cpp"], "the solvers share one test file "
-                                "(DynamicRelaxation.*; see explicit.cpp)"),
-    "engine/static_solver.cpp": by(["tests/engine/test_solvers.cpp", "tests/engine/test_pneunet_solvers.cpp"],
-                                   "the solvers share one test file (PatchTest, CylinderInflation, Cantilever; see "
-                                   "explicit.cpp); the globalisation on a pneu-net in test_pneunet_solvers.cpp"),
     "engine/model.cpp": by(["tests/engine/test_membrane.cpp"], "validate(): its membrane checks are tested with "
                            "the membranes; the other checks through the scenes that build models"),
     "engine/quasi_static.cpp": by(["tests/engine/test_pneunet_solvers.cpp", "tests/engine/test_creep.cpp",
