@@ -76,19 +76,12 @@ MAPPED = {
                          "each command's dispatch are tested through the executable"),
     "app/compare/cli.cpp": runs(["tests/app/compare/test_command.cpp"], _CLI + "tests/app/compare/test_command.cpp"),
     "app/diagnose/cli.cpp": runs(["tests/app/test_cli.cpp"], _CLI + "tests/app/test_cli.cpp"),
-    "app/fit_material/cli.cpp": runs(["tests/app/fit_material/test_fit_material.cpp"],
-                                     _CLI + "tests/app/fit_material/test_fit_material.cpp"),
+    "app/fit_material/cli.cpp": runs(["tests/app/fit_material/test_command.cpp"],
+                                     _CLI + "tests/app/fit_material/test_command.cpp"),
     "app/simulate/cli.cpp": runs(["tests/app/test_cli.cpp"], _CLI + "tests/app/test_cli.cpp"),
     "app/sweep/cli.cpp": runs(["tests/app/sweep/test_command.cpp"], _CLI + "tests/app/sweep/test_command.cpp"),
     "app/synth/cli.cpp": runs(["tests/app/synth/test_command.cpp"], _CLI + "tests/app/synth/test_command.cpp"),
-    # app/fit_material, app/simulate
-    "app/fit_material/command.cpp": by(["tests/app/fit_material/test_fit_material.cpp"],
-                                       "fit-material's three files share one test file; to split along them "
-                                       "(test_command.cpp, test_test_data.cpp, test_deck_test_data.cpp)"),
-    "app/fit_material/test_data.cpp": by(["tests/app/fit_material/test_fit_material.cpp"],
-                                         "fit-material's three files share one test file (see command.cpp)"),
-    "app/fit_material/deck_test_data.cpp": by(["tests/app/fit_material/test_fit_material.cpp"],
-                                              "fit-material's three files share one test file (see command.cpp)"),
+    # app/simulate
     "app/simulate/command.cpp": by(["tests/app/simulate/test_console.cpp", "tests/app/simulate/test_reduced.cpp"],
                                    "run_simulation is tested by what it prints (test_console.cpp), by its "
                                    "reduced-model path (test_reduced.cpp) and through the executable (test_cli.cpp)"),

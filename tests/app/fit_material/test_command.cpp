@@ -1,6 +1,7 @@
-// `pneufem fit-material`: the test-data reader (units, layouts, bad input), the Ecoflex 00-50 Yeoh fit
-// against an independent reference, Treloar through the whole command, and the material block read
-// back by the scene reader.
+// `pneufem fit-material` (app/fit_material/command.h): the Ecoflex 00-50 Yeoh fit against an
+// independent reference, Treloar through the whole command, the material and effect blocks read back by
+// the scene reader, and the command line. The readers of test data are test_test_data.cpp (CSV) and
+// test_deck_test_data.cpp (an Abaqus deck's *UNIAXIAL TEST DATA ...).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,12 +11,11 @@
 #include <string>
 
 #include "app/fit_material/command.h"
-#include "app/fit_material/deck_test_data.h"
-#include "app/fit_material/test_data.h"
 #include "fit/inelastic.h"
 #include "scenes/build_model.h"
 #include "scenes/scene.h"
 #include "tests/app/cli_helpers.h"
+#include "tests/app/fit_material/fit_material_helpers.h"
 #include "tests/support/input_error.h"
 
 namespace pneufem {
@@ -24,124 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using fit::TestMode;
 using test::error_of;
-
-const std::string kData = PNEUFEM_TEST_DATA_DIR;
-const std::string kEcoflex = kData + "/soro-materials-db/ecoflex_00-50.csv";
-
-/// Writes `text` to a fresh file under the test temp directory and returns its path.
-std::string write_temp(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "pneufem_fit_material";
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
-  std::ofstream(p) << text;
-  return p.string();
-}
-
-/// A Treloar .dat file (stretch, MPa; no header) as CSV with the header 'stretch,stress_MPa'.
-std::string treloar_csv(const std::string& mode) {
-  std::ifstream in(kData + "/treloar1944/treloar_" + mode + ".dat");
-  std::string text = "stretch,stress_MPa\n";
-  for (std::string l, P; in >> l >> P;) text += l + "," + P + "\n";
-  return write_temp(mode + ".csv", text);
-}
-
-fit::TestCurve read(const std::string& path, TestMode m = TestMode::uniaxial) {
-  std::vector<std::string> notes;
-  return read_test_csv(path, m, notes);
-}
-
-// --- reader ---------------------------------------------------------------------------------
-
-TEST(TestData, UnitsComeFromTheHeader) {
-  const fit::TestCurve kpa = read(write_temp("kpa.csv", "strain,stress_kPa\n0,0\n0.5,20\n1.0,35\n"));
-  ASSERT_EQ(kpa.points.size(), 3u);
-  EXPECT_DOUBLE_EQ(kpa.points[2].stretch, 2.0);
-  EXPECT_DOUBLE_EQ(kpa.points[2].P_Pa, 35e3);
-  EXPECT_EQ(kpa.points[2].line, 4);
-  const fit::TestCurve mpa = read(write_temp("mpa.csv", "Stretch, Stress (MPa)\n1.5,0.02\n"));
-  EXPECT_DOUBLE_EQ(mpa.points[0].stretch, 1.5);
-  EXPECT_DOUBLE_EQ(mpa.points[0].P_Pa, 0.02e6);
-  const fit::TestCurve pct = read(write_temp("pct.csv", "time_s,strain_percent,stress_psi\n0,50,1\n"));
-  EXPECT_DOUBLE_EQ(pct.points[0].stretch, 1.5);
-  EXPECT_NEAR(pct.points[0].P_Pa, 6894.757, 1e-3);
-  // decimal commas with ';' (a spreadsheet in a decimal-comma locale)
-  const fit::TestCurve comma = read(write_temp("comma.csv", "Dehnung;strain;stress_N/mm^2\nx;0,25;0,5\n"));
-  EXPECT_DOUBLE_EQ(comma.points[0].stretch, 1.25);
-  EXPECT_DOUBLE_EQ(comma.points[0].P_Pa, 0.5e6);
-}
-
-// The testing machine's export as it is: 17 metadata lines, ';', true and engineering columns.
-TEST(TestData, ReadsTheMachineExportWithItsMetadataBlock) {
-  std::vector<std::string> notes;
-  const fit::TestCurve c = read_test_csv(kEcoflex, TestMode::uniaxial, notes);
-  ASSERT_EQ(c.points.size(), 720u);  // 721 rows, the first (negative stress) left out
-  EXPECT_EQ(c.points[0].line, 20);
-  EXPECT_DOUBLE_EQ(c.points[0].stretch, 1.06795);
-  EXPECT_DOUBLE_EQ(c.points[0].P_Pa, 0.00224e6);
-  std::string all;
-  for (const std::string& n : notes) all += n + "\n";
-  EXPECT_NE(all.find("16 line(s) before the header (line 18) skipped"), std::string::npos) << all;
-  EXPECT_NE(all.find("'True Strain', 'True Stress (MPa)' skipped"), std::string::npos) << all;
-  EXPECT_NE(all.find("ecoflex_00-50.csv:19: 1 point(s) with zero or negative stress"), std::string::npos) << all;
-}
-
-TEST(TestData, TheTestModeComesFromThePrefixOrTheFileName) {
-  EXPECT_EQ(parse_test_spec("planar:a.csv").mode, TestMode::planar);
-  EXPECT_EQ(parse_test_spec("planar:a.csv").path, "a.csv");
-  EXPECT_EQ(parse_test_spec("equibiaxial:x/b.csv").mode, TestMode::biaxial);
-  EXPECT_EQ(parse_test_spec("data/silicone_pure_shear.csv").mode, TestMode::planar);
-  EXPECT_EQ(parse_test_spec("run3_Equibiaxial.csv").mode, TestMode::biaxial);
-  const std::string e = error_of([] { parse_test_spec("data/silicone.csv"); });
-  EXPECT_NE(e.find("which test is it? Write uniaxial:data/silicone.csv"), std::string::npos) << e;
-}
-
-// --- reader: bad input, each naming the file and line and what to do -------------------------------
-
-TEST(TestDataErrors, NonMonotonicStrain) {
-  const std::string p = write_temp("cycle.csv", "strain,stress_kPa\n0.1,5\n0.5,20\n0.3,8\n");
-  const std::string e = error_of([&] { read(p); });
-  EXPECT_NE(e.find("cycle.csv:4: the strain falls from 0.5 (line 3) to 0.3"), std::string::npos) << e;
-  EXPECT_NE(e.find("Keep the first loading up to line 3"), std::string::npos) << e;
-}
-
-TEST(TestDataErrors, NegativeStrain) {
-  const std::string p = write_temp("compression.csv", "strain,stress_kPa\n-0.2,-5\n0,0\n0.5,20\n");
-  const std::string e = error_of([&] { read(p); });
-  EXPECT_NE(e.find("compression.csv:2: nominal strain -0.2 is negative"), std::string::npos) << e;
-  EXPECT_NE(e.find("tension tests only"), std::string::npos) << e;
-  const std::string s = write_temp("stretch0.csv", "stretch,stress_kPa\n0,0\n");
-  EXPECT_NE(error_of([&] { read(s); }).find("stretch0.csv:2: stretch 0 <= 0"), std::string::npos);
-}
-
-TEST(TestDataErrors, MixedMissingAndUnknownUnits) {
-  const std::string mixed = write_temp("mixed.csv", "strain,stress_kPa,stress_MPa\n0.5,20,0.02\n");
-  std::string e = error_of([&] { read(mixed); });
-  EXPECT_NE(e.find("mixed.csv:1: columns 'stress_kPa' and 'stress_MPa' both give the stress in different units "
-                   "(mixed units); keep one of them"),
-            std::string::npos)
-      << e;
-  const std::string two_strains = write_temp("two.csv", "strain,stretch,stress_MPa\n0.5,1.5,0.02\n");
-  EXPECT_NE(error_of([&] { read(two_strains); }).find("both give the strain in different units"), std::string::npos);
-  const std::string none = write_temp("nounit.csv", "# my test\nstrain,stress\n0.5,20\n");
-  e = error_of([&] { read(none); });
-  EXPECT_NE(e.find("nounit.csv:2: column 'stress' has no unit; name it stress_Pa, stress_kPa"), std::string::npos) << e;
-  const std::string bar = write_temp("bar.csv", "strain,stress_bar\n0.5,20\n");
-  EXPECT_NE(error_of([&] { read(bar); }).find("bar.csv:1: column 'stress_bar': unknown stress unit 'bar'"),
-            std::string::npos);
-  const std::string cells = write_temp("cells.csv", "strain,stress_kPa\n0.5,20 kPa\n");
-  e = error_of([&] { read(cells); });
-  EXPECT_NE(e.find("cells.csv:2: '20 kPa' in column 'stress_kPa' is not a number (units belong in the header"),
-            std::string::npos)
-      << e;
-}
-
-TEST(TestDataErrors, NoHeader) {
-  const std::string p = write_temp("bare.csv", "0.5,20\n1.0,35\n");
-  const std::string e = error_of([&] { read(p); });
-  EXPECT_NE(e.find("bare.csv:1: data before any header; the first line must name the columns"), std::string::npos) << e;
-  const std::string q = write_temp("words.csv", "a,b\nc,d\n");
-  EXPECT_NE(error_of([&] { read(q); }).find("words.csv: no header naming the columns with their units, e.g. 'strain,stress_kPa'"), std::string::npos);
-}
+using namespace test::fit_material;
 
 // --- fits ------------------------------------------------------------------------------------
 
@@ -402,75 +285,6 @@ TEST(FitMaterialCommand, AVolumetricTestSetsKOverMu) {
   EXPECT_NE(error_of([&] { read_volumetric_csv(write_temp("v2.csv", "J,pressure_kPa\n0,1\n"), notes); })
                 .find("v2.csv:2: volume ratio 0 <= 0 is impossible"),
             std::string::npos);
-}
-
-/// Treloar's three tests as an Abaqus deck: *HYPERELASTIC, OGDEN, N=3, TEST DATA INPUT and the test data
-/// blocks (nominal stress, nominal strain; mm-N-MPa), after a material without test data.
-std::string treloar_deck() {
-  std::string deck = "** Treloar 1944 as Abaqus test data\n*MATERIAL, NAME=STEEL\n*ELASTIC\n210000., 0.3\n"
-                     "*MATERIAL, NAME=Treloar\n*HYPERELASTIC, OGDEN, N=3, TEST DATA INPUT\n";
-  for (const auto& [kw, file] : std::vector<std::pair<std::string, std::string>>{
-           {"UNIAXIAL", "uniaxial"}, {"BIAXIAL", "equibiaxial"}, {"PLANAR", "pureshear"}}) {
-    deck += "*" + kw + " TEST DATA\n";
-    std::ifstream in(kData + "/treloar1944/treloar_" + file + ".dat");
-    for (double l, P; in >> l >> P;) deck += std::to_string(P) + ", " + std::to_string(l - 1.0) + "\n";
-  }
-  return write_temp("treloar.inp", deck);
-}
-
-// The same fit from a deck as from the CSV files: the law from the *HYPERELASTIC line, the same
-// points (to the 6 decimals std::to_string wrote: constants within 1e-4 relative of the CSV fit).
-TEST(DeckTestData, TreloarFromAnAbaqusDeckFitsAsFromCsv) {
-  FitMaterialOptions o;
-  o.data = {"deck:" + treloar_deck()};
-  o.out_dir = test::fresh_dir("fit_deck").string();
-  const FitMaterialResult deck = run_fit_material(o);
-  EXPECT_EQ(deck.model, "ogden3");
-  ASSERT_EQ(deck.tests.size(), 3u);
-  EXPECT_EQ(deck.tests[1].mode, TestMode::biaxial);
-  EXPECT_EQ(deck.tests[0].points.size(), 25u);
-  o.data = {treloar_csv("uniaxial"), "biaxial:" + treloar_csv("equibiaxial"), treloar_csv("pureshear")};
-  o.model = "ogden3";
-  const FitMaterialResult csv = run_fit_material(o);
-  ASSERT_EQ(deck.fit.constants.c.size(), csv.fit.constants.c.size());
-  for (std::size_t i = 0; i < csv.fit.constants.c.size(); ++i) {
-    EXPECT_NEAR(deck.fit.constants.c[i], csv.fit.constants.c[i], 1e-4 * csv.fit.constants.c[i]);
-    EXPECT_NEAR(deck.fit.constants.alpha[i], csv.fit.constants.alpha[i], 1e-4 * std::abs(csv.fit.constants.alpha[i]));
-  }
-}
-
-TEST(DeckTestData, Errors) {
-  const auto deck = [&](const std::string& name, const std::string& text) { return write_temp(name, text); };
-  const std::string arruda = deck("ab.inp", "*MATERIAL, NAME=R\n*HYPERELASTIC, ARRUDA-BOYCE, TEST DATA INPUT\n");
-  std::string e = error_of([&] { read_deck_test_data(arruda, "mm"); });
-  EXPECT_NE(e.find("ab.inp:2: *HYPERELASTIC, ARRUDA-BOYCE: pneufem has no such law"), std::string::npos) << e;
-  const std::string outside = deck("out.inp", "*MATERIAL, NAME=R\n*HYPERELASTIC, YEOH\n0.1, 0, 0, 0\n*UNIAXIAL TEST DATA\n0.1, 0.2\n");
-  e = error_of([&] { read_deck_test_data(outside, "mm"); });
-  EXPECT_NE(e.find("out.inp:4: *UNIAXIAL TEST DATA outside a *HYPERELASTIC, TEST DATA INPUT"), std::string::npos) << e;
-  const std::string bad = deck("bad.inp", "*MATERIAL, NAME=R\n*HYPERELASTIC, TEST DATA INPUT\n*UNIAXIAL TEST DATA\n0.1, x\n");
-  e = error_of([&] { read_deck_test_data(bad, "mm"); });
-  EXPECT_NE(e.find("bad.inp:4: field 2 (nominal strain) is not a number; a test data line is 'nominal stress, nominal strain'"),
-            std::string::npos) << e;
-  const std::string two = deck("two.inp", "*MATERIAL, NAME=A\n*HYPERELASTIC, YEOH, TEST DATA INPUT\n*UNIAXIAL TEST DATA\n"
-                                          "0.1, 0.2\n0.2, 0.5\n0.3,1\n*MATERIAL, NAME=B\n*HYPERELASTIC, TEST DATA INPUT\n"
-                                          "*PLANAR TEST DATA\n0.1, 0.2\n0.2, 0.5\n");
-  FitMaterialOptions o;
-  o.out_dir = test::fresh_dir("fit_deck_errors").string();
-  o.data = {"deck:" + two};
-  e = error_of([&] { run_fit_material(o); });
-  EXPECT_NE(e.find("several materials have test data (A, B); choose one with --deck-material NAME"), std::string::npos) << e;
-  o.deck_material = "B";
-  // no law on the line: Abaqus's default POLYNOMIAL, N=1 (Mooney-Rivlin), whose C10 and C01 a planar
-  // test alone cannot separate (P = 2 (l - l^-3)(C10 + C01))
-  e = error_of([&] { run_fit_material(o); });
-  EXPECT_NE(e.find("two.inp:9 (*MATERIAL B) (2 points) do not determine the 2 constants of mooney_rivlin"),
-            std::string::npos) << e;
-  o.model = "neo_hookean";
-  o.model_given = true;
-  const FitMaterialResult r = run_fit_material(o);
-  EXPECT_EQ(r.model, "neo_hookean");
-  EXPECT_EQ(r.tests[0].mode, TestMode::planar);
-  EXPECT_NEAR(r.tests[0].points[1].P_Pa, 0.2e6, 1e-6);  // MPa with --deck-length-unit mm
 }
 
 // The executable: exit code 2 and the message for bad input; a run prints R^2 and the constants.
