@@ -95,15 +95,7 @@ MAPPED = {
                                   _DIAG + "the files written", through="app/diagnose/evaluator.h"),
     "app/diagnose/report.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
                                   _DIAG + "the report through the outputs", through="app/diagnose/evaluator.h"),
-    # damage/
-    "damage/effects.cpp": by(["tests/damage/test_decorator_battery.cpp", "tests/damage/test_registry.cpp"],
-                             "make_mullins/fatigue/viscoelastic and decorate(): four one-line factories, built by "
-                             "every decorator test"),
-    "damage/material_point.cpp": by(["tests/damage/test_mullins.cpp", "tests/damage/test_fatigue.cpp"],
-                                    "a point's committed/trial state: the history tests of each decorator drive it"),
     # engine/
-    "engine/model.cpp": by(["tests/engine/test_membrane.cpp"], "validate(): its membrane checks are tested with "
-                           "the membranes; the other checks through the scenes that build models"),
     "engine/quasi_static.cpp": by(["tests/engine/test_pneunet_solvers.cpp", "tests/engine/test_creep.cpp",
                                    "tests/engine/test_cycle_jump.cpp"],
                                   "the quasi-static driver: each solver and its globalisation on a pneu-net, creep "

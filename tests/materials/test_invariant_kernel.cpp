@@ -13,8 +13,8 @@
 namespace pneufem {
 namespace {
 
-// W = c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2 with x = I1b - 3, y = I2b - 3; U = k/2 (J-1)^2 + m (J-1)^3.
-constexpr double c1 = 0.3, c2 = 0.1, c3 = 0.05, c4 = -0.02, c5 = 0.03, k = 20.0, m = 4.0;
+// W = c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2 with x = I1b - 3, y = I2b - 3; U = kappa/2 (J-1)^2 + m3 (J-1)^3.
+constexpr double c1 = 0.3, c2 = 0.1, c3 = 0.05, c4 = -0.02, c5 = 0.03, kappa = 20.0, m3 = 4.0;
 
 InvariantDerivatives derivatives(const Invariants& v) {
   const double x = v.I1b - 3.0, y = v.I2b - 3.0, j = v.J - 1.0;
@@ -25,9 +25,9 @@ InvariantDerivatives derivatives(const Invariants& v) {
   d.W11 = 2.0 * c3;
   d.W12 = c4;
   d.W22 = 2.0 * c5;
-  d.U = 0.5 * k * j * j + m * j * j * j;
-  d.dU = k * j + 3.0 * m * j * j;
-  d.d2U = k + 6.0 * m * j;
+  d.U = 0.5 * kappa * j * j + m3 * j * j * j;
+  d.dU = kappa * j + 3.0 * m3 * j * j;
+  d.d2U = kappa + 6.0 * m3 * j;
   return d;
 }
 
