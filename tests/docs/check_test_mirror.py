@@ -120,8 +120,6 @@ MAPPED = {
                                      "truths (test_material_truth.cpp), parametrised over the laws"),
     "materials/ogden.cpp": by(["tests/materials/test_materials.cpp", "tests/materials/test_material_truth.cpp"],
                               "the laws share the battery and the truths (see hyperelastic.cpp)"),
-    "materials/scaled.cpp": by(["tests/materials/test_materials.cpp"], "the stiffness scale is a law of the battery "
-                               "(see hyperelastic.cpp)"),
     "materials/material.cpp": by(["tests/materials/test_materials.cpp"], "the Material interface's defaults, "
                                  "through every law of the battery"),
     # scenes/
@@ -135,9 +133,6 @@ MAPPED = {
     "scenes/inp/read_parts.cpp": by(["tests/scenes/inp/test_assembly.cpp"], "the Abaqus/CAE parts and instances of "
                                     "a deck: DeckReader's methods of reader.h, run by read_inp (deck.h), tested with the assembly they make",
                                     through="scenes/inp/deck.h"),
-    "scenes/pressure_lag.cpp": by(["tests/scenes/test_scales_lag.cpp", "tests/app/simulate/test_drive.cpp"],
-                                  "the pressure lag is tested with the stiffness scales (test_scales_lag.cpp) and "
-                                  "in the drive it delays (test_drive.cpp)"),
     "scenes/scene_materials.cpp": by(["tests/scenes/test_build_model.cpp"], "the [materials] tables of a scene to "
                                      "laws: part of build_model, tested through it", through="scenes/build_model.h"),
     "scenes/stl/distance.cpp": by(["tests/scenes/stl/test_surface.cpp"], "the signed distance to a surface is "
