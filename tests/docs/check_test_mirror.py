@@ -135,8 +135,6 @@ MAPPED = {
                                     through="scenes/inp/deck.h"),
     "scenes/scene_materials.cpp": by(["tests/scenes/test_build_model.cpp"], "the [materials] tables of a scene to "
                                      "laws: part of build_model, tested through it", through="scenes/build_model.h"),
-    "scenes/stl/distance.cpp": by(["tests/scenes/stl/test_surface.cpp"], "the signed distance to a surface is "
-                                  "tested with the surface it measures"),
     "scenes/stl/stuffing.cpp": by(["tests/scenes/stl/test_smoothing.cpp"], "isosurface stuffing is tested with the "
                                   "smoothing of the tetrahedra it makes"),
 }
