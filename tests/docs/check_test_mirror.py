@@ -31,7 +31,8 @@ It fails (exit 1, one line per problem: the file and what to do) on
   * a stale entry: its unit no longer exists, no longer has logic of its own, or now has a mirrored
     test file (then the entry is to be removed);
   * a mirrored test file not built by its folder's CMakeLists.txt;
-  * a top-level folder holding C++ sources that is neither in PRODUCT nor in NOT_MIRRORED.
+  * a top-level folder holding C++ sources that is neither in PRODUCT nor in NOT_MIRRORED, and a
+    folder of NOT_MIRRORED that holds none.
 
 Usage: check_test_mirror.py REPO_ROOT      check the repository
        check_test_mirror.py --self-test    check the checker on a made-up tree (it must report an
@@ -51,7 +52,6 @@ NOT_MIRRORED = {
     "bench": "benchmark drivers: they measure, they do not assert",
     "fuzz": "fuzz targets: each is a test of the reader it feeds (scripts/fuzz.sh)",
     "python": "the Python bindings: python/tests tests them through pytest",
-    "examples": "examples for users",
 }
 
 
@@ -251,6 +251,9 @@ def check(root, product, not_mirrored, mapped):
                 and not top.startswith("build") and sources(root, top)):
             problems.append(f"{top}/: a folder of C++ sources that is neither mirrored (PRODUCT) nor exempt "
                             f"(NOT_MIRRORED) in tests/docs/check_test_mirror.py: add it to one, with the reason")
+    for top in sorted(not_mirrored):
+        if not sources(root, top):
+            problems.append(f"check_test_mirror.py: NOT_MIRRORED: {top}/ holds no C++ sources: remove it")
     found, present = units(root, product)
     mirrored = [u for u in found if os.path.isfile(os.path.join(root, mirror_of(u)))]
     for u in sorted(mirrored):
@@ -383,7 +386,7 @@ def self_test():
     broken["tests/core/CMakeLists.txt"] = "pneufem_test(test_core SOURCES test_other_errors.cpp)\n"  # not built
     broken["tests/engine/test_all.cpp"] = '#include "engine/step.h"\n'         # no longer reaches solve.h
     broken["tests/app/test_cli.cpp"] = 'TEST(A, B) { run("walk --x"); }\n'   # runs nothing of cli.cpp
-    text, count, _ = run(broken, mapped, nm={"tests": ""})
+    text, count, _ = run(broken, mapped, nm={"tests": "", "tools": ""})
     expect("engine/new.cpp: no test file tests/engine/test_new.cpp" in text, "the unmapped unit is not reported", text)
     expect("tests/core/test_errors.cpp: the test file of core/errors.h is not built" in text,
            "the mirrored test file that is not built is not reported", text)
@@ -399,7 +402,9 @@ def self_test():
            "an undeclared top-level folder is not reported", text)
     expect("MAPPED[engine/more.cpp]: tests/engine/test_all.cpp does not include engine/solve.h" in text,
            "a test file that does not include the `through` header (reached through the folder) is not reported", text)
-    expect(count == 8, f"{count} problems instead of 8", text)
+    expect("check_test_mirror.py: NOT_MIRRORED: tools/ holds no C++ sources" in text,
+           "an exemption of a folder without sources is not reported", text)
+    expect(count == 9, f"{count} problems instead of 9", text)
 
     stale = dict(mapped)
     stale["engine/gone.cpp"] = by(["tests/engine/test_all.cpp"], "gone")
