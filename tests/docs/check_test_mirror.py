@@ -88,9 +88,11 @@ MAPPED = {
     # app/diagnose: being reorganised in parallel (issue 34); its tests are named after the diagnosis's steps
     "app/diagnose/detail.h": by(["tests/app/diagnose/test_calibrate.cpp", "tests/app/diagnose/test_evidence.cpp"],
                                 _DIAG + "the shared helpers through calibration and evidence"),
-    "app/diagnose/evaluator.cpp": by(["tests/app/diagnose/test_outputs.cpp"], _DIAG + "the evaluator through the outputs"),
+    "app/diagnose/evaluator.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
+                                     _DIAG + "the evaluator through the outputs"),
     "app/diagnose/fem.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
-                               _DIAG + "the FEM runs of a diagnosis through the outputs", through="app/diagnose/evaluator.h"),
+                               _DIAG + "the FEM runs of a diagnosis through the outputs",
+                               through="app/diagnose/evaluator.h"),
     "app/diagnose/output.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
                                   _DIAG + "the files written", through="app/diagnose/evaluator.h"),
     "app/diagnose/report.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
@@ -104,7 +106,8 @@ MAPPED = {
                                  "the element kernels through the assembly (consistent tangents) and the "
                                  "mesher's element quality", through="engine/assembly.h"),
     "engine/reduced_basis.cpp": by(["tests/engine/test_rom.cpp"], "the reduced model's files are being edited in "
-                                   "parallel (issue 28); test_rom.cpp tests them through rom.h", through="engine/rom.h"),
+                                   "parallel (issue 28); test_rom.cpp tests them through rom.h",
+                                   through="engine/rom.h"),
     "engine/rom_basis.cpp": by(["tests/engine/test_rom.cpp"], "implements rom.h (see reduced_basis.cpp)",
                                through="engine/rom.h"),
     "engine/rom_points.cpp": by(["tests/engine/test_rom.cpp"], "the hyper-reduction points, through rom.h (see "
@@ -115,23 +118,25 @@ MAPPED = {
     "fit/stability.cpp": by(["tests/fit/test_incompressible.cpp"], "the Drucker tangent and stability "
                             "(DruckerTangent.*, DruckerStability.*) share the incompressible responses' laws and "
                             "finite differences; to split out into test_stability.cpp"),
-    "materials/hyperelastic.cpp": by(["tests/materials/test_materials.cpp", "tests/materials/test_material_truth.cpp"],
+    "materials/hyperelastic.cpp": by(["tests/materials/test_materials.cpp",
+                                      "tests/materials/test_material_truth.cpp"],
                                      "the laws share the derivative battery (test_materials.cpp) and the analytic "
                                      "truths (test_material_truth.cpp), parametrised over the laws"),
     "materials/ogden.cpp": by(["tests/materials/test_materials.cpp", "tests/materials/test_material_truth.cpp"],
                               "the laws share the battery and the truths (see hyperelastic.cpp)"),
-    "materials/material.cpp": by(["tests/materials/test_materials.cpp"], "the Material interface's defaults, "
-                                 "through every law of the battery"),
     # scenes/
-    "scenes/calculix_deck.cpp": by(["tests/app/simulate/test_deck_round_trip.cpp", "tests/scenes/test_fabric_membrane.cpp"],
+    "scenes/calculix_deck.cpp": by(["tests/app/simulate/test_deck_round_trip.cpp",
+                                    "tests/scenes/test_fabric_membrane.cpp"],
                                    "the CalculiX deck a scene writes is tested by reading it back (deck round trip) "
                                    "and with the fabric membrane it writes"),
     "scenes/deck_materials.cpp": by(["tests/scenes/inp/test_materials.cpp"],
-                                    "the deck's materials as a layer of the scene: DeckMaterials.* share the fixture "
-                                    "of the *MATERIAL reader's tests; to move into tests/scenes/test_deck_materials.cpp",
+                                    "the deck's materials as a layer of the scene: DeckMaterials.* share the "
+                                    "fixture of the *MATERIAL reader's tests; to move into "
+                                    "tests/scenes/test_deck_materials.cpp",
                                     through="scenes/scene.h"),
-    "scenes/inp/read_parts.cpp": by(["tests/scenes/inp/test_assembly.cpp"], "the Abaqus/CAE parts and instances of "
-                                    "a deck: DeckReader's methods of reader.h, run by read_inp (deck.h), tested with the assembly they make",
+    "scenes/inp/read_parts.cpp": by(["tests/scenes/inp/test_assembly.cpp"],
+                                    "the Abaqus/CAE parts and instances of a deck: DeckReader's methods (reader.h), "
+                                    "run by read_inp (deck.h), tested with the assembly they make",
                                     through="scenes/inp/deck.h"),
     "scenes/scene_materials.cpp": by(["tests/scenes/test_build_model.cpp"], "the [materials] tables of a scene to "
                                      "laws: part of build_model, tested through it", through="scenes/build_model.h"),
@@ -422,7 +427,8 @@ def self_test():
            "an entry of a header without a body is not reported", text)
     expect("MAPPED[core/errors.h]: core/errors.h now has its mirrored test file" in text,
            "an entry beside a mirrored test file is not reported", text)
-    expect("MAPPED[engine/parts.cpp]: through=engine/step.h, but engine/parts.cpp does not include engine/step.h" in text,
+    expect("MAPPED[engine/parts.cpp]: through=engine/step.h, but engine/parts.cpp does not include "
+           "engine/step.h" in text,
            "a `through` header that is not linked to the unit is not reported", text)
     expect("MAPPED[app/main.cpp]: app/main.cpp has no header of its own: name the header it implements" in text,
            "a lone .cpp entry without `through` is not reported", text)
