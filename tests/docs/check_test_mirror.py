@@ -102,9 +102,6 @@ MAPPED = {
                                    "tests/engine/test_cycle_jump.cpp"],
                                   "the quasi-static driver: each solver and its globalisation on a pneu-net, creep "
                                   "and the cycle jump are the driver's tests under the names of what they drive"),
-    "engine/tet_element.cpp": by(["tests/engine/test_assembly.cpp", "tests/scenes/stl/test_mesher.cpp"],
-                                 "the element kernels through the assembly (consistent tangents) and the "
-                                 "mesher's element quality", through="engine/assembly.h"),
     "engine/reduced_basis.cpp": by(["tests/engine/test_rom.cpp"], "the reduced model's files are being edited in "
                                    "parallel (issue 28); test_rom.cpp tests them through rom.h",
                                    through="engine/rom.h"),
@@ -114,10 +111,7 @@ MAPPED = {
                                 "reduced_basis.cpp)", through="engine/rom.h"),
     "engine/rom_replay.cpp": by(["tests/engine/test_rom.cpp"], "implements rom.h (see reduced_basis.cpp)",
                                 through="engine/rom.h"),
-    # fit/, materials/
-    "fit/stability.cpp": by(["tests/fit/test_incompressible.cpp"], "the Drucker tangent and stability "
-                            "(DruckerTangent.*, DruckerStability.*) share the incompressible responses' laws and "
-                            "finite differences; to split out into test_stability.cpp"),
+    # materials/
     "materials/hyperelastic.cpp": by(["tests/materials/test_materials.cpp",
                                       "tests/materials/test_material_truth.cpp"],
                                      "the laws share the derivative battery (test_materials.cpp) and the analytic "
