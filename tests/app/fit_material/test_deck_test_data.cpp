@@ -3,12 +3,14 @@
 #include "app/fit_material/deck_test_data.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "app/fit_material/command.h"
 #include <gtest/gtest.h>
 
+#include "app/fit_material/command.h"
 #include "fit/inelastic.h"
+#include "tests/app/cli_helpers.h"
 #include "tests/app/fit_material/fit_material_helpers.h"
 #include "tests/support/input_error.h"
 
