@@ -141,9 +141,13 @@ TEST(TetElement, Tet10DistortionOfAMidNodeOffItsEdge) {
     const Tet10Distortion d = tet10_distortion(m, 0);
     EXPECT_EQ(d.farthest_mid_node, 4);
     EXPECT_NEAR(d.mid_node_offset, f, 1e-12);
-    if (f < 0.25) EXPECT_GT(d.min_scaled_jacobian, 0.0) << f;
-    if (f == 0.25) EXPECT_NEAR(d.min_scaled_jacobian, 0.0, 1e-12);  // folds at a quarter, as documented
-    if (f > 0.25) EXPECT_LT(d.min_scaled_jacobian, 0.0) << f;
+    if (f < 0.25) {
+      EXPECT_GT(d.min_scaled_jacobian, 0.0) << f;
+    } else if (f == 0.25) {
+      EXPECT_NEAR(d.min_scaled_jacobian, 0.0, 1e-12);  // folds at a quarter, as documented
+    } else {
+      EXPECT_LT(d.min_scaled_jacobian, 0.0) << f;
+    }
     EXPECT_LT(d.min_scaled_jacobian, 1.0);
   }
 }
