@@ -284,27 +284,5 @@ TEST_F(CompareCli, RegionSensitivityFindsAPerturbedRegion) {
   EXPECT_NE(slurp(*dir_ / "regions" / "report.html").find("fig_regions"), std::string::npos);
 }
 
-TEST(CompareHistory, AppendsAndReadsBack) {
-  const fs::path d = fs::temp_directory_path() / ("pneufem_history_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  HistoryEntry e;
-  e.time_utc = "2026-01-01T00:00:00Z";
-  e.label = "quote \" and \\ backslash";
-  e.scene_hash = "0123456789abcdef";
-  e.nrmse = 0.125;
-  e.trial_nrmse = {0.1, std::nan(""), 0.15};
-  e.source = "diagnose";
-  append_history(d.string(), e);
-  append_history(d.string(), e);
-  const std::vector<HistoryEntry> h = read_history(d.string());
-  ASSERT_EQ(h.size(), 2u);
-  EXPECT_EQ(h[1].label, e.label);
-  EXPECT_EQ(h[1].source, "diagnose");
-  EXPECT_EQ(h[1].nrmse, 0.125);
-  ASSERT_EQ(h[1].trial_nrmse.size(), 3u);
-  EXPECT_TRUE(std::isnan(h[1].trial_nrmse[1]));
-  fs::remove_all(d);
-}
-
 }  // namespace
 }  // namespace pneufem

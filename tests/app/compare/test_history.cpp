@@ -3,6 +3,8 @@
 // (a non-finite NRMSE) read back as NaN; keys are found by the JSON structure, not by text search.
 #include "app/compare/history.h"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -68,6 +70,28 @@ TEST(History, UnreadableLinesAreSkippedAndKeysAreNotFoundInsideStrings) {
   EXPECT_EQ(h[0].nrmse, 0.25);
   EXPECT_TRUE(h[0].trial_nrmse.empty());
   EXPECT_TRUE(read_history((d / "none").string()).empty());
+}
+
+TEST(CompareHistory, AppendsAndReadsBack) {
+  const fs::path d = fs::temp_directory_path() / ("pneufem_history_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  HistoryEntry e;
+  e.time_utc = "2026-01-01T00:00:00Z";
+  e.label = "quote \" and \\ backslash";
+  e.scene_hash = "0123456789abcdef";
+  e.nrmse = 0.125;
+  e.trial_nrmse = {0.1, std::nan(""), 0.15};
+  e.source = "diagnose";
+  append_history(d.string(), e);
+  append_history(d.string(), e);
+  const std::vector<HistoryEntry> h = read_history(d.string());
+  ASSERT_EQ(h.size(), 2u);
+  EXPECT_EQ(h[1].label, e.label);
+  EXPECT_EQ(h[1].source, "diagnose");
+  EXPECT_EQ(h[1].nrmse, 0.125);
+  ASSERT_EQ(h[1].trial_nrmse.size(), 3u);
+  EXPECT_TRUE(std::isnan(h[1].trial_nrmse[1]));
+  fs::remove_all(d);
 }
 
 }  // namespace
