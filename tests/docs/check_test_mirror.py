@@ -123,11 +123,6 @@ MAPPED = {
                                     "tests/scenes/test_fabric_membrane.cpp"],
                                    "the CalculiX deck a scene writes is tested by reading it back (deck round trip) "
                                    "and with the fabric membrane it writes"),
-    "scenes/deck_materials.cpp": by(["tests/scenes/inp/test_materials.cpp"],
-                                    "the deck's materials as a layer of the scene: DeckMaterials.* share the "
-                                    "fixture of the *MATERIAL reader's tests; to move into "
-                                    "tests/scenes/test_deck_materials.cpp",
-                                    through="scenes/scene.h"),
     "scenes/inp/read_parts.cpp": by(["tests/scenes/inp/test_assembly.cpp"],
                                     "the Abaqus/CAE parts and instances of a deck: DeckReader's methods (reader.h), "
                                     "run by read_inp (deck.h), tested with the assembly they make",
