@@ -111,13 +111,6 @@ MAPPED = {
                                 "reduced_basis.cpp)", through="engine/rom.h"),
     "engine/rom_replay.cpp": by(["tests/engine/test_rom.cpp"], "implements rom.h (see reduced_basis.cpp)",
                                 through="engine/rom.h"),
-    # materials/
-    "materials/hyperelastic.cpp": by(["tests/materials/test_materials.cpp",
-                                      "tests/materials/test_material_truth.cpp"],
-                                     "the laws share the derivative battery (test_materials.cpp) and the analytic "
-                                     "truths (test_material_truth.cpp), parametrised over the laws"),
-    "materials/ogden.cpp": by(["tests/materials/test_materials.cpp", "tests/materials/test_material_truth.cpp"],
-                              "the laws share the battery and the truths (see hyperelastic.cpp)"),
     # scenes/
     "scenes/calculix_deck.cpp": by(["tests/app/simulate/test_deck_round_trip.cpp",
                                     "tests/scenes/test_fabric_membrane.cpp"],

@@ -1,11 +1,15 @@
 #pragma once
 // Helpers shared by the material tests: single-point evaluation, the deformation states of the
-// derivative battery, and homogeneous uniaxial tension solved with the material's own tangent.
-#include <Eigen/Geometry>
+// derivative battery, and homogeneous uniaxial tension solved with the material's own tangent and
+// checked against an incompressible curve.
 #include <cmath>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
 
 #include "materials/material.h"
 #include "materials/ogden.h"
@@ -88,6 +92,33 @@ inline Uniaxial solve_uniaxial(const Material& m, double lambda) {
   }
   const Mat3 P = eval(m, F(s), false).P();
   return {P(0, 0), P(1, 1), P(2, 2), s};
+}
+
+/// Checks uniaxial tension of a nearly incompressible decoupled law against its incompressible
+/// nominal stress P_inc(lambda) for lambda in [1, lambda_max].
+///
+/// Compressibility error. With sigma_22 = 0 the mean Cauchy stress is sigma/3, so J = 1 + delta,
+/// delta = sigma/(3K). A decoupled law with U = U(J) gives exactly sigma_11 = sigma_inc(lb)/J,
+/// lb = lambda J^{-1/3}, where sigma_inc(x) = x P_inc(x); hence P11 = sigma_inc(lb)/lambda and
+///   P11 / P_inc(lambda) - 1 = -lambda sigma_inc'(lambda) / (9K) + O(delta^2),
+/// which is -mu0/(3K) at small strain (the expected O(mu0/K)) and grows with the tangent stiffness
+/// at large stretch. The first check allows twice that first-order error; the second checks the exact
+/// identity P11 = sigma_inc(lb)/lambda to round-off (the Newton solve converges to |ds| <= 1e-15 s).
+inline void check_uniaxial(const Material& m, const std::function<double(double)>& P_inc, double lambda_max) {
+  const double K = m.initial_bulk_modulus(), mu0 = m.initial_shear_modulus();
+  const auto sigma_inc = [&](double x) { return x * P_inc(x); };
+  for (double lambda = 1.0; lambda <= lambda_max + 1e-12; lambda += 0.25) {
+    SCOPED_TRACE("lambda = " + std::to_string(lambda));
+    const test::Uniaxial u = solve_uniaxial(m, lambda);
+    EXPECT_LE(std::abs(u.P22), 1e-12 * K);
+    EXPECT_LE(std::abs(u.P33), 1e-12 * K);
+    const double dsigma = (sigma_inc(lambda * (1 + 1e-6)) - sigma_inc(lambda * (1 - 1e-6))) / (2e-6 * lambda);
+    const double rel_first_order = lambda * dsigma / (9.0 * K);
+    EXPECT_NEAR(u.P11, P_inc(lambda), 2.0 * rel_first_order * std::abs(P_inc(lambda)) + 1e-9 * mu0);
+    const double J = lambda * u.lateral * u.lateral;
+    const double lb = lambda * std::cbrt(1.0 / J);
+    EXPECT_NEAR(u.P11, sigma_inc(lb) / lambda, 1e-9 * std::abs(u.P11) + 1e-9 * mu0);
+  }
 }
 
 }  // namespace pneufem::test
