@@ -140,6 +140,20 @@ struct RomBasisOptions {
   /// trial 1 (0.8-0.9 deg), which needs the modes' parts along the tangents
   /// (bench/results/rom_h6_ceiling, section 5).
   bool tangent_free_modes = false;
+  /// How the stiff parts (the fabric) enter the reduced equations. E (see the header) holds them
+  /// linear in q about the path; the other two also put them in the bracket
+  /// G_hat - G_hat_ref - K_hat_ref q, which then carries their nonlinearity in q: the 10^5 times
+  /// stiffer fabric stretched to second order by the modes' rotations. Measured on the h = 6 story
+  /// with the FEM's states in the basis (bench/results/rom_h6_ceiling, section 10): linear, the
+  /// FEM's states with the FEM's history sat 0.14 deg below the reduced equations' roots by trial 5's
+  /// 40 kPa hold; exact, 0.02 deg. With a basis that cannot hold the fabric's finite rotation (the
+  /// 16 softening modes) the exact fabric locks: a spurious root of 5.5 deg at the first release.
+  enum class StiffParts {
+    linear,   ///< through E only (the default)
+    exact,    ///< every stiff element in the bracket at weight 1 (cost grows with the mesh)
+    sampled,  ///< stiff elements in the bracket, sampled by ECSW trained on their nonlinear remainder
+  };
+  StiffParts stiff_parts = StiffParts::linear;
   bool verbose = false;
 };
 

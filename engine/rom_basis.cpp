@@ -695,6 +695,33 @@ std::vector<TrainingState> ecsw_training_states(const ReducedBasis& B, const Eig
   return train;
 }
 
+/// A state the stiff parts' remainder is trained on: path sample k and correction q.
+struct RemainderState {
+  int k;
+  Eigen::VectorXd q;
+  double t_scale;  // RMS size of w_k, as TrainingState::t_scale
+};
+
+/// The remainder's training states: every training state off the path, as its nearest path sample
+/// (by angle) plus its mass-weighted projection onto the modes.
+std::vector<RemainderState> remainder_training_states(const ReducedBasis& B, const Eigen::VectorXd& mass, const Model& reference,
+                                                      const std::vector<TrainingState>& train) {
+  const double m_tot = mass.sum();
+  Eigen::MatrixXd MPhi = B.Phi;
+  for (Eigen::Index i = 0; i < B.dofs(); ++i) MPhi.row(i) *= mass[i / 3];
+  std::vector<RemainderState> out;
+  for (const TrainingState& s : train) {
+    const double th = bending_angle(reference, s.u).angle_deg;
+    int k = path_segment_index(B.theta, th);
+    if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+    const Eigen::VectorXd q = MPhi.transpose() * (s.u - B.U.col(k)) / m_tot;
+    if (k == 0 || q.norm() == 0.0) continue;
+    const Eigen::VectorXd wk = B.W.col(k);
+    out.push_back({k, q, std::sqrt(mass_dot(mass, wk, wk) / m_tot) + 1e-300});
+  }
+  return out;
+}
+
 /// ECSW in one cluster: non-negative element weights that reproduce the cluster's reduced force
 /// (theta row and every mode, of the whole and of the isochoric force) on the training states
 /// within the tolerance. Returns the picked (element, weight) pairs and the relative residual.
@@ -752,10 +779,83 @@ std::vector<std::pair<int, double>> ecsw_cluster_weights(const Model& reference,
   return picked;
 }
 
+/// Clusters of the stiff elements (the fabric): k-means within each region, about `total` / 4 in
+/// all (at least one per region).
+std::vector<std::vector<int>> stiff_clusters(const Model& model, const std::vector<char>& stiff, int total) {
+  const Mesh& mesh = model.mesh;
+  std::map<int, std::vector<int>> by_region;
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    if (stiff[model.element_part[e]]) by_region[mesh.region.empty() ? 0 : mesh.region[e]].push_back(e);
+  std::vector<std::vector<int>> out;
+  const int k = std::max(1, total / 4 / std::max<int>(1, static_cast<int>(by_region.size())));
+  for (auto& [region, elems] : by_region)
+    for (auto& c : kmeans(mesh, elems, std::min<int>(k, static_cast<int>(elems.size())))) out.push_back(std::move(c));
+  return out;
+}
+
+/// ECSW of the stiff elements on what the bracket integrates for them: the remainder of their
+/// force beyond its linearisation about the path sample k,
+///     f_e(U_k + Phi q) - f_e(U_k) - K_e(U_k) Phi q,
+/// tested with [w_k, Phi] (K_e Phi q by a central difference: the remainder is second order in q,
+/// the difference's error third order, 1e-4 of it at the step below). The reference's quadrature
+/// (G_hat_ref, K_hat_ref) uses the same weights, so the bracket of a stiff part is exactly the
+/// weighted sum of these remainders. Rows scaled per coordinate by their RMS, as the soft parts'.
+std::vector<std::pair<int, double>> ecsw_remainder_weights(const Model& reference, const ElementGeometry& geom, const ReducedBasis& B,
+                                                           const std::vector<int>& el, const std::vector<RemainderState>& train,
+                                                           double tolerance, double& residual) {
+  const int r = B.num_modes(), n1 = r + 1;
+  const std::size_t nt = train.size();
+  Eigen::MatrixXd G(static_cast<Eigen::Index>(nt * n1), static_cast<Eigen::Index>(el.size()));
+  Eigen::VectorXd f, fp, fm, fi;
+  for (std::size_t j = 0; j < el.size(); ++j) {
+    const int e = el[j];
+    const int* n = reference.mesh.element(e);
+    for (std::size_t s = 0; s < nt; ++s) {
+      const Eigen::VectorXd uk = B.U.col(train[s].k);
+      const Eigen::VectorXd d = B.Phi * train[s].q;
+      constexpr double eps = 1e-2;  // relative to q: the remainder is O(|q|^2), the difference's error O(eps^2 |q|^3)
+      element_force(reference, geom, e, uk + d, f, fi);
+      element_force(reference, geom, e, uk + eps * d, fp, fi);
+      element_force(reference, geom, e, uk - eps * d, fm, fi);
+      const Eigen::VectorXd rem = f - (fp + fm) * 0.5 - (fp - fm) / (2.0 * eps);  // f(u+d) - f(u) - K d, f(u) ~ (fp+fm)/2
+      const Eigen::Index row = static_cast<Eigen::Index>(s * n1);
+      double gth = 0.0;
+      Eigen::VectorXd gq = Eigen::VectorXd::Zero(r);
+      for (int a = 0; a < geom.npe; ++a) {
+        gth += B.W.col(train[s].k).segment<3>(3 * n[a]).dot(rem.segment<3>(3 * a));
+        for (int m = 0; m < r; ++m) gq[m] += B.Phi.col(m).segment<3>(3 * n[a]).dot(rem.segment<3>(3 * a));
+      }
+      G(row, static_cast<Eigen::Index>(j)) = gth / train[s].t_scale;
+      G.block(row + 1, static_cast<Eigen::Index>(j), r, 1) = gq;
+    }
+  }
+  for (Eigen::Index row = 0; row < G.rows(); ++row)
+    if (!G.row(row).allFinite()) G.row(row).setZero();
+  Eigen::VectorXd target = G.rowwise().sum();
+  for (int i = 0; i < n1; ++i) {
+    double ss = 0.0;
+    for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>(s * n1 + i)], 2);
+    const double scale = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(nt, 1)));
+    if (!(scale > 0.0)) continue;
+    for (std::size_t s = 0; s < nt; ++s) {
+      G.row(static_cast<Eigen::Index>(s * n1 + i)) /= scale;
+      target[static_cast<Eigen::Index>(s * n1 + i)] /= scale;
+    }
+  }
+  const NnlsResult res = nnls(G, target, tolerance);
+  residual = res.residual / std::max(target.norm(), 1e-300);
+  std::vector<std::pair<int, double>> picked;
+  for (std::size_t j = 0; j < el.size(); ++j)
+    if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked.push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
+  return picked;
+}
+
 /// The sampled elements and their weights (B.elements, B.weights, sorted by element): ECSW per
-/// cluster, or every soft element at weight 1 without hyper-reduction.
+/// cluster, or every soft element at weight 1 without hyper-reduction; and the stiff parts' elements
+/// as RomBasisOptions::stiff_parts asks (every one at weight 1, or ECSW on their remainder).
 void set_sampled_elements(const Model& reference, const ElementGeometry& geom, const std::vector<std::vector<int>>& clusters,
-                          const std::vector<TrainingState>& train, const RomBasisOptions& opt, ReducedBasis& B) {
+                          const std::vector<TrainingState>& train, const std::vector<RemainderState>& remainder_train,
+                          const RomBasisOptions& opt, ReducedBasis& B) {
   std::vector<std::vector<std::pair<int, double>>> picked(clusters.size());
   std::vector<double> cluster_residual(clusters.size(), 0.0);
   if (!opt.hyper_reduce) {
@@ -770,6 +870,21 @@ void set_sampled_elements(const Model& reference, const ElementGeometry& geom, c
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     all.insert(all.end(), picked[c].begin(), picked[c].end());
     B.info.ecsw_worst_residual = std::max(B.info.ecsw_worst_residual, cluster_residual[c]);
+  }
+  if (opt.stiff_parts == RomBasisOptions::StiffParts::exact)
+    for (int e = 0; e < reference.mesh.num_elements(); ++e)
+      if (B.stiff_part[reference.element_part[e]]) all.push_back({e, 1.0});
+  if (opt.stiff_parts == RomBasisOptions::StiffParts::sampled) {
+    const std::vector<std::vector<int>> stiff = stiff_clusters(reference, B.stiff_part, opt.clusters);
+    std::vector<std::vector<std::pair<int, double>>> pick(stiff.size());
+    std::vector<double> res(stiff.size(), 0.0);
+    tbb::parallel_for(std::size_t(0), stiff.size(), [&](std::size_t c) {
+      pick[c] = ecsw_remainder_weights(reference, geom, B, stiff[c], remainder_train, opt.ecsw_tolerance, res[c]);
+    });
+    for (std::size_t c = 0; c < stiff.size(); ++c) {
+      all.insert(all.end(), pick[c].begin(), pick[c].end());
+      B.info.ecsw_worst_residual = std::max(B.info.ecsw_worst_residual, res[c]);
+    }
   }
   std::sort(all.begin(), all.end());
   for (auto [e, w] : all) {
@@ -856,7 +971,10 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
   // training states (path samples, and path samples plus the response to a random softening field).
   const std::vector<TrainingState> train = ecsw_training_states(B, mass, reference, shapes, mode_k, all_snapshots, opt);
   shapes = CandidateShapes{};
-  set_sampled_elements(reference, A.geometry(), clusters, train, opt, B);
+  const std::vector<RemainderState> remainder_train = opt.stiff_parts == RomBasisOptions::StiffParts::sampled
+                                                          ? remainder_training_states(B, mass, reference, train)
+                                                          : std::vector<RemainderState>{};
+  set_sampled_elements(reference, A.geometry(), clusters, train, remainder_train, opt, B);
   if (opt.verbose)
     std::fprintf(stderr, "reduced basis: ECSW kept %zu of %d soft elements (%zu training states, worst cluster residual %.2e), %.1f s\n",
                  B.elements.size(), B.info.soft_elements, train.size(), B.info.ecsw_worst_residual, seconds_since(t_start));
