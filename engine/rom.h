@@ -58,6 +58,9 @@
 //       model is reproduced exactly whatever the rest; the fabric (10^5 times stiffer than the silicone)
 //       enters only here, linearly in q: a linearised rotation of a correction mode does not stretch it
 //       to second order, which locked every linear reduced basis tried before (BENCHMARKS.md §7).
+//       The price: the fabric's second order in q is missing, and with a basis rich enough to hold
+//       its finite rotations (the FEM's states) that was the reduced equations' whole late bias;
+//       RomBasisOptions::stiff_parts puts the fabric in the bracket below as well.
 //   P:  the follower load's second order in q, -p/2 T^T g2[Phi q, Phi q] (pq, pw below). The load per
 //       unit pressure g(u) = dV/du is quadratic in the nodal positions, so E plus this term is its
 //       exact projection, not a linearisation. It matters where q is large (a damaged wall
