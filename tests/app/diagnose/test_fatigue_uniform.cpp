@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,9 +57,11 @@ TEST(UniformFatigue, PointsLoadedProportionallySoftenAlike) {
     for (double lambda : {1.0, 1.1, 1.2, 1.3, 1.2, 1.1})
       h.emplace_back(lambda, 0.5);
   const double a = fraction_after(h, 1.0), b = fraction_after(h, 0.5);
-  EXPECT_LT(a, 0.97);  // a visible softening (measured ~0.9)
+  std::printf("stiffness fraction after the history: %.6f at the full strain, %.6f at half of it\n", a, b);
+  EXPECT_LT(a, 0.97);  // a visible softening (~6 s of counted load, D ~ 0.07; measured 0.9344)
   // Not exactly equal: W0 of a Yeoh solid is not the same function of time at two strain amplitudes
-  // (its C20, C30 terms), so W0/W_max differs slightly below the peak; 1 % of the softening's size.
+  // (its C20, C30 terms), so W0/W_max differs slightly below the peak; 1 % of the softening's size
+  // (measured: 0.9344 and 0.9347, 0.5 % of it).
   EXPECT_NEAR(a, b, 0.01 * (1.0 - a));
 }
 
