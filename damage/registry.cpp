@@ -2,12 +2,14 @@
 
 #include <cmath>
 #include <deque>
+#include <memory>
 #include <set>
 #include <stdexcept>
 
 #include "core/errors.h"
 #include "core/number_text.h"
 #include "damage/effects.h"
+#include "damage/fatigue_uniform.h"
 
 namespace pneufem {
 
@@ -105,6 +107,29 @@ std::vector<MaterialEffect> builtins() {
                                ViscoParams{{p.at("gamma")}, {p.at("tau_s")}, ViscoModuli::instantaneous});
     };
     e.order = 300;
+    v.push_back(e);
+  }
+  {
+    // Fatigue as a uniform compliance growth with a load-weighted count (damage/fatigue_uniform.h; issue
+    // 35): not a built-in table (no per-term lists, no choices), so the default scene and the scene
+    // reference leave it out and scenes read it as any registered effect. Order 250: it counts by the
+    // energy of what it wraps, so it wraps mullins (100; a fatigue base, 200, is refused: its energy is
+    // not a potential of its stress), and viscoelastic (300) wraps it.
+    // Ranges: a in [1e-3, 0.5] (0.1 % to 50 % more compliance per e-fold of the count: from below what
+    // a recording resolves to a silicone that halves its stiffness within a few cycles); t0 in
+    // [0.1, 1e4] s of peak load (the growth turns logarithmic within the first ramp, up to never within
+    // hours of loading: then D ~ a N / t0, a constant rate).
+    MaterialEffect e;
+    e.name = "fatigue_uniform";
+    e.doc = "fatigue as a uniform compliance growth 1 + a ln(1 + N/t0) of the silicone, N = int W/W_max dt the "
+            "load-weighted count";
+    e.params = {{"a", "1", "> 0; compliance growth per e-fold of the count", 0.03, 1e-3, 0.5, true},
+                {"t0_s", "s", "> 0; the count (s at the peak load) where the growth turns logarithmic", 10.0, 0.1,
+                 1e4, true}};
+    e.decorate = [](MaterialPtr base, const std::map<std::string, double>& p) -> MaterialPtr {
+      return std::make_shared<const UniformFatigue>(std::move(base), UniformFatigueParams{p.at("a"), p.at("t0_s")});
+    };
+    e.order = 250;
     v.push_back(e);
   }
   return v;

@@ -16,7 +16,9 @@
 // Decoration order. Effects are applied around the (stiffness-scaled) hyperelastic base in
 // ascending `order`, ties in registration order. The built-ins have
 //     mullins 100, fatigue 200, viscoelastic 300
-// which reproduces viscoelastic(fatigue(mullins(base))) (damage/effects.h). A new effect with the
+// which reproduces viscoelastic(fatigue(mullins(base))) (damage/effects.h). The in-tree effect
+// fatigue_uniform (damage/fatigue_uniform.h, order 250) is registered beside them but read as a
+// registered effect (numbers only; not in the default scene's tables). A new effect with the
 // default order 0 wraps the base first: mullins and fatigue are driven by the energy of whatever they
 // wrap, which must stay a potential of its stress, so an energy-conserving effect (a softening, an
 // anisotropy) belongs below 100; a rate-dependent one (its stress not a potential) belongs above 200.

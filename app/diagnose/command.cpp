@@ -964,8 +964,17 @@ bool selection_round(Selection& s, int round, std::chrono::steady_clock::time_po
   const DiagnoseOptions& opt = s.opt;
   std::vector<CandidateResult> results(s.cands.size());
   std::vector<std::size_t> todo;
-  for (std::size_t i = 0; i < s.cands.size(); ++i)
-    if (!s.used[i]) todo.push_back(i);
+  for (std::size_t i = 0; i < s.cands.size(); ++i) {
+    if (s.used[i]) continue;
+    // A form of an effect already selected is not stacked on it: it is tried in its place after the
+    // round (try_other_forms). Forms in one scene table refuse each other anyway (their sets throw);
+    // fatigue_uniform has its own table, and two fatigues at once would be one effect named twice.
+    const CandidateEffect* c = s.cands[i];
+    if (!c->family.empty() && std::any_of(s.chosen.begin(), s.chosen.end(),
+                                          [&](const auto& ch) { return ch.first->family == c->family; }))
+      continue;
+    todo.push_back(i);
+  }
   if (todo.empty()) return false;
   if (stop_at_noise_floor(s, round)) return false;
   const Scene cur_scene = s.cal_scene.with(s.selected_sets);

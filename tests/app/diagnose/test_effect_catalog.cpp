@@ -41,7 +41,8 @@ TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   const auto& all = candidate_effects();
   const std::vector<std::string> names = {"stiffness",          "viscoelastic", "viscoelastic_instantaneous",
                                           "viscoelastic_broad", "mullins",      "fatigue",
-                                          "fatigue_saturating", "pressure_lag", "gravity"};
+                                          "fatigue_saturating", "fatigue_uniform", "pressure_lag",
+                                          "gravity"};
   ASSERT_GE(all.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   for (const CandidateEffect& c : all) {
@@ -62,7 +63,7 @@ TEST(EffectCatalog, BuiltInsComeFirstWithSaneBounds) {
   const std::string e = error_of([] { candidate_effect("creep"); });
   EXPECT_NE(e.find("unknown candidate effect 'creep'"), std::string::npos) << e;
   EXPECT_NE(e.find("stiffness, viscoelastic, viscoelastic_instantaneous, viscoelastic_broad, mullins, fatigue, "
-                   "fatigue_saturating, pressure_lag, gravity"),
+                   "fatigue_saturating, fatigue_uniform, pressure_lag, gravity"),
             std::string::npos)
       << e;
 }

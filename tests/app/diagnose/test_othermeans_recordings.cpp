@@ -55,7 +55,7 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
 std::set<std::string> names_of(const std::string& hidden) {
   if (hidden == "creep") return {"viscoelastic", "viscoelastic_instantaneous", "viscoelastic_broad"};  // one or three terms
   if (hidden == "lag") return {"pressure_lag"};
-  if (hidden == "fatigue") return {"fatigue", "fatigue_saturating"};  // with or without saturation
+  if (hidden == "fatigue") return {"fatigue", "fatigue_saturating", "fatigue_uniform"};  // any of its three forms
   return {hidden};
 }
 
@@ -157,7 +157,10 @@ TEST(OtherMeansRecording, DISABLED_StretchedExponentialCreepIsNamed) { expect_fo
 // the broad creep 0.0306 in round 1 (0.0149 beyond a static misfit against the one-term's 0.0157), with
 // tau at its 30 s bound, and not swapped in; round 2 nothing (gravity 0.0230, stiffness 0.0243).
 TEST(OtherMeansRecording, DISABLED_PowerLawCreepIsNamed) { expect_found(diagnose("creep_powerlaw"), {"creep"}); }
-// Not measured in time (10 trials: ~15 min of one core with two rounds).
+// Measured with the candidates stiffness, fatigue_saturating, fatigue_uniform (max 2; 2026-11-29,
+// bench/notes/2026-11-29-diag6.md, 104 s CPU): fatigue_uniform named alone, 0.0386 -> 0.0165 at a 0.0129
+// floor, 0.43x: FAILS the 0.4x bound by 0.03x (fatigue_saturating 0.0174, 0.45x, equally good); round 2
+// stiffness dAIC +1.4. What is left is flat over the trials (0.09-0.13 deg), 19 % of it static.
 TEST(OtherMeansRecording, DISABLED_PowerLawFatigueOverTenTrialsIsNamed) {
   expect_found(diagnose("fatigue_powerlaw"), {"fatigue"});
 }
@@ -183,6 +186,28 @@ TEST(OtherMeansRecording, LogarithmicFatigueIsNamedAsSaturatingFatigue) {
     return c == r.candidates.end() ? std::numeric_limits<double>::infinity() : c->nrmse;
   };
   EXPECT_LT(first("fatigue_saturating"), first("fatigue"));  // the law that slows down fits better
+}
+// The uniform form of fatigue (damage/fatigue_uniform.h: the whole loaded silicone softens with a
+// load-weighted count, where the two threshold forms damage its most strained points) beside the
+// saturating one, with every round run (no stop at the noise floor). Measured (2026-11-29, bench/notes/
+// 2026-11-29-diag6.md, the CLI with stiffness too, max 2): fatigue_uniform 0.0374 -> 0.0146 (0.39x) at a
+// 0.0133 floor (a 0.101, t0 30 s), fatigue_saturating 0.0148 reported as equally good; 66 s CPU.
+// Asserted: one fatigue is named and the other form is not stacked on it in round 2 (it is a form of
+// the same effect: tried in its place, try_other_forms; before diag6 a form in another scene table
+// would have been calibrated on top of it), and the error is within the 0.4x.
+TEST(OtherMeansRecording, LogarithmicFatigueIsNamedOnceInOneOfItsForms) {
+  DiagnoseOptions o;
+  o.candidates = {"fatigue_saturating", "fatigue_uniform"};
+  o.max_effects = 2;
+  o.stop_at_noise_floor = false;
+  o.data_path = std::string(PNEUFEM_TEST_DATA_DIR) + "/othermeans/fatigue_log.csv";
+  o.out_dir = (fs::temp_directory_path() / "pneufem_diag_othermeans_fatigue_log_forms").string();
+  fs::remove_all(o.out_dir);
+  o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();
+  const DiagnosisResult r = test::run_and_print_diagnosis("fatigue_log (forms)", kScene, o);
+  expect_found(r, {"fatigue"});
+  EXPECT_EQ(r.selected.size(), 1u);
+  for (const CandidateResult& c : r.candidates) EXPECT_EQ(c.round, 1) << c.effect << " tried in round " << c.round;
 }
 // The whole catalog (measured with five candidates above).
 TEST(OtherMeansRecording, DISABLED_LogarithmicFatigueIsNamed) { expect_found(diagnose("fatigue_log"), {"fatigue"}); }
@@ -275,6 +300,12 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // A second start of round 3's joint re-fit from the fatigue's round-1 constants (its frozen
 // calibration ends where it does nothing) ended worse (29.1 against 20.2 deg^2) and was not kept.
 // Measured with broad creep, lag, fatigue_saturating and stiffness (max 3): 917 s CPU, 111 MB.
+// With fatigue_uniform (the whole silicone's compliance growing with a load-weighted count, the
+// generator's kind of fatigue; bench/notes/2026-11-29-diag6.md): broad creep, lag, fatigue_uniform (max
+// 3, 544 s CPU) give the same rounds and round 3 fatigue_uniform dAIC +3.9 at no damage (the creep's
+// 259 s term again). With the creep's slowest term bounded by the recording (an experiment, not
+// committed) the growth stays in the residual, and round 3's fatigue_uniform, re-fitted jointly on the
+// raw RSS, ends at no damage and worse (0.0198 -> 0.0221). Still FAILS.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
