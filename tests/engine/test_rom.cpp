@@ -11,7 +11,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -21,7 +20,6 @@
 #include "damage/registry.h"
 #include "engine/angle.h"
 #include "engine/assembly.h"
-#include "engine/nnls.h"
 #include "engine/path_model.h"
 #include "engine/path_spline.h"
 #include "engine/quasi_static.h"
@@ -34,56 +32,6 @@ namespace pneufem {
 namespace {
 
 using pneufem::test::error_of;
-
-// ------------------------------------------------------------------ NNLS
-
-/// KKT conditions of min |Ax - b| s.t. x >= 0: x >= 0, w = A^T (b - A x) <= 0 where x = 0 and
-/// w = 0 where x > 0 (tolerance: round-off of the QR subproblems, ~1e-10 of |A^T b|).
-TEST(Nnls, ReachesTheKktPointOfRandomProblems) {
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> N;
-  for (int trial = 0; trial < 40; ++trial) {
-    const int m = 6 + trial % 13, n = 3 + (trial * 7) % 17;
-    Eigen::MatrixXd A(m, n);
-    Eigen::VectorXd b(m);
-    for (int i = 0; i < m; ++i) {
-      b[i] = N(rng);
-      for (int j = 0; j < n; ++j) A(i, j) = N(rng);
-    }
-    const NnlsResult r = nnls(A, b, 1e-14);
-    ASSERT_EQ(r.x.size(), n);
-    const Eigen::VectorXd w = A.transpose() * (b - A * r.x);
-    const double scale = (A.transpose() * b).norm() + 1.0;
-    for (int j = 0; j < n; ++j) {
-      EXPECT_GE(r.x[j], 0.0);
-      if (r.x[j] > 0.0)
-        EXPECT_NEAR(w[j], 0.0, 1e-10 * scale) << "trial " << trial << " column " << j;
-      else
-        EXPECT_LE(w[j], 1e-10 * scale) << "trial " << trial << " column " << j;
-    }
-    EXPECT_NEAR(r.residual, (A * r.x - b).norm(), 1e-12 * (1.0 + b.norm()));
-  }
-}
-
-/// A target that is a non-negative combination of 3 of 40 columns is met exactly, and the early
-/// stop returns as soon as the residual falls below the tolerance, with fewer columns.
-TEST(Nnls, RecoversASparseNonNegativeCombinationAndStopsEarly) {
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  Eigen::MatrixXd A(60, 40);
-  for (int i = 0; i < A.rows(); ++i)
-    for (int j = 0; j < A.cols(); ++j) A(i, j) = U(rng);
-  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(40);
-  x0[4] = 1.5, x0[17] = 0.25, x0[31] = 2.0;
-  const Eigen::VectorXd b = A * x0;
-  const NnlsResult exact = nnls(A, b, 1e-13);
-  EXPECT_TRUE(exact.converged);
-  EXPECT_LT((exact.x - x0).norm(), 1e-9);
-  const NnlsResult early = nnls(A, b, 0.2);
-  EXPECT_TRUE(early.converged);
-  EXPECT_LE(early.residual, 0.2 * b.norm());
-  EXPECT_LE((early.x.array() > 0.0).count(), 3);
-}
 
 // ------------------------------------------------------------------ splines
 
