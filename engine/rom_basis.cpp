@@ -647,6 +647,13 @@ struct TrainingState {
   double t_scale;        // its RMS size: the theta row in force per metre, as the modes' rows
 };
 
+/// The path sample nearest in angle to th (deg).
+int nearest_sample(const ReducedBasis& B, double th) {
+  int k = path_segment_index(B.theta, th);
+  if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+  return k;
+}
+
 /// The ECSW training states: path samples (the top one and every stride-th below it), path samples
 /// plus the response to a random cluster-wise softening field, and the snapshots themselves.
 std::vector<TrainingState> ecsw_training_states(const ReducedBasis& B, const Eigen::VectorXd& mass, const Model& reference,
@@ -687,8 +694,7 @@ std::vector<TrainingState> ecsw_training_states(const ReducedBasis& B, const Eig
   // sample 0 gives no training state.
   for (const Eigen::VectorXd& u : snapshots) {
     const double th = bending_angle(reference, u).angle_deg;
-    int k = path_segment_index(B.theta, th);
-    if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+    const int k = nearest_sample(B, th);
     if (k > 0) train.push_back({u, B.W.col(k), 0.0});
   }
   for (TrainingState& s : train) s.t_scale = std::sqrt(mass_dot(mass, s.t, s.t) / m_tot) + 1e-300;
@@ -712,8 +718,7 @@ std::vector<RemainderState> remainder_training_states(const ReducedBasis& B, con
   std::vector<RemainderState> out;
   for (const TrainingState& s : train) {
     const double th = bending_angle(reference, s.u).angle_deg;
-    int k = path_segment_index(B.theta, th);
-    if (std::abs(B.theta[static_cast<std::size_t>(k) + 1] - th) < std::abs(B.theta[static_cast<std::size_t>(k)] - th)) ++k;
+    const int k = nearest_sample(B, th);
     const Eigen::VectorXd q = MPhi.transpose() * (s.u - B.U.col(k)) / m_tot;
     if (k == 0 || q.norm() == 0.0) continue;
     const Eigen::VectorXd wk = B.W.col(k);
@@ -722,9 +727,42 @@ std::vector<RemainderState> remainder_training_states(const ReducedBasis& B, con
   return out;
 }
 
+/// The NNLS fit of ECSW: G holds, per training state s and generalised coordinate c (row
+/// s * ncomp + c), each element's contribution (one column per element of `el`); the target is the
+/// whole cluster's (the row sums). A training state that inverts an element says nothing about
+/// it: its rows are dropped. Every coordinate counts alike, relative to its own size over the
+/// training states: the theta row, which sets the angle, is then fitted as well as any mode's, not
+/// drowned by the sixteen of them. Returns the picked (element, weight) pairs and the relative
+/// residual.
+std::vector<std::pair<int, double>> ecsw_fit(Eigen::MatrixXd& G, int ncomp, const std::vector<int>& el, double tolerance,
+                                             double& residual) {
+  const Eigen::Index rows = G.rows();
+  const std::size_t nt = static_cast<std::size_t>(rows / ncomp);
+  for (Eigen::Index row = 0; row < rows; ++row)
+    if (!G.row(row).allFinite()) G.row(row).setZero();
+  Eigen::VectorXd target = G.rowwise().sum();
+  for (int comp = 0; comp < ncomp; ++comp) {
+    double ss = 0.0;
+    for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>(s * ncomp + comp)], 2);
+    const double scale = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(nt, 1)));
+    if (!(scale > 0.0)) continue;
+    for (std::size_t s = 0; s < nt; ++s) {
+      const Eigen::Index row = static_cast<Eigen::Index>(s * ncomp + comp);
+      G.row(row) /= scale;
+      target[row] /= scale;
+    }
+  }
+  const NnlsResult res = nnls(G, target, tolerance);
+  residual = res.residual / std::max(target.norm(), 1e-300);
+  std::vector<std::pair<int, double>> picked;
+  for (std::size_t j = 0; j < el.size(); ++j)
+    if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked.push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
+  return picked;
+}
+
 /// ECSW in one cluster: non-negative element weights that reproduce the cluster's reduced force
 /// (theta row and every mode, of the whole and of the isochoric force) on the training states
-/// within the tolerance. Returns the picked (element, weight) pairs and the relative residual.
+/// within the tolerance (ecsw_fit).
 std::vector<std::pair<int, double>> ecsw_cluster_weights(const Model& reference, const ElementGeometry& geom, const ReducedBasis& B,
                                                          const std::vector<int>& el, const std::vector<TrainingState>& train,
                                                          double tolerance, double& residual) {
@@ -752,31 +790,7 @@ std::vector<std::pair<int, double>> ecsw_cluster_weights(const Model& reference,
       }
     }
   }
-  // A training state that inverts an element of this cluster says nothing about it: dropped.
-  for (Eigen::Index row = 0; row < rows; ++row)
-    if (!G.row(row).allFinite()) G.row(row).setZero();
-  Eigen::VectorXd target = G.rowwise().sum();
-  // Every generalised coordinate (theta and each mode, of the whole and of the isochoric force)
-  // counts alike, relative to its own size over the training states: the theta row, which sets
-  // the angle, is then fitted as well as any mode's, not drowned by the sixteen of them.
-  for (int comp = 0; comp < 2 * n1; ++comp) {
-    const int blk = comp / n1, i = comp % n1;
-    double ss = 0.0;
-    for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>((s * 2 + blk) * n1 + i)], 2);
-    const double scale = std::sqrt(ss / static_cast<double>(nt));
-    if (!(scale > 0.0)) continue;
-    for (std::size_t s = 0; s < nt; ++s) {
-      const Eigen::Index row = static_cast<Eigen::Index>((s * 2 + blk) * n1 + i);
-      G.row(row) /= scale;
-      target[row] /= scale;
-    }
-  }
-  const NnlsResult res = nnls(G, target, tolerance);
-  residual = res.residual / std::max(target.norm(), 1e-300);
-  std::vector<std::pair<int, double>> picked;
-  for (std::size_t j = 0; j < el.size(); ++j)
-    if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked.push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
-  return picked;
+  return ecsw_fit(G, 2 * n1, el, tolerance, residual);
 }
 
 /// Clusters of the stiff elements (the fabric): k-means within each region, about `total` / 4 in
@@ -799,7 +813,7 @@ std::vector<std::vector<int>> stiff_clusters(const Model& model, const std::vect
 /// tested with [w_k, Phi] (K_e Phi q by a central difference: the remainder is second order in q,
 /// the difference's error third order, 1e-4 of it at the step below). The reference's quadrature
 /// (G_hat_ref, K_hat_ref) uses the same weights, so the bracket of a stiff part is exactly the
-/// weighted sum of these remainders. Rows scaled per coordinate by their RMS, as the soft parts'.
+/// weighted sum of these remainders. Fitted as the soft parts' (ecsw_fit).
 std::vector<std::pair<int, double>> ecsw_remainder_weights(const Model& reference, const ElementGeometry& geom, const ReducedBasis& B,
                                                            const std::vector<int>& el, const std::vector<RemainderState>& train,
                                                            double tolerance, double& residual) {
@@ -807,18 +821,18 @@ std::vector<std::pair<int, double>> ecsw_remainder_weights(const Model& referenc
   const std::size_t nt = train.size();
   Eigen::MatrixXd G(static_cast<Eigen::Index>(nt * n1), static_cast<Eigen::Index>(el.size()));
   Eigen::VectorXd f, fp, fm, fi;
-  for (std::size_t j = 0; j < el.size(); ++j) {
-    const int e = el[j];
-    const int* n = reference.mesh.element(e);
-    for (std::size_t s = 0; s < nt; ++s) {
-      const Eigen::VectorXd uk = B.U.col(train[s].k);
-      const Eigen::VectorXd d = B.Phi * train[s].q;
-      constexpr double eps = 1e-2;  // relative to q: the remainder is O(|q|^2), the difference's error O(eps^2 |q|^3)
-      element_force(reference, geom, e, uk + d, f, fi);
-      element_force(reference, geom, e, uk + eps * d, fp, fi);
-      element_force(reference, geom, e, uk - eps * d, fm, fi);
+  constexpr double eps = 1e-2;  // relative to q: the remainder is O(|q|^2), the difference's error O(eps^2 |q|^3)
+  for (std::size_t s = 0; s < nt; ++s) {  // states outside: the three displacements once per state
+    const Eigen::VectorXd d = B.Phi * train[s].q;
+    const Eigen::VectorXd u = B.U.col(train[s].k) + d, up = B.U.col(train[s].k) + eps * d, um = B.U.col(train[s].k) - eps * d;
+    const Eigen::Index row = static_cast<Eigen::Index>(s * n1);
+    for (std::size_t j = 0; j < el.size(); ++j) {
+      const int e = el[j];
+      const int* n = reference.mesh.element(e);
+      element_force(reference, geom, e, u, f, fi);
+      element_force(reference, geom, e, up, fp, fi);
+      element_force(reference, geom, e, um, fm, fi);
       const Eigen::VectorXd rem = f - (fp + fm) * 0.5 - (fp - fm) / (2.0 * eps);  // f(u+d) - f(u) - K d, f(u) ~ (fp+fm)/2
-      const Eigen::Index row = static_cast<Eigen::Index>(s * n1);
       double gth = 0.0;
       Eigen::VectorXd gq = Eigen::VectorXd::Zero(r);
       for (int a = 0; a < geom.npe; ++a) {
@@ -829,25 +843,7 @@ std::vector<std::pair<int, double>> ecsw_remainder_weights(const Model& referenc
       G.block(row + 1, static_cast<Eigen::Index>(j), r, 1) = gq;
     }
   }
-  for (Eigen::Index row = 0; row < G.rows(); ++row)
-    if (!G.row(row).allFinite()) G.row(row).setZero();
-  Eigen::VectorXd target = G.rowwise().sum();
-  for (int i = 0; i < n1; ++i) {
-    double ss = 0.0;
-    for (std::size_t s = 0; s < nt; ++s) ss += std::pow(target[static_cast<Eigen::Index>(s * n1 + i)], 2);
-    const double scale = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(nt, 1)));
-    if (!(scale > 0.0)) continue;
-    for (std::size_t s = 0; s < nt; ++s) {
-      G.row(static_cast<Eigen::Index>(s * n1 + i)) /= scale;
-      target[static_cast<Eigen::Index>(s * n1 + i)] /= scale;
-    }
-  }
-  const NnlsResult res = nnls(G, target, tolerance);
-  residual = res.residual / std::max(target.norm(), 1e-300);
-  std::vector<std::pair<int, double>> picked;
-  for (std::size_t j = 0; j < el.size(); ++j)
-    if (res.x[static_cast<Eigen::Index>(j)] > 0.0) picked.push_back({el[j], res.x[static_cast<Eigen::Index>(j)]});
-  return picked;
+  return ecsw_fit(G, n1, el, tolerance, residual);
 }
 
 /// The sampled elements and their weights (B.elements, B.weights, sorted by element): ECSW per
