@@ -14,20 +14,13 @@
 #include "core/errors.h"
 #include "scenes/build_model.h"
 #include "tests/support/input_error.h"
+#include "tests/support/tiny_scene.h"
 
 namespace pneufem {
 namespace {
 
-// 3 chambers at h = 6 mm (as in test_stiffness_scale.cpp): the scene's load is what is checked here.
-const std::vector<std::string> kTiny = {"geometry.chambers=3", "mesh.h_mm=6.0", "output.vtu=none"};
-
-std::vector<std::string> tiny(std::vector<std::string> more) {
-  std::vector<std::string> s = kTiny;
-  s.insert(s.end(), more.begin(), more.end());
-  return s;
-}
-
 using pneufem::test::error_of;
+using pneufem::test::tiny;  // 3 chambers at h = 6 mm
 
 // ---- Pressure lag ----
 

@@ -15,20 +15,13 @@
 #include "materials/scaled.h"
 #include "scenes/build_model.h"
 #include "tests/support/input_error.h"
+#include "tests/support/tiny_scene.h"
 
 namespace pneufem {
 namespace {
 
-// 3 chambers at h = 6 mm: a few hundred Tet10, each equilibrium takes milliseconds.
-const std::vector<std::string> kTiny = {"geometry.chambers=3", "mesh.h_mm=6.0", "output.vtu=none"};
-
-std::vector<std::string> tiny(std::vector<std::string> more) {
-  std::vector<std::string> s = kTiny;
-  s.insert(s.end(), more.begin(), more.end());
-  return s;
-}
-
 using pneufem::test::error_of;
+using pneufem::test::tiny;  // 3 chambers at h = 6 mm
 
 /// Angles at every report of the scene's load.
 std::vector<double> angles(const Scene& s) {
