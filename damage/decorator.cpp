@@ -2,6 +2,15 @@
 
 #include <cassert>
 
+namespace pneufem {
+
+MaterialDecorator::MaterialDecorator(MaterialPtr base, std::string effect, int own)
+    : base_(std::move(base)), effect_(std::move(effect)), own_(own) {
+  detail::require_split_base(base_, effect_);
+}
+
+}  // namespace pneufem
+
 namespace pneufem::detail {
 
 bool stress_base(const Material& base, StressBatch& b, const TimeStep& step, std::span<const double> state_old,

@@ -14,6 +14,17 @@
 //  * an EMPTY state_old means "the virgin state" (own history at its initial values; the base gets
 //    an empty span too), so a decorated law can be evaluated like an elastic one;
 //  * an empty state_new means "do not write the trial state" (the engine's energy-only passes).
+//
+// The forwarding that a layer does not change lives once, in MaterialDecorator below (Mullins,
+// FatigueDamage and UniformFatigue derive from it): the name "effect(base)", the state size
+// own + base, the small-strain moduli, the linear-drive history and the non-local driver (each
+// handed the base's slice of the block), and the base itself. A layer overrides only what it
+// changes (FatigueDamage its non-local driver). Cycle jumping is deliberately NOT forwarded: a layer
+// that does not say how its own history extrapolates must refuse (Material's default for a law with
+// state), so Mullins and FatigueDamage override jumps_cycles/jump_cycles/jump_error and UniformFatigue
+// does not jump. Viscoelastic (viscoelastic.h) still spells the same forwarding out; its own state
+// size, 6 (1 + terms), is known only once its constructor has checked the Prony terms.
+//
 // evaluate() calls the base one point at a time (one virtual call per point and layer, since the
 // base's slices are strided by the full block): the price of composability, paid where the tangent
 // dominates anyway. The force-only stress() calls the base's stress() once for the whole batch
@@ -34,6 +45,52 @@
 #include "core/errors.h"
 #include "core/number_text.h"
 #include "materials/material.h"
+
+namespace pneufem {
+
+/// A Material wrapping a split base law with `own` doubles of history per point in front of the
+/// base's (the layout above). Forwards what the layer does not change; the constructor throws
+/// InputError unless the base is a non-null split law (detail::require_split_base).
+class MaterialDecorator : public Material {
+ public:
+  /// "effect(base)", e.g. "mullins(yeoh)".
+  std::string name() const override { return effect_ + "(" + base_->name() + ")"; }
+  /// The layer's own doubles per point, at the head of its block.
+  int own_state_size() const { return own_; }
+  int state_size() const override { return own_ + base_->state_size(); }
+  double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
+  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
+  /// Forwarded to the base (its slice of the state).
+  LinearDrive linear_drive() const override { return base_->linear_drive(); }
+  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
+    base_->linear_drive_value(base_state(state), out);
+  }
+  /// Forwarded to the base (its slice of the state): a fatigue law inside keeps its non-local driver.
+  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
+  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
+    return base_->nonlocal_driver(F, base_state(state));
+  }
+  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
+    base_->set_nonlocal_driver(base_state(state), local, average);
+  }
+  const MaterialPtr& base() const { return base_; }
+
+ protected:
+  /// `effect` names the layer in name() and in the errors of its checks. Defined in decorator.cpp.
+  MaterialDecorator(MaterialPtr base, std::string effect, int own);
+  const std::string& effect() const { return effect_; }
+  /// The base's slice of one point's block [own | base].
+  std::span<const double> base_state(std::span<const double> state) const { return state.subspan(own_size()); }
+  std::span<double> base_state(std::span<double> state) const { return state.subspan(own_size()); }
+  std::size_t own_size() const { return static_cast<std::size_t>(own_); }
+
+ private:
+  MaterialPtr base_;
+  std::string effect_;
+  int own_;
+};
+
+}  // namespace pneufem
 
 namespace pneufem::detail {
 

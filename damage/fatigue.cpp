@@ -133,10 +133,10 @@ FatigueRate fatigue_rate(double X, const FatigueParams& p) {
   return r;
 }
 
-FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(std::move(base)), p_(p) {
-  const std::string me = "fatigue";
-  detail::require_split_base(base_, me);
-  detail::require_potential_base(base_, me);
+FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p)
+    : MaterialDecorator(std::move(base), "fatigue", p.nonlocal_radius_m > 0.0 ? 2 : 1), p_(p) {
+  const std::string& me = effect();
+  detail::require_potential_base(this->base(), me);
   detail::require_finite(me, {{"tau", p.tau_s}, {"q", p.q}, {"d_fail", p.d_fail}, {"n", p.n}});
   if (p.driver == FatigueDriver::energy) {
     detail::require_finite(me, {{"W_th", p.W_th_Pa}});
@@ -162,12 +162,12 @@ FatigueDamage::FatigueDamage(MaterialPtr base, const FatigueParams& p) : base_(s
 void FatigueDamage::init_state(std::span<double> state) const {
   state[0] = 1.0;  // integrity 1 - d
   if (own_state_size() > 1) state[1] = 1.0;  // rho: no average known yet
-  base_->init_state(state.subspan(static_cast<std::size_t>(own_state_size())));
+  base()->init_state(base_state(state));
 }
 
 void FatigueDamage::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                                 std::span<double> out) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  const std::size_t own = own_size();
   std::copy(after.begin(), after.begin() + static_cast<std::ptrdiff_t>(own), out.begin());  // rho: the last cycle's
   // z = s^(1-n) (n > 1) or -ln s (n = 1), linear in time at a constant driver (fatigue.h).
   const auto z_of = [&](double s) { return p_.n > 1.0 ? std::pow(s, 1.0 - p_.n) : -std::log(s); };
@@ -176,32 +176,30 @@ void FatigueDamage::jump_cycles(std::span<const double> before, std::span<const 
   const double dz = std::max(0.0, z_of(s_after) - z_of(before[0]));
   const double s_jump = s_of(z_of(s_after) + cycles * dz);
   out[0] = std::min(s_after, std::max(s_jump, 1.0 - p_.d_fail));  // never heals, stops at d_fail
-  base_->jump_cycles(before.subspan(own), after.subspan(own), cycles, out.subspan(own));
+  base()->jump_cycles(before.subspan(own), after.subspan(own), cycles, out.subspan(own));
 }
 
 double FatigueDamage::jump_error(std::span<const double> predicted, std::span<const double> computed) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
-  return std::max(std::abs(predicted[0] - computed[0]), base_->jump_error(predicted.subspan(own), computed.subspan(own)));
+  const std::size_t own = own_size();
+  return std::max(std::abs(predicted[0] - computed[0]), base()->jump_error(predicted.subspan(own), computed.subspan(own)));
 }
 
 Material::NonlocalSpec FatigueDamage::nonlocal() const {
-  if (!(p_.nonlocal_radius_m > 0.0)) return base_->nonlocal();
+  if (!(p_.nonlocal_radius_m > 0.0)) return MaterialDecorator::nonlocal();
   return {p_.nonlocal_radius_m, p_.driver == FatigueDriver::energy ? "fatigue:energy" : "fatigue:stretch"};
 }
 
 double FatigueDamage::nonlocal_driver(const Mat3& F, std::span<const double> state) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
-  if (!(p_.nonlocal_radius_m > 0.0)) return base_->nonlocal_driver(F, state.subspan(own));
+  if (!(p_.nonlocal_radius_m > 0.0)) return MaterialDecorator::nonlocal_driver(F, state);
   if (p_.driver == FatigueDriver::max_principal_stretch) return max_principal_stretch(F);
   // W0: the base's isochoric energy at its committed state (as evaluate() sees it at dt = 0).
   PointResponse r;
-  detail::evaluate_base(*base_, F, TimeStep{}, detail::PointState{{}, {}, state.subspan(own), {}}, r, false);
+  detail::evaluate_base(*base(), F, TimeStep{}, detail::PointState{{}, {}, base_state(state), {}}, r, false);
   return r.psi_iso;
 }
 
 void FatigueDamage::set_nonlocal_driver(std::span<double> state, double local, double average) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
-  if (!(p_.nonlocal_radius_m > 0.0)) return base_->set_nonlocal_driver(state.subspan(own), local, average);
+  if (!(p_.nonlocal_radius_m > 0.0)) return MaterialDecorator::set_nonlocal_driver(state, local, average);
   // rho = average / local; 1 where the local driver is ~0 (an unloaded point of the energy driver:
   // below any threshold either way) or not finite.
   const double scale = p_.driver == FatigueDriver::energy ? p_.W_th_Pa : 1.0;
@@ -212,13 +210,13 @@ void FatigueDamage::set_nonlocal_driver(std::span<double> state, double local, d
 void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                              std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = own_size(), nb = static_cast<std::size_t>(base()->state_size());
   const double dt_over_tau = step.dt_s / p_.tau_s;
   const bool by_energy = p_.driver == FatigueDriver::energy;
   for (std::size_t q = 0; q < F.size(); ++q) {
     const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
     PointResponse& r = out[q];
-    detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
+    detail::evaluate_base(*base(), F[q], step, ps, r, tangent);
     const double s_old = ps.own_old.empty() ? 1.0 : ps.own_old[0];
     const double rho = own > 1 && !ps.own_old.empty() ? ps.own_old[1] : 1.0;  // non-local ratio (1: local)
 
@@ -259,8 +257,8 @@ void FatigueDamage::evaluate(std::span<const Mat3> F, const TimeStep& step, std:
 void FatigueDamage::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
                            std::span<double> state_new) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
-  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+  const std::size_t own = own_size(), nb = static_cast<std::size_t>(base()->state_size());
+  if (!detail::stress_base(*base(), b, step, state_old, state_new, own))
     return Material::stress(b, step, state_old, state_new);
   const double dt_over_tau = step.dt_s / p_.tau_s;
   const bool by_energy = p_.driver == FatigueDriver::energy;
@@ -286,7 +284,7 @@ void FatigueDamage::stress(StressBatch& b, const TimeStep& step, std::span<const
 }
 
 PointFields FatigueDamage::fields(std::span<const double> state) const {
-  PointFields f = base_->fields(state.subspan(static_cast<std::size_t>(own_state_size())));
+  PointFields f = base()->fields(base_state(state));
   const double d = 1.0 - state[0];
   f.damage = detail::combine_damage(d, f.damage);
   f.failed = f.failed || state[0] <= 1.0 - p_.d_fail;  // the integrity floor, bit for bit (evaluate)

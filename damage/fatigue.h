@@ -62,6 +62,7 @@
 // State per point: [1 - d] (local) or [1 - d, rho] (non-local).
 #include <string>
 
+#include "damage/decorator.h"
 #include "materials/material.h"
 
 namespace pneufem {
@@ -93,18 +94,14 @@ struct FatigueRate {
 };
 FatigueRate fatigue_rate(double X, const FatigueParams& p);
 
-class FatigueDamage final : public Material {
+class FatigueDamage final : public MaterialDecorator {
  public:
-
   /// Throws InputError for bad parameters or a base that is not split or whose energy is not a
   /// potential of its stress (a viscoelastic base: wrap viscoelastic around fatigue instead).
   FatigueDamage(MaterialPtr base, const FatigueParams& p);
 
-  std::string name() const override { return "fatigue(" + base_->name() + ")"; }
   bool isochoric_energy_is_potential() const override { return false; }
-  /// [1 - d] or, with a non-local driver, [1 - d, rho].
-  int own_state_size() const { return p_.nonlocal_radius_m > 0.0 ? 2 : 1; }
-  int state_size() const override { return own_state_size() + base_->state_size(); }
+  /// Own state (own_state_size()): [1 - d] or, with a non-local driver, [1 - d, rho].
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
@@ -113,13 +110,6 @@ class FatigueDamage final : public Material {
               std::span<double> state_new) const override;
   /// damage = 1 - (1 - d)(1 - base damage); failed = d >= d_fail or the base failed; the rest from the base.
   PointFields fields(std::span<const double> state) const override;
-  double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
-  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
-  /// Forwarded to the base (its slice of the state).
-  LinearDrive linear_drive() const override { return base_->linear_drive(); }
-  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
-    base_->linear_drive_value(state.subspan(static_cast<std::size_t>(own_state_size())), out);
-  }
   /// Cycle jumping (Material::jump_cycles). At a constant driver the exact integrity is
   /// s(t)^(1-n) = s(0)^(1-n) + (n - 1) g t / tau (n > 1) and -ln s(t) = -ln s(0) + g t / tau (n = 1):
   /// z = s^(1-n) resp. -ln s grows linearly in time, so over cycles that repeat the driver's history
@@ -127,23 +117,21 @@ class FatigueDamage final : public Material {
   /// Van Paepegem et al. 2001 for a damage rate of this form). The result is clipped to damage
   /// never decreasing and never passing d_fail; rho (non-local) is the last cycle's. jump_error:
   /// |s_predicted - s_computed| (the stiffness fraction is s times the base's), or the base's if larger.
-  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  bool jumps_cycles() const override { return base()->jumps_cycles(); }
   void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                    std::span<double> out) const override;
   double jump_error(std::span<const double> predicted, std::span<const double> computed) const override;
   /// With nonlocal_radius_m > 0: kind "fatigue:energy" or "fatigue:stretch"; the driver X at the
-  /// committed state; rho = average / X stored for the next increments.
+  /// committed state; rho = average / X stored for the next increments. Local: forwarded to the base.
   NonlocalSpec nonlocal() const override;
   double nonlocal_driver(const Mat3& F, std::span<const double> state) const override;
   void set_nonlocal_driver(std::span<double> state, double local, double average) const override;
 
   const FatigueParams& params() const { return p_; }
-  const MaterialPtr& base() const { return base_; }
   /// Damage d of this layer alone from a point's state block.
   static double damage(std::span<const double> state) { return 1.0 - state[0]; }
 
  private:
-  MaterialPtr base_;
   FatigueParams p_;
 };
 

@@ -8,14 +8,14 @@
 
 namespace pneufem {
 
-UniformFatigue::UniformFatigue(MaterialPtr base, const UniformFatigueParams& p) : base_(std::move(base)), p_(p) {
-  const std::string me = "fatigue_uniform";
-  detail::require_split_base(base_, me);
-  detail::require_potential_base(base_, me);
+UniformFatigue::UniformFatigue(MaterialPtr base, const UniformFatigueParams& p)
+    : MaterialDecorator(std::move(base), "fatigue_uniform", kOwnState), p_(p) {
+  const std::string& me = effect();
+  detail::require_potential_base(this->base(), me);
   detail::require_finite(me, {{"a", p.a}, {"t0", p.t0_s}});
   detail::require(p.a > 0.0, me, "a must be > 0 (compliance growth per e-fold of the count), got " + short_num(p.a));
   detail::require(p.t0_s > 0.0, me, "t0 must be > 0 s (the count at the knee), got " + short_num(p.t0_s));
-  floor_Pa_ = kFloorOfMu * base_->initial_shear_modulus();
+  floor_Pa_ = kFloorOfMu * this->base()->initial_shear_modulus();
 }
 
 double UniformFatigue::growth(double N) const { return p_.a * std::log1p(std::max(N, 0.0) / p_.t0_s); }
@@ -23,17 +23,17 @@ double UniformFatigue::growth(double N) const { return p_.a * std::log1p(std::ma
 void UniformFatigue::init_state(std::span<double> state) const {
   state[0] = 0.0;  // N
   state[1] = 0.0;  // W_max
-  base_->init_state(state.subspan(kOwnState));
+  base()->init_state(base_state(state));
 }
 
 void UniformFatigue::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                               std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base()->state_size());
   for (std::size_t q = 0; q < F.size(); ++q) {
     const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
     PointResponse& r = out[q];
-    detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
+    detail::evaluate_base(*base(), F[q], step, ps, r, tangent);
     const double W0 = r.psi_iso;
     const double N_old = ps.own_old.empty() ? 0.0 : ps.own_old[0];
     const double W_max_old = ps.own_old.empty() ? 0.0 : ps.own_old[1];
@@ -65,7 +65,7 @@ void UniformFatigue::evaluate(std::span<const Mat3> F, const TimeStep& step, std
 }
 
 PointFields UniformFatigue::fields(std::span<const double> state) const {
-  PointFields f = base_->fields(state.subspan(kOwnState));
+  PointFields f = base()->fields(base_state(state));
   const double D = growth(state[0]);
   f.damage = detail::combine_damage(D / (1.0 + D), f.damage);
   f.fatigue_damage = detail::combine_damage(D / (1.0 + D), f.fatigue_damage);

@@ -35,6 +35,7 @@
 // State per point: [N (s), W_max (Pa)].
 #include <string>
 
+#include "damage/decorator.h"
 #include "materials/material.h"
 
 namespace pneufem {
@@ -44,7 +45,7 @@ struct UniformFatigueParams {
   double t0_s = 0.0;  ///< count at the knee (s at the peak load, > 0)
 };
 
-class UniformFatigue final : public Material {
+class UniformFatigue final : public MaterialDecorator {
  public:
   static constexpr int kOwnState = 2;  ///< [N, W_max]
   /// Floor of W_max below which nothing counts, relative to the base's initial shear modulus (see above).
@@ -54,34 +55,20 @@ class UniformFatigue final : public Material {
   /// potential of its stress.
   UniformFatigue(MaterialPtr base, const UniformFatigueParams& p);
 
-  std::string name() const override { return "fatigue_uniform(" + base_->name() + ")"; }
   bool isochoric_energy_is_potential() const override { return false; }
-  int state_size() const override { return kOwnState + base_->state_size(); }
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
   /// damage = 1 - (1 - d)(1 - base damage) with d = D / (1 + D); W_max from this law; the rest from the base.
   PointFields fields(std::span<const double> state) const override;
-  double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
-  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
-  LinearDrive linear_drive() const override { return base_->linear_drive(); }
-  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
-    base_->linear_drive_value(state.subspan(kOwnState), out);
-  }
-  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
-  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
-    return base_->nonlocal_driver(F, state.subspan(kOwnState));
-  }
-  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
-    base_->set_nonlocal_driver(state.subspan(kOwnState), local, average);
-  }
+  /// Cycle jumping is not overridden: the law does not say how its count extrapolates, so it never
+  /// jumps (Material's default for a law with state; decorator.h).
 
   /// The compliance growth D at count N.
   double growth(double N) const;
   const UniformFatigueParams& params() const { return p_; }
 
  private:
-  MaterialPtr base_;
   UniformFatigueParams p_;
   double floor_Pa_ = 0.0;
 };

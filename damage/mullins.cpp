@@ -22,10 +22,10 @@ MullinsEta ogden_roxburgh(double W_dev, double W_max, const MullinsParams& p) {
   return e;
 }
 
-Mullins::Mullins(MaterialPtr base, const MullinsParams& p) : base_(std::move(base)), p_(p) {
-  const std::string me = "mullins";
-  detail::require_split_base(base_, me);
-  detail::require_potential_base(base_, me);
+Mullins::Mullins(MaterialPtr base, const MullinsParams& p)
+    : MaterialDecorator(std::move(base), "mullins", kOwnState), p_(p) {
+  const std::string& me = effect();
+  detail::require_potential_base(this->base(), me);
   detail::require_finite(me, {{"r", p.r}, {"m", p.m_Pa}, {"beta", p.beta}});
   detail::require(p.r > 1.0, me, "r must be > 1 (the largest stress softening is 1/r), got " + short_num(p.r));
   detail::require(p.m_Pa >= 0.0, me, "m must be >= 0 Pa (an energy density), got " + short_num(p.m_Pa));
@@ -38,24 +38,24 @@ Mullins::Mullins(MaterialPtr base, const MullinsParams& p) : base_(std::move(bas
 void Mullins::init_state(std::span<double> state) const {
   state[0] = 0.0;  // W_max
   state[1] = 1.0;  // eta
-  base_->init_state(state.subspan(kOwnState));
+  base()->init_state(base_state(state));
 }
 
 void Mullins::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                           std::span<double> out) const {
   out[0] = after[0] + cycles * std::max(0.0, after[0] - before[0]);  // W_max: linear per cycle (mullins.h)
   out[1] = after[1];                                                 // eta_last: output only
-  base_->jump_cycles(before.subspan(kOwnState), after.subspan(kOwnState), cycles, out.subspan(kOwnState));
+  base()->jump_cycles(before.subspan(kOwnState), after.subspan(kOwnState), cycles, out.subspan(kOwnState));
 }
 
 double Mullins::jump_error(std::span<const double> predicted, std::span<const double> computed) const {
-  const double base = base_->jump_error(predicted.subspan(kOwnState), computed.subspan(kOwnState));
+  const double inner = base()->jump_error(predicted.subspan(kOwnState), computed.subspan(kOwnState));
   const double dW = std::abs(predicted[0] - computed[0]);
-  if (dW == 0.0) return base;
+  if (dW == 0.0) return inner;
   const double D = p_.m_Pa + p_.beta * std::min(predicted[0], computed[0]);
   // The bound of mullins.h; with m = 0 and a virgin point (D = 0) the softening can change by up to 1/r.
   const double e = D > 0.0 ? std::min(1.0 / p_.r, 2.0 * dW / (p_.r * std::sqrt(std::numbers::pi) * D)) : 1.0 / p_.r;
-  return std::max(base, e);
+  return std::max(inner, e);
 }
 
 namespace {
@@ -77,11 +77,11 @@ std::optional<MullinsEta> soften(double W_dev, const detail::PointState& ps, con
 
 void Mullins::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                        std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
-  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base()->state_size());
   for (std::size_t q = 0; q < F.size(); ++q) {
     const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
     PointResponse& r = out[q];
-    detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
+    detail::evaluate_base(*base(), F[q], step, ps, r, tangent);
     const double W_dev = r.psi_iso;
     const std::optional<MullinsEta> e = soften(W_dev, ps, p_);
     if (!e) continue;
@@ -96,8 +96,8 @@ void Mullins::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<
 
 void Mullins::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
                      std::span<double> state_new) const {
-  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base_->state_size());
-  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+  const std::size_t own = kOwnState, nb = static_cast<std::size_t>(base()->state_size());
+  if (!detail::stress_base(*base(), b, step, state_old, state_new, own))
     return Material::stress(b, step, state_old, state_new);
   for (int l = 0; l < b.n; ++l) {
     const detail::PointState ps = detail::point_state(state_old, state_new, static_cast<std::size_t>(l), own, nb);
@@ -110,7 +110,7 @@ void Mullins::stress(StressBatch& b, const TimeStep& step, std::span<const doubl
 }
 
 PointFields Mullins::fields(std::span<const double> state) const {
-  PointFields f = base_->fields(state.subspan(kOwnState));
+  PointFields f = base()->fields(base_state(state));
   f.W_max = state[0];
   f.damage = detail::combine_damage(1.0 - state[1], f.damage);
   return f;

@@ -30,6 +30,7 @@
 // State per point: [W_max (J/m^3), eta at the last evaluated configuration (output only: fields())].
 #include <string>
 
+#include "damage/decorator.h"
 #include "materials/material.h"
 
 namespace pneufem {
@@ -50,7 +51,7 @@ struct MullinsEta {
 };
 MullinsEta ogden_roxburgh(double W_dev, double W_max, const MullinsParams& p);
 
-class Mullins final : public Material {
+class Mullins final : public MaterialDecorator {
  public:
   static constexpr int kOwnState = 2;  ///< [W_max, eta_last]
 
@@ -58,8 +59,6 @@ class Mullins final : public Material {
   /// potential of its stress (fatigue, viscoelastic: wrap those around mullins instead).
   Mullins(MaterialPtr base, const MullinsParams& p);
 
-  std::string name() const override { return "mullins(" + base_->name() + ")"; }
-  int state_size() const override { return kOwnState + base_->state_size(); }
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
@@ -68,13 +67,6 @@ class Mullins final : public Material {
               std::span<double> state_new) const override;
   /// W_max from this law; damage = 1 - eta_last (x) the base's stiffness fraction; the rest from the base.
   PointFields fields(std::span<const double> state) const override;
-  double initial_shear_modulus() const override { return base_->initial_shear_modulus(); }
-  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
-  /// Forwarded to the base (its slice of the state).
-  LinearDrive linear_drive() const override { return base_->linear_drive(); }
-  void linear_drive_value(std::span<const double> state, std::span<double> out) const override {
-    base_->linear_drive_value(state.subspan(kOwnState), out);
-  }
   /// Cycle jumping (Material::jump_cycles): W_max is a running maximum; when the structure softens
   /// from cycle to cycle (fatigue) the peak energy of the repeated load grows slowly, and it is
   /// extrapolated linearly, W_max,(k+N) = W_max,k + N max(0, W_max,k - W_max,(k-1)); eta_last is the
@@ -83,23 +75,14 @@ class Mullins final : public Material {
   /// |d eta / d W_max| = (2 / (r sqrt(pi))) exp(-z^2) (m + beta W_dev) / (m + beta W_max)^2 with
   /// z >= (W_max - W_max1) / D2; integrated over W_max in [W_max1, W_max2], with Di = m + beta W_maxi,
   ///   |d eta| <= (D2 / D1) erf(dW / D2) / r     (<= 2 dW / (r sqrt(pi) D1) for small dW; at most 1/r).
-  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  bool jumps_cycles() const override { return base()->jumps_cycles(); }
   void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                    std::span<double> out) const override;
   double jump_error(std::span<const double> predicted, std::span<const double> computed) const override;
-  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
-  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
-    return base_->nonlocal_driver(F, state.subspan(kOwnState));
-  }
-  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
-    base_->set_nonlocal_driver(state.subspan(kOwnState), local, average);
-  }
 
   const MullinsParams& params() const { return p_; }
-  const MaterialPtr& base() const { return base_; }
 
  private:
-  MaterialPtr base_;
   MullinsParams p_;
 };
 

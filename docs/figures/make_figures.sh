@@ -2,7 +2,7 @@
 # Regenerates the figures of the user guide (docs/user_guide.md) and the README by running its
 # tutorial on the small actuator of the test recordings: a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve.
-# About 3 min on 2 cores.
+# About 7 min on 2 cores (the diagnose about 5 of them).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
 cd "$(dirname "$0")/../.."

@@ -1,7 +1,8 @@
 // damage/decorator.h: the plumbing the decorators share - the layout of a point's state block
 // [own | base], the batched call of the base (stress_base: the base's slices gathered into consecutive
 // blocks and scattered back), the check that a base's energy is a potential, and the two scalar
-// helpers. The decorators' physics is tested by their own files and the derivative battery.
+// helpers, and the forwarding of MaterialDecorator. The decorators' physics is tested by their own
+// files and the derivative battery.
 #include "damage/decorator.h"
 
 #include <string>
@@ -10,6 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "damage/effects.h"
+#include "damage/fatigue.h"
+#include "damage/fatigue_uniform.h"
+#include "damage/mullins.h"
 #include "materials/hyperelastic.h"
 #include "tests/support/input_error.h"
 
@@ -94,6 +98,37 @@ TEST(Decorator, CombinedDamageAndMacaulayBracket) {
   EXPECT_EQ(detail::combine_damage(1.0, 0.4), 1.0);  // a failed point stays failed
   EXPECT_EQ(detail::macaulay(-1.0), 0.0);
   EXPECT_EQ(detail::macaulay(2.5), 2.5);
+}
+
+TEST(Decorator, ForwardsWhatTheLayerDoesNotChangeButNotCycleJumping) {
+  const MaterialPtr base = yeoh();
+  const auto mullins = std::make_shared<const Mullins>(base, MullinsParams{2.0, 1e3, 0.1});
+  const auto fatigue = std::make_shared<const FatigueDamage>(mullins, FatigueParams{100.0, 10.0});
+  const auto uniform = std::make_shared<const UniformFatigue>(base, UniformFatigueParams{0.05, 2.0});
+  EXPECT_EQ(mullins->name(), "mullins(" + base->name() + ")");
+  EXPECT_EQ(fatigue->name(), "fatigue(mullins(" + base->name() + "))");
+  EXPECT_EQ(uniform->name(), "fatigue_uniform(" + base->name() + ")");
+  // [own | base], each layer's own doubles at the head of its block.
+  EXPECT_EQ(mullins->own_state_size(), Mullins::kOwnState);
+  EXPECT_EQ(fatigue->own_state_size(), 1);
+  EXPECT_EQ(fatigue->state_size(), 1 + Mullins::kOwnState);
+  EXPECT_EQ(uniform->state_size(), UniformFatigue::kOwnState);
+  EXPECT_EQ(fatigue->base(), mullins);
+  for (const MaterialPtr& m : {MaterialPtr(mullins), MaterialPtr(fatigue), MaterialPtr(uniform)}) {
+    EXPECT_EQ(m->initial_shear_modulus(), base->initial_shear_modulus()) << m->name();
+    EXPECT_EQ(m->initial_bulk_modulus(), base->initial_bulk_modulus()) << m->name();
+    EXPECT_EQ(m->linear_drive(), base->linear_drive()) << m->name();
+    EXPECT_EQ(m->nonlocal().radius_m, 0.0) << m->name();
+  }
+  // Only a layer that says how its own history extrapolates jumps (decorator.h): Mullins and fatigue
+  // do, the uniform fatigue law does not, whatever its base can do.
+  EXPECT_TRUE(mullins->jumps_cycles());
+  EXPECT_TRUE(fatigue->jumps_cycles());
+  EXPECT_TRUE(base->jumps_cycles());
+  EXPECT_FALSE(uniform->jumps_cycles());
+  // The shared constructor's check names the layer.
+  EXPECT_NE(pneufem::test::error_of([] { Mullins(nullptr, MullinsParams{2.0, 1e3, 0.1}); }).find("mullins: no base material"),
+            std::string::npos);
 }
 
 }  // namespace
