@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   bool root_test = false;
   int root_trials = 1 << 30;
   bool fem = false, check = false, dump = false, dump_every = false, corrected = false, corrected_tops = false, fabric_strain = false;
-  int snap_trials = 0, enrich = 0;
+  int snap_trials = 0, enrich = 0, enrich_modes = 0;
   double rom_time_tol = 0.0;
   int path_steps = 40;  // the elastic path's pressure step is p_max / path_steps (its samples' density)  // > 0: the reduced run's time_tol alone (the FEM judge keeps the scene's)
   std::string save_corrected, extra_snapshots, in_run;
@@ -138,7 +138,8 @@ int main(int argc, char** argv) {
     else if (a == "--rom-time-tol") rom_time_tol = std::stod(next());  // the reduced run's time_tol only
     else if (a == "--save-corrected") save_corrected = next();   // the enrichment's corrected states, to a file
     else if (a == "--extra-snapshots") extra_snapshots = next(); // snapshots from such a file join the basis
-    else if (a == "--enrich") enrich = std::stoi(next());  // rounds: the corrected states join the basis, the run is repeated
+    else if (a == "--enrich") enrich = std::stoi(next());
+    else if (a == "--enrich-modes") enrich_modes = std::stoi(next());  // max_modes of the enriched bases (default: --modes)  // rounds: the corrected states join the basis, the run is repeated
     else if (a == "--check") check = true;
     else if (a == "--corrected") check = corrected = true, corrected_tops = next() == "tops";  // tops | reports
     else if (a == "--corrected-in-run") in_run = next();  // tops | reports: the corrected history fed back into the run
@@ -157,6 +158,7 @@ int main(int argc, char** argv) {
     else if (a == "--tangent-free") ro.tangent_free_modes = true;  // modes orthogonal to every path tangent, no gauge
     else if (a == "--exact-fabric") ro.stiff_parts = RomBasisOptions::StiffParts::exact;  // every fabric element in the bracket (nonlinear in q)
     else if (a == "--sampled-fabric") ro.stiff_parts = RomBasisOptions::StiffParts::sampled;  // fabric elements by ECSW on their remainder
+    else if (a == "--release-modes") ro.release_responses = true;  // responses of the unloaded body to the path's frozen stress
     else if (a == "--root-trials") root_trials = std::stoi(next());  // the root test stops after this trial
     else if (a == "--softened") ro.softened_levels = std::stoi(next());  // softened equilibria as snapshots (levels)
     else if (a == "--softened-max") ro.softened_max = std::stod(next());
@@ -276,6 +278,7 @@ int main(int argc, char** argv) {
     if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
     if (ro.galerkin_theta_row) snap_key += "galerkin-theta";
     if (ro.tangent_free_modes) snap_key += "tangent-free";
+    if (ro.release_responses) snap_key += "release-modes-v2";  // v2: the whole body at every path sample, own POD
     if (ro.stiff_parts == RomBasisOptions::StiffParts::exact) snap_key += "exact-fabric";
     if (ro.stiff_parts == RomBasisOptions::StiffParts::sampled) snap_key += "sampled-fabric";
     if (path_steps != 40) snap_key += "path-steps:" + std::to_string(path_steps);  // the basis holds the path's operators
@@ -469,7 +472,9 @@ int main(int argc, char** argv) {
       std::vector<Eigen::VectorXd> snaps = snapshots;
       snaps.insert(snaps.end(), corrected_states.begin(), corrected_states.end());
       const auto t0 = Clock::now();
-      bases.push_back(std::make_unique<ReducedBasis>(build_reduced_basis(ref->model, trace, ro, snaps)));
+      RomBasisOptions ro_e = ro;
+      if (enrich_modes > 0) ro_e.max_modes = enrich_modes;
+      bases.push_back(std::make_unique<ReducedBasis>(build_reduced_basis(ref->model, trace, ro_e, snaps)));
       std::printf("enrich %d: %zu snapshots, %d modes, %zu sampled elements, basis %.1f s\n", round, snaps.size(),
                   bases.back()->num_modes(), bases.back()->elements.size(), since(t0));
       roms.push_back(std::make_unique<ReducedOrderModel>(ref->model, *bases.back(), bm->model));

@@ -498,6 +498,81 @@ void add_softening_responses(const Assembler& A, const Model& reference, const R
   }
 }
 
+/// The linear responses of the unloaded actuator to the isochoric stress that each cluster of soft
+/// elements carries at the mode samples, frozen and applied at the reference configuration:
+/// du_c = K_T(0)^-1 int B_0^T S_iso,c(theta_k) dV (S_iso = F^-1 P_iso, the second Piola-Kirchhoff
+/// stress). Why: a history law that relaxes under load (a Prony series) leaves, after a release in
+/// zero time, a frozen stress of the loaded state's pattern (Simo 1987: the overstress jumps by
+/// gamma (S_0(F) - S_0(F_n)), so the total holds h_n - gamma S_0(F_n)); the released state is the
+/// response of the unloaded body to it, a small self-equilibrated shape no loaded response or
+/// softened equilibrium contains. Without it the reduced release found roots far from the FEM's.
+void add_release_responses(const Assembler& A, const Model& reference, const ReducedBasis& B,
+                           const std::vector<std::vector<int>>& clusters, const std::vector<int>& mode_k, bool verbose,
+                           CandidateShapes& out) {
+  const int ndof = reference.num_dofs();
+  const Eigen::VectorXd& mass = A.lumped_mass();
+  const ElementGeometry& geom = A.geometry();
+  SparseMatrix K = tangent(A, Eigen::VectorXd::Zero(ndof), 0.0);
+  A.apply_constraints(K, 1.0);
+  LinearSolver solver;
+  if (!solver.factorize(K)) {
+    if (verbose) std::fprintf(stderr, "reduced basis: the unloaded tangent is not positive definite, no release responses\n");
+    return;
+  }
+  const Eigen::VectorXd t = B.dU.col(0);
+  const double tt = mass_dot(mass, t, t);
+  const int npe = geom.npe, nqp = geom.nqp;
+  // Every path sample (the frozen stress of a Prony term is the path's stress history weighted by a
+  // kernel of time alone: a combination of the whole body's stress fields at all angles), each as
+  // one response of the whole soft body, and the clusters' at the mode samples (a damage law weighs
+  // that history locally).
+  std::vector<int> ks;
+  for (int k = 1; k < B.num_samples(); ++k) ks.push_back(k);
+  std::vector<std::vector<int>> whole(1);
+  for (const auto& c : clusters) whole[0].insert(whole[0].end(), c.begin(), c.end());
+  for (std::size_t pass = 0; pass < 2; ++pass)
+  for (int k : pass == 0 ? ks : mode_k) {
+    const std::vector<std::vector<int>>& groups = pass == 0 ? whole : clusters;
+    const Eigen::VectorXd uk = B.U.col(k);
+    std::vector<Eigen::VectorXd> fel(static_cast<std::size_t>(reference.mesh.num_elements()));
+    tbb::parallel_for(std::size_t(0), groups.size(), [&](std::size_t c) {
+      for (int e : groups[c]) {
+        const int* n = reference.mesh.element(e);
+        std::array<Mat3, 4> F;
+        std::array<PointResponse, 4> resp;
+        for (int q = 0; q < nqp; ++q) {
+          const double* g = geom.grad(e, q);
+          F[q] = Mat3::Identity();
+          for (int a = 0; a < npe; ++a) F[q] += uk.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
+        }
+        reference.material_of(e).evaluate(std::span<const Mat3>(F.data(), nqp), TimeStep{}, {}, {},
+                                          std::span<PointResponse>(resp.data(), nqp), false);
+        Eigen::VectorXd& f = fel[static_cast<std::size_t>(e)];
+        f = Eigen::VectorXd::Zero(3 * npe);
+        for (int q = 0; q < nqp; ++q) {
+          const Mat3 S = F[q].inverse() * resp[q].P_iso;  // second Piola-Kirchhoff, isochoric
+          const double* g = geom.grad(e, q);
+          const double w = geom.w(e, q);
+          for (int a = 0; a < npe; ++a) f.segment<3>(3 * a) += w * S * Eigen::Map<const Eigen::Vector3d>(g + 3 * a);
+        }
+      }
+    });
+    for (const auto& cl : groups) {
+      Eigen::VectorXd f = Eigen::VectorXd::Zero(ndof);
+      for (int e : cl) {
+        const int* n = reference.mesh.element(e);
+        for (int a = 0; a < npe; ++a) f.segment<3>(3 * n[a]) += fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
+      }
+      A.zero_fixed(f);
+      Eigen::VectorXd du = solver.solve(f);
+      A.zero_fixed(du);
+      du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
+      out.shape.push_back(std::move(du));
+      out.sample.push_back(0);
+    }
+  }
+}
+
 /// Each state's departure from the path point of equal angle (bisection on the path's angle),
 /// without its part along the path tangent there.
 void add_departures(const Model& reference, const ReducedBasis& B, const Eigen::VectorXd& mass,
@@ -535,14 +610,18 @@ void add_departures(const Model& reference, const ReducedBasis& B, const Eigen::
 /// actuator stayed 8 % short after three trials; taken first, 1 % (docs/theory.md). Sets B.Phi and
 /// B.info.pod_energy_left.
 void set_modes(const CandidateShapes& shapes, const Eigen::VectorXd& mass, const RomBasisOptions& opt, ReducedBasis& B) {
-  std::vector<Eigen::VectorXd> snapshot_shapes, response_shapes;
+  std::vector<Eigen::VectorXd> snapshot_shapes, response_shapes, release_shapes;
   for (std::size_t i = 0; i < shapes.shape.size(); ++i)
-    (shapes.sample[i] < 0 ? snapshot_shapes : response_shapes).push_back(shapes.shape[i]);
+    (shapes.sample[i] < 0 ? snapshot_shapes : shapes.sample[i] == 0 ? release_shapes : response_shapes).push_back(shapes.shape[i]);
   std::vector<Eigen::VectorXd> modes;
   double left = 0.0;
   if (!snapshot_shapes.empty())
     pod_append(snapshot_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left, /*normalise=*/false);
   pod_append(response_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left);
+  if (!release_shapes.empty()) {
+    double left_release = 0.0;
+    pod_append(release_shapes, mass, opt.max_modes, opt.pod_tolerance, modes, left_release);
+  }
   if (opt.tangent_free_modes) project_out_path_tangents(B.dU, mass, modes);
   const int r = static_cast<int>(modes.size());
   B.info.pod_energy_left = left;
@@ -943,6 +1022,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
   }
   CandidateShapes shapes;
   add_softening_responses(A, reference, B, clusters, mode_k, opt.verbose, shapes);
+  if (opt.release_responses) add_release_responses(A, reference, B, clusters, mode_k, opt.verbose, shapes);
   add_departures(reference, B, mass, all_snapshots, shapes);
   if (shapes.shape.empty())
     throw PhysicsError("reduced model: no tangent along the elastic path could be factorised (the path may start at a limit "

@@ -549,7 +549,9 @@ PhysicsError StaticSolver::stalled_continuation(double pa, double ta, const Newt
   // definite) means the structure is at or past a limit point; a positive-definite tangent
   // with a residual still falling means Newton merely ran out of iterations.
   std::ostringstream s;
-  s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << r.failure;
+  std::string why = r.failure;  // a sentence of its own (an element's message): its full stop is ours below
+  if (!why.empty() && why.back() == '.') why.pop_back();
+  s << "static continuation stalled at p = " << pa * 1e-3 << " kPa (t = " << ta << " s): " << why;
   if (r.regularised > 0)
     // Only what works: past a limit point under a pressure load there is no nearby
     // equilibrium (the wall balloons or the softened part gives way), so explicit dynamics,

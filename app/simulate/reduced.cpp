@@ -119,6 +119,9 @@ std::unique_ptr<ReducedSetup> reduced_setup(const Scene& scene, double p_max_Pa,
   h.num(options.softened_max);
   if (options.galerkin_theta_row) h.str("galerkin theta row");  // absent from older keys: they stay valid
   if (options.tangent_free_modes) h.str("tangent-free modes");  // likewise
+  if (options.stiff_parts == RomBasisOptions::StiffParts::exact) h.str("stiff parts exact");      // likewise
+  if (options.stiff_parts == RomBasisOptions::StiffParts::sampled) h.str("stiff parts sampled");  // likewise
+  if (options.release_responses) h.str("release responses");  // likewise
   auto build = [&] { return build_reduced_basis(ref, path, options).to_doubles(); };
   out->basis = ReducedBasis::from_doubles(cache_dir.empty() ? (out->basis_source = "computed", build())
                                                             : cached_doubles(cache_dir, "rom_basis", h.hex(), build, &out->basis_source));

@@ -155,6 +155,7 @@ TEST(FitMaterialCommand, UserGuideStepSevenTheFittedSiliconeOnTheSmallActuator) 
   const std::size_t at = fitted.out.find(stalled);
   ASSERT_NE(at, std::string::npos) << fitted.out;
   EXPECT_NEAR(std::stod(fitted.out.substr(at + stalled.size())), 23.4, 0.05) << fitted.out;
+  EXPECT_EQ(fitted.out.find(".. "), std::string::npos) << "one full stop between the element's sentence and the hint: " << fitted.out;
 }
 
 // A fit that loses Drucker stability inside its own data is refused, naming the first such row;
