@@ -4,7 +4,8 @@
 //             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--corrected-in-run reports|tops] [--dump-points]
 //             [--dump-every] [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
-//             [--root-test] [--root-trials N] [--exact-fabric | --sampled-fabric]
+//             [--root-test] [--root-trials N] [--exact-fabric | --sampled-fabric] [--release-modes]
+//             [--enrich N] [--enrich-modes R] [--save-corrected FILE] [--extra-snapshots FILE]
 // --softened N adds softened equilibria (N levels to --softened-max; 6 to 0.9 is the tested choice, off in the scenes' default,
 // the bench's 0 so that A/B runs name what they add); --check replays the run and prints the
 // adjoint and Newton-step indicators beside every report's error; --corrected reports|tops adds the
