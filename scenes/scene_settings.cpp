@@ -138,6 +138,10 @@ SolverSettings solver_settings(const Scene& s) {
   if (sv.reduced.max_modes < 1) s.fail("solver.reduced_modes", "must be >= 1");
   sv.reduced.ecsw_tolerance = positive(s, "solver.reduced_ecsw_tol");
   sv.reduced.softened_levels = s.integer("solver.reduced_softened_levels");
+  sv.reduced.stiff_parts = choice<RomBasisOptions::StiffParts>(s, "solver.reduced_fabric", {{"linear", RomBasisOptions::StiffParts::linear},
+                                                                                          {"exact", RomBasisOptions::StiffParts::exact},
+                                                                                          {"sampled", RomBasisOptions::StiffParts::sampled}});
+  sv.reduced.release_responses = s.boolean("solver.reduced_release_modes");
   if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
   sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
   sv.reduced_check_at = choice<SolverSettings::CheckAt>(s, "solver.reduced_check_at", {{"tops", SolverSettings::CheckAt::Tops},

@@ -71,7 +71,7 @@ struct SolverSettings {
   Mode mode = Mode::QuasiStatic;
   enum class Model { Full, Reduced };  ///< quasi-static: the full FEM or the reduced model (engine/rom.h)
   Model model = Model::Full;
-  RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels
+  RomBasisOptions reduced;             ///< solver.reduced_modes, _ecsw_tol, _softened_levels, _fabric, _release_modes
   double reduced_check_deg = 0.25;     ///< indicator tolerance of a reduced run's reports
   enum class CheckAt { Tops, Reports };  ///< where the corrected history is corrected (app/simulate/reduced.h)
   CheckAt reduced_check_at = CheckAt::Tops;

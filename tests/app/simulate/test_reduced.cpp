@@ -216,6 +216,27 @@ TEST(SimulateReduced, TheCheckCorrectsAtTheTopsOrAtEveryLoadedReport) {
             std::string::npos);
 }
 
+// solver.reduced_fabric and solver.reduced_release_modes reach the basis (RomBasisOptions::stiff_parts,
+// release_responses): a basis built with them is not taken from the cache of the default one (the
+// key names them), the release responses add modes of their own, and the run with the fabric exact
+// follows the full FEM as the default does (the 0.1 deg of ReportsTheReducedRunAndReusesItsCacheBitForBit).
+TEST(SimulateReduced, TheFabricAndReleaseKeysReachTheBasis) {
+  const fs::path cache = temp_dir("keys_cache"), plain = temp_dir("keys_plain"), keyed = temp_dir("keys_exact"), full = temp_dir("keys_full");
+  run(plain, {"solver.model=\"reduced\""}, cache.string());
+  const RunResult rk =
+      run(keyed, {"solver.model=\"reduced\"", "solver.reduced_fabric=\"exact\"", "solver.reduced_release_modes=true"}, cache.string());
+  const RunResult rf = run(full, {});
+  const nlohmann::json sp = summary(plain), sk = summary(keyed);
+  EXPECT_EQ(sk["reduced_model"]["offline"]["basis"], "computed") << "not the default basis from the cache";
+  EXPECT_EQ(sk["reduced_model"]["fallback"], "none");
+  EXPECT_GT(sk["reduced_model"]["online"]["modes"].get<double>(), sp["reduced_model"]["online"]["modes"].get<double>());
+  ASSERT_EQ(rk.records.size(), rf.records.size());
+  for (std::size_t i = 0; i < rk.records.size(); ++i)
+    EXPECT_NEAR(rk.records[i].angle_deg, rf.records[i].angle_deg, 0.1) << "report " << i;
+  EXPECT_NE(error_of([&] { run(keyed, {"solver.model=\"reduced\"", "solver.reduced_fabric=\"cubic\""}); }).find("solver.reduced_fabric"),
+            std::string::npos);
+}
+
 TEST(SimulateReduced, BadReducedKeysAreErrors) {
   const fs::path dir = temp_dir("bad");
   EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"tiny\""}); }).find("solver.model"), std::string::npos);
