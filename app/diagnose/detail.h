@@ -22,8 +22,8 @@
 
 #include "analysis/measurements.h"
 #include "analysis/model_vs_measured.h"
-#include "app/diagnose/command.h"
 #include "app/diagnose/effect_catalog.h"
+#include "app/diagnose/options_and_results.h"
 #include "scenes/scene.h"
 
 namespace pneufem::diagnose_detail {

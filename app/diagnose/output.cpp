@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "app/compare/history.h"
+#include "app/diagnose/command.h"
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
 #include "core/atomic_file.h"

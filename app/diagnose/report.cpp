@@ -8,6 +8,7 @@
 #include <string>
 
 #include "app/compare/history.h"
+#include "app/diagnose/command.h"
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
 #include "core/version.h"
