@@ -722,6 +722,8 @@ void select(Selection& s, int round, std::size_t pick, const CandidateResult& be
   // from trial 1 to the last trial (rms 0.48 -> 1.40 deg)", the baseline's, where the creep and lag
   // selected left 0.13, 0.07, 0.10, 0.09, 0.08, 0.11 deg, no growth).
   s.sig = signature_of(s.current);
+  if (s.opt.progress && s.sig.growth_trials >= 2)
+    std::fprintf(stderr, "diagnose: after round %d, %s\n", round, growth_split_text(s.sig).c_str());
   s.out.after_round.push_back(model_after_round(s.out.selected, s.selected_sets, s.current));
 }
 
@@ -1101,6 +1103,8 @@ void run_rounds(Selection& s, const DiagnoseOptions& opt, std::chrono::steady_cl
   record_baseline(base, opt, s.out);
   have_baseline = true;
   s.sig = signature_of(base);
+  if (opt.progress && s.sig.growth_trials >= 2)
+    std::fprintf(stderr, "diagnose: baseline, %s\n", growth_split_text(s.sig).c_str());
   s.current = base;
   s.current_rss = base.rss_deg2;
   s.current_static = fit_static_discrepancy(base.frames);
