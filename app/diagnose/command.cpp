@@ -1076,6 +1076,7 @@ void close_rounds(const Selection& s, const DiagnoseOptions& opt, DiagnosisResul
     out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
   }
   describe_static_remainder(s.current, s.current_static, opt, out);
+  out.final_growth = {s.sig.growth_trials, s.sig.top_growth_deg, s.sig.rest_growth_deg};  // s.sig: of s.current
   out.final_parameters = 0;
   out.final_constants.clear();
   for (const auto& [e, v] : s.chosen) {
@@ -1103,6 +1104,7 @@ void run_rounds(Selection& s, const DiagnoseOptions& opt, std::chrono::steady_cl
   record_baseline(base, opt, s.out);
   have_baseline = true;
   s.sig = signature_of(base);
+  s.out.baseline_growth = {s.sig.growth_trials, s.sig.top_growth_deg, s.sig.rest_growth_deg};
   if (opt.progress && s.sig.growth_trials >= 2)
     std::fprintf(stderr, "diagnose: baseline, %s\n", growth_split_text(s.sig).c_str());
   s.current = base;

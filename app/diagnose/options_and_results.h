@@ -176,11 +176,23 @@ struct RoundCost {
   double wall_s = 0.0;
 };
 
+/// Where the angle grows over the trials (issue 35: creep against fatigue): the growth from trial 2 to
+/// the last of the mean residual measured - model at the top holds and at rest (Signature in
+/// app/diagnose/detail.h). A creep that recovers slower than the rests grows both; a permanent
+/// softening grows the top and barely the rest. `trials` 0: not computed (fewer than three trials,
+/// or no rest or top steps).
+struct GrowthSplit {
+  int trials = 0;  ///< trials after the first it is taken over
+  double top_deg = 0.0, rest_deg = 0.0;
+};
+
 struct DiagnosisResult {
   double baseline_nrmse = 0.0;
   std::vector<double> baseline_nrmse_per_trial;
   std::vector<double> baseline_rmse_deg_per_trial;
   double noise_floor_nrmse = 0.0;
+  GrowthSplit baseline_growth;              ///< of the baseline's residual
+  GrowthSplit final_growth;                 ///< of the final model's residual
   std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
   std::vector<std::string> selected;
   std::string missing_effect;               ///< "" = none significant
