@@ -48,59 +48,73 @@ std::vector<double> interpolation_nodes(ParameterInterpolation how, const Candid
   return v;
 }
 
-Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
-                      int budget, const std::vector<double>* start) {
-  const std::size_t k = c.params.size();
-  Calibration best;
-  // Largest finite RSS seen (deg^2), for the failure score; starts at 1e6 deg^2 (tens of degrees
-  // RMS over a recording) so that a failure before any large RSS never scores like a good fit.
-  double worst = 1e6;
-  // Optimisers re-evaluate points (BOBYQA starts at the point the grid already scored): each costs a
-  // model run (a full FEM run for --fem-calibrate), so repeats are answered from memory.
-  std::map<std::vector<double>, double> seen;
-  std::vector<double> best_x;  // calibration coordinates of best.values
-  std::function<double(const std::vector<double>&)> eval_new;
-  auto eval = [&](const std::vector<double>& x) {
-    const auto hit = seen.find(x);
-    if (hit != seen.end()) return hit->second;
-    const double f = eval_new(x);
-    seen.emplace(x, f);
+namespace {
+
+/// The objective calibrate() minimises, on the [0, 1] calibration coordinates of a candidate's
+/// constants: log(RSS), a failed run (an exception, or a non-finite RSS) scored one decade above the
+/// largest finite RSS seen; each point is run once (optimisers re-evaluate points: BOBYQA starts at
+/// the point the grid already scored, and each run costs a model run, a full FEM run for
+/// --fem-calibrate), and every run is traced into `best`, which keeps the best point.
+class CalibrationObjective {
+ public:
+  CalibrationObjective(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss, Calibration& best)
+      : c_(c), rss_(rss), best_(best) {}
+
+  double operator()(const std::vector<double>& x) {
+    const auto hit = seen_.find(x);
+    if (hit != seen_.end()) return hit->second;
+    const double f = run(x);
+    seen_.emplace(x, f);
     return f;
-  };
-  eval_new = [&](const std::vector<double>& x) {
+  }
+
+  /// Calibration coordinates of best.values.
+  const std::vector<double>& best_x() const { return best_x_; }
+
+ private:
+  double run(const std::vector<double>& x) {
+    const std::size_t k = c_.params.size();
     std::vector<double> v(k);
-    for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c.params[i], x[i]);
+    for (std::size_t i = 0; i < k; ++i) v[i] = unscale(c_.params[i], x[i]);
     double r = std::numeric_limits<double>::infinity();
-    ++best.evaluations;
+    ++best_.evaluations;
     std::string err;
     try {
-      r = rss(v);
+      r = rss_(v);
     } catch (const std::exception& e) {
       err = e.what();
-      if (best.error.empty()) best.error = err;
+      if (best_.error.empty()) best_.error = err;
     }
-    best.trace.push_back({v, r, err});
-    if (r < best.rss) {
-      best.rss = r;
-      best.values = v;
-      best_x = x;
+    best_.trace.push_back({v, r, err});
+    if (r < best_.rss) {
+      best_.rss = r;
+      best_.values = v;
+      best_x_ = x;
     }
     if (std::isfinite(r)) {
-      worst = std::max(worst, r);
+      worst_ = std::max(worst_, r);
       return std::log(std::max(r, 1e-300));
     }
-    return std::log(std::max(worst, 1e-300)) + std::log(10.0);
-  };
-  if (k == 0) {
-    eval({});
-    return best;
+    return std::log(std::max(worst_, 1e-300)) + std::log(10.0);
   }
-  // Coarse grid (and the catalog's initial point).
+
+  const CandidateEffect& c_;
+  const std::function<double(const std::vector<double>&)>& rss_;
+  Calibration& best_;
+  // Largest finite RSS seen (deg^2), for the failure score; starts at 1e6 deg^2 (tens of degrees
+  // RMS over a recording) so that a failure before any large RSS never scores like a good fit.
+  double worst_ = 1e6;
+  std::map<std::vector<double>, double> seen_;
+  std::vector<double> best_x_;
+};
+
+/// The start of the local search: the catalog's initial point (or `start`) and, without a start, a
+/// grid of `per` points per constant (cell centres); the calibration coordinates of the best point.
+std::vector<double> grid_start(const CandidateEffect& c, CalibrationObjective& eval, const std::vector<double>* start, int per) {
+  const std::size_t k = c.params.size();
   std::vector<double> x0(k);
   for (std::size_t i = 0; i < k; ++i) x0[i] = scale(c.params[i], start ? (*start)[i] : c.params[i].initial);
   double fbest = eval(x0);
-  // From a given start (refinement): a local search only, in a cell of +-1/per around it.
-  const int per = start ? 6 : (k == 1 ? 5 : 3);
   std::vector<int> idx(k, 0);
   std::vector<double> xbest = x0;
   while (!start) {
@@ -112,26 +126,32 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
     while (i < k && ++idx[i] == per) idx[i++] = 0;
     if (i == k) break;
   }
-  const int left = std::max(4, budget - best.evaluations);
-  if (k == 1) {
-    // Golden section on the grid cell around the best point (+- one cell).
-    double a = std::max(0.0, xbest[0] - 1.0 / per), b = std::min(1.0, xbest[0] + 1.0 / per);
-    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-    double c1 = b - r * (b - a), c2 = a + r * (b - a);
-    double f1 = eval({c1}), f2 = eval({c2});
-    for (int it = 2; it < left && b - a > 1e-4; ++it) {
-      if (f1 < f2) {
-        b = c2, c2 = c1, f2 = f1;
-        c1 = b - r * (b - a);
-        f1 = eval({c1});
-      } else {
-        a = c1, c1 = c2, f1 = f2;
-        c2 = a + r * (b - a);
-        f2 = eval({c2});
-      }
+  return xbest;
+}
+
+/// One constant: golden section on the grid cell around `xbest` (+- one cell), `left` runs at most.
+void golden_section(CalibrationObjective& eval, double xbest, int per, int left) {
+  double a = std::max(0.0, xbest - 1.0 / per), b = std::min(1.0, xbest + 1.0 / per);
+  const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c1 = b - r * (b - a), c2 = a + r * (b - a);
+  double f1 = eval({c1}), f2 = eval({c2});
+  for (int it = 2; it < left && b - a > 1e-4; ++it) {
+    if (f1 < f2) {
+      b = c2, c2 = c1, f2 = f1;
+      c1 = b - r * (b - a);
+      f1 = eval({c1});
+    } else {
+      a = c1, c1 = c2, f1 = f2;
+      c2 = a + r * (b - a);
+      f2 = eval({c2});
     }
-    return best;
   }
+}
+
+/// Several constants: BOBYQA from `xbest` (first trust region half a grid cell), restarted from the
+/// best point while a restart still gains, until `budget` runs in all (best.evaluations) are spent.
+void bobyqa_with_restarts(CalibrationObjective& eval, Calibration& best, std::vector<double> xbest, int per, int left, int budget) {
+  const std::size_t k = xbest.size();
   constexpr double kLogRssTol = 1e-4;
   nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(k));
   opt.set_lower_bounds(std::vector<double>(k, 0.0));
@@ -143,7 +163,7 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
   auto fn = [](const std::vector<double>& x, std::vector<double>&, void* data) {
     return (*static_cast<std::function<double(const std::vector<double>&)>*>(data))(x);
   };
-  std::function<double(const std::vector<double>&)> f = eval;
+  std::function<double(const std::vector<double>&)> f = [&eval](const std::vector<double>& x) { return eval(x); };
   opt.set_min_objective(fn, &f);
   // Restarts. BOBYQA stops when one step gains less than ftol, which also happens early in a walk
   // down a narrow valley, while its trust region is still small. Measured on the hidden
@@ -153,21 +173,42 @@ Calibration calibrate(const CandidateEffect& c, const std::function<double(const
   // walking on. So a stop is trusted only when a fresh start from the best point (a new quadratic
   // model, the first trust region again; its repeated points come from memory) gains no more than
   // ftol either, or the budget is spent.
-  std::vector<double> x = xbest;
+  std::vector<double> x = std::move(xbest);
   for (double before = std::numeric_limits<double>::infinity(); best.evaluations < budget;) {
     opt.set_maxeval(std::max(1, budget - best.evaluations));
     double fx = 0.0;
     try {
       opt.optimize(x, fx);
     } catch (const std::exception&) {
-      // roundoff / forced stop: the best point seen is kept by eval()
+      // roundoff / forced stop: the best point seen is kept by the objective
     }
     if (!std::isfinite(best.rss)) break;
     const double now = std::log(std::max(best.rss, 1e-300));
     if (!(before - now > kLogRssTol)) break;
     before = now;
-    x = best_x;
+    x = eval.best_x();
   }
+}
+
+}  // namespace
+
+Calibration calibrate(const CandidateEffect& c, const std::function<double(const std::vector<double>&)>& rss,
+                      int budget, const std::vector<double>* start) {
+  const std::size_t k = c.params.size();
+  Calibration best;
+  CalibrationObjective eval(c, rss, best);
+  if (k == 0) {
+    eval({});
+    return best;
+  }
+  // From a given start (refinement): a local search only, in a cell of +-1/per around it.
+  const int per = start ? 6 : (k == 1 ? 5 : 3);
+  const std::vector<double> xbest = grid_start(c, eval, start, per);
+  const int left = std::max(4, budget - best.evaluations);
+  if (k == 1)
+    golden_section(eval, xbest[0], per, left);
+  else
+    bobyqa_with_restarts(eval, best, xbest, per, left, budget);
   return best;
 }
 
@@ -252,6 +293,89 @@ TradeOff trade_off(const CandidateEffect& c, const std::function<double(const st
   return out;
 }
 
+namespace {
+
+/// The Hessian of the RSS from its stencil's values (joint_intervals' stencil order: the centre, then
+/// +h and -h along each constant, then +h along each pair).
+Eigen::MatrixXd hessian_from_stencil(const std::vector<double>& f, int k, double h) {
+  const double fc = f[0];
+  Eigen::MatrixXd H(k, k);
+  for (int i = 0; i < k; ++i) H(i, i) = (f[1 + 2 * i] - 2.0 * fc + f[2 + 2 * i]) / (h * h);
+  std::size_t o = 1 + 2 * static_cast<std::size_t>(k);
+  for (int i = 0; i < k; ++i)
+    for (int j = i + 1; j < k; ++j) H(i, j) = H(j, i) = (f[o++] - f[1 + 2 * i] - f[1 + 2 * j] + fc) / (h * h);
+  return H;
+}
+
+/// One end of a joint interval: where the profile path of a constant, walked one way from the best
+/// point, meets the RSS contour.
+struct ProfileEnd {
+  Eigen::VectorXd dir;  // profile path direction (component i = +1 or -1)
+  double t = 0.0;       // distance along it (the change of constant i, calibration scale)
+  double t_max = 0.0;   // the box
+};
+
+/// The quadratic model's ends, two per constant (lower, upper): the profile paths of H^-1 (flat
+/// directions floored at a curvature of dRSS / 2, as joint_intervals says), cut at the box.
+std::vector<ProfileEnd> quadratic_ends(const Eigen::MatrixXd& H, const Eigen::VectorXd& x0, double drss) {
+  const int k = static_cast<int>(x0.size());
+  // Flat directions: curvature below 2 dRSS / 4 (the RSS would rise by less than dRSS across two
+  // calibration ranges), negative ones included.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  const Eigen::VectorXd lam = eig.eigenvalues().cwiseMax(0.5 * drss);
+  const Eigen::MatrixXd Hinv = eig.eigenvectors() * lam.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  std::vector<ProfileEnd> ends;
+  for (int i = 0; i < k; ++i)
+    for (const double sign : {-1.0, 1.0}) {
+      ProfileEnd e;
+      e.dir = sign * Hinv.col(i) / Hinv(i, i);
+      e.t_max = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < k; ++j) {
+        if (e.dir[j] > 1e-12) e.t_max = std::min(e.t_max, (1.0 - x0[j]) / e.dir[j]);
+        if (e.dir[j] < -1e-12) e.t_max = std::min(e.t_max, -x0[j] / e.dir[j]);
+      }
+      e.t = std::min(std::sqrt(2.0 * drss * Hinv(i, i)), e.t_max);
+      ends.push_back(e);
+    }
+  return ends;
+}
+
+/// Checks the ends on the real RSS and corrects them: `measure(due)` evaluates the ends flagged in
+/// `due` and writes their rises ((RSS - best) / dRSS) into `rise`. Up to three corrections where an
+/// end's rise is outside [0.5, 2]: the rise is taken as a power of t along the path, t^2 at first
+/// (the quadratic model) and then the power the last two measurements show (a secant in log-log,
+/// exact for one power; the power within [1, 8], each step at most 4x out or in). An end that did
+/// not rise at all goes 4x out, to the box at most.
+template <class Measure>
+void correct_ends(std::vector<ProfileEnd>& ends, std::vector<double>& rise, const Measure& measure) {
+  std::vector<char> due(ends.size(), 1);  // ends to (re-)measure
+  measure(due);
+  std::vector<double> t_prev(ends.size(), 0.0), r_prev(ends.size(), 0.0);
+  for (int pass = 0; pass < 3; ++pass) {
+    bool moved = false;
+    for (std::size_t n = 0; n < ends.size(); ++n) {
+      ProfileEnd& e = ends[n];
+      if (e.t <= 0.0 || (rise[n] >= 0.5 && rise[n] <= 2.0)) continue;
+      if (rise[n] < 1.0 && e.t >= e.t_max) continue;  // the contour lies beyond the bound
+      double factor = 4.0;
+      if (rise[n] > 0.0) {
+        double power = 2.0;
+        if (t_prev[n] > 0.0 && r_prev[n] > 0.0 && t_prev[n] != e.t)
+          power = std::clamp(std::log(rise[n] / r_prev[n]) / std::log(e.t / t_prev[n]), 1.0, 8.0);
+        factor = std::clamp(std::pow(1.0 / rise[n], 1.0 / power), 0.25, 4.0);
+      }
+      t_prev[n] = e.t, r_prev[n] = rise[n];
+      e.t = std::min(e.t * factor, e.t_max);
+      due[n] = 1;
+      moved = true;
+    }
+    if (!moved) break;
+    measure(due);
+  }
+}
+
+}  // namespace
+
 JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
                                const std::function<std::vector<double>(const std::vector<std::vector<double>>&)>& rss_batch,
                                const std::vector<double>& values, double rss_tol) {
@@ -291,41 +415,14 @@ JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
   const std::vector<double> f = evaluate(stencil);
   const double fc = f[0], f0 = centred ? fc : f.back();
   if (!std::isfinite(f0) || !std::isfinite(fc)) return out;
-  Eigen::MatrixXd H(k, k);
-  for (int i = 0; i < k; ++i) H(i, i) = (f[1 + 2 * i] - 2.0 * fc + f[2 + 2 * i]) / (h * h);
-  std::size_t o = 1 + 2 * static_cast<std::size_t>(k);
-  for (int i = 0; i < k; ++i)
-    for (int j = i + 1; j < k; ++j) H(i, j) = H(j, i) = (f[o++] - f[1 + 2 * i] - f[1 + 2 * j] + fc) / (h * h);
+  const Eigen::MatrixXd H = hessian_from_stencil(f, k, h);
   if (!H.allFinite()) return out;
   out.rss_best = f0;
   const double drss = rss_tol * f0;
-  // Flat directions: curvature below 2 dRSS / 4 (the RSS would rise by less than dRSS across two
-  // calibration ranges), negative ones included.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
-  const Eigen::VectorXd lam = eig.eigenvalues().cwiseMax(0.5 * drss);
-  const Eigen::MatrixXd Hinv = eig.eigenvectors() * lam.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
   // Per constant and side: the quadratic model's end, then the check on the real RSS.
-  struct End {
-    Eigen::VectorXd dir;  // profile path direction (component i = +1 or -1)
-    double t = 0.0;       // distance along it (the change of constant i, calibration scale)
-    double t_max = 0.0;   // the box
-  };
-  std::vector<End> ends;
-  for (int i = 0; i < k; ++i)
-    for (const double sign : {-1.0, 1.0}) {
-      End e;
-      e.dir = sign * Hinv.col(i) / Hinv(i, i);
-      e.t_max = std::numeric_limits<double>::infinity();
-      for (int j = 0; j < k; ++j) {
-        if (e.dir[j] > 1e-12) e.t_max = std::min(e.t_max, (1.0 - x0[j]) / e.dir[j]);
-        if (e.dir[j] < -1e-12) e.t_max = std::min(e.t_max, -x0[j] / e.dir[j]);
-      }
-      e.t = std::min(std::sqrt(2.0 * drss * Hinv(i, i)), e.t_max);
-      ends.push_back(e);
-    }
+  std::vector<ProfileEnd> ends = quadratic_ends(H, x0, drss);
   std::vector<double> rise(ends.size(), 0.0);
-  std::vector<char> due(ends.size(), 1);  // ends to (re-)measure
-  auto measure = [&] {
+  correct_ends(ends, rise, [&](std::vector<char>& due) {
     std::vector<Eigen::VectorXd> xs;
     std::vector<std::size_t> which;
     for (std::size_t n = 0; n < ends.size(); ++n)
@@ -333,39 +430,12 @@ JointIntervals joint_intervals(const std::vector<CandidateParameter>& params,
     const std::vector<double> fe = evaluate(xs);
     for (std::size_t m = 0; m < which.size(); ++m) rise[which[m]] = (fe[m] - f0) / drss;
     std::fill(due.begin(), due.end(), 0);
-  };
-  measure();
-  // Up to three corrections on the real RSS, where an end's rise is outside [0.5, 2]: the rise is
-  // taken as a power of t along the path, t^2 at first (the quadratic model) and then the power the
-  // last two measurements show (a secant in log-log, exact for one power; the power within [1, 8],
-  // each step at most 4x out or in). An end that did not rise at all goes 4x out, to the box at most.
-  std::vector<double> t_prev(ends.size(), 0.0), r_prev(ends.size(), 0.0);
-  for (int pass = 0; pass < 3; ++pass) {
-    bool moved = false;
-    for (std::size_t n = 0; n < ends.size(); ++n) {
-      End& e = ends[n];
-      if (e.t <= 0.0 || (rise[n] >= 0.5 && rise[n] <= 2.0)) continue;
-      if (rise[n] < 1.0 && e.t >= e.t_max) continue;  // the contour lies beyond the bound
-      double factor = 4.0;
-      if (rise[n] > 0.0) {
-        double power = 2.0;
-        if (t_prev[n] > 0.0 && r_prev[n] > 0.0 && t_prev[n] != e.t)
-          power = std::clamp(std::log(rise[n] / r_prev[n]) / std::log(e.t / t_prev[n]), 1.0, 8.0);
-        factor = std::clamp(std::pow(1.0 / rise[n], 1.0 / power), 0.25, 4.0);
-      }
-      t_prev[n] = e.t, r_prev[n] = rise[n];
-      e.t = std::min(e.t * factor, e.t_max);
-      due[n] = 1;
-      moved = true;
-    }
-    if (!moved) break;
-    measure();
-  }
+  });
   out.c.resize(k);
   for (int i = 0; i < k; ++i) {
     JointInterval& ci = out.c[i];
-    const End& lo = ends[2 * i];
-    const End& hi = ends[2 * i + 1];
+    const ProfileEnd& lo = ends[2 * i];
+    const ProfileEnd& hi = ends[2 * i + 1];
     ci.lo = unscale(params[i], x0[i] - lo.t);
     ci.hi = unscale(params[i], x0[i] + hi.t);
     const bool lo_at_bound = lo.t >= lo.t_max && rise[2 * i] < 1.0;

@@ -722,6 +722,8 @@ void select(Selection& s, int round, std::size_t pick, const CandidateResult& be
   // from trial 1 to the last trial (rms 0.48 -> 1.40 deg)", the baseline's, where the creep and lag
   // selected left 0.13, 0.07, 0.10, 0.09, 0.08, 0.11 deg, no growth).
   s.sig = signature_of(s.current);
+  if (s.opt.progress && s.sig.growth_trials >= 2)
+    std::fprintf(stderr, "diagnose: after round %d, %s\n", round, growth_split_text(s.sig).c_str());
   s.out.after_round.push_back(model_after_round(s.out.selected, s.selected_sets, s.current));
 }
 
@@ -1023,10 +1025,9 @@ bool selection_round(Selection& s, int round, std::chrono::steady_clock::time_po
   return true;
 }
 
-}  // namespace
-
-DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in) {
-  const auto t0 = std::chrono::steady_clock::now();
+/// The options of a run, checked (--out, --max-effects) and with the calibration mesh resolved
+/// (resolve_calibration_h; its note goes to stderr), before anything is read or fitted.
+DiagnoseOptions checked_options(const Scene& scene, const DiagnoseOptions& opt_in) {
   DiagnoseOptions opt = opt_in;
   if (opt.out_dir.empty()) throw InputError("diagnose: --out DIR is required");
   check_output_dir(opt.out_dir, "--out");  // before anything is read or fitted: a bad --out fails now
@@ -1036,6 +1037,108 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
     for (const std::string& n : notes) std::fprintf(stderr, "note: %s\n", n.c_str());
   }
   if (opt.max_effects < 1) throw InputError("diagnose: --max-effects must be >= 1");
+  return opt;
+}
+
+/// The reduced model of the recording (PathModelEvaluator: the elastic path of `cal_scene`, swept on
+/// the scene's own mesh when calibrating on another). Minutes of elastic FEM and no round yet: when it
+/// fails for a reason other than the input, diagnosis.json says that it failed, where and why.
+std::unique_ptr<const PathModelEvaluator> trace_elastic_path(const Scene& scene, const Scene& cal_scene, const Recording& rec,
+                                                             const std::vector<ComparedFrame>& frames, const DiagnoseOptions& opt) {
+  try {
+    return std::make_unique<const PathModelEvaluator>(cal_scene, rec, frames, opt.rom_points,
+                                                      opt.calibration_h_mm > 0.0 ? &scene : nullptr, opt.cache_dir);
+  } catch (const InputError&) {
+    throw;  // bad input (an unusable --cache, a scene the FEM refuses): nothing is written
+  } catch (const std::exception& e) {
+    json::Object root;
+    root.add_str("version", version_string()).add_str("command", opt.command_line).add_str("data", opt.data_path);
+    root.add_str("status", std::string("failed: ") + e.what());
+    root.add_str("failed_in", "tracing the elastic path, before the baseline and any round");
+    root.add("candidates", "[]").add("selected", "[]");
+    try {
+      write_file_atomic((std::filesystem::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
+    } catch (const std::exception&) {
+      // the original error matters more than this one
+    }
+    throw;
+  }
+}
+
+/// The final model of the rounds done so far into `out`: its errors, the static remainder, the
+/// constants and the equivalent models.
+void close_rounds(const Selection& s, const DiagnoseOptions& opt, DiagnosisResult& out) {
+  out.final_nrmse = s.current.nrmse;
+  out.final_nrmse_per_trial.clear();
+  out.final_rmse_deg_per_trial.clear();
+  for (const TrialComparison& t : s.current.trials) {
+    out.final_nrmse_per_trial.push_back(t.nrmse);
+    out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
+  }
+  describe_static_remainder(s.current, s.current_static, opt, out);
+  out.final_growth = {s.sig.growth_trials, s.sig.top_growth_deg, s.sig.rest_growth_deg};  // s.sig: of s.current
+  out.final_parameters = 0;
+  out.final_constants.clear();
+  for (const auto& [e, v] : s.chosen) {
+    out.final_parameters += static_cast<int>(v.size());
+    out.final_constants.push_back(v);
+  }
+  out.equivalent_models = equivalent_models(out);
+}
+
+/// fitted.toml: the scene with the selected effects, under a header that says what it is (and, for a
+/// failed diagnosis, that it failed).
+std::string fitted_toml_text(const Scene& fitted, const DiagnosisResult& out, const DiagnoseOptions& opt) {
+  const std::string head = out.failure.empty() ? "# pneufem diagnose: the input scene plus the selected effects ("
+                                               : "# pneufem diagnose FAILED (" + out.failure +
+                                                     "); the input scene plus the effects selected before it failed (";
+  return head + (out.selected.empty() ? std::string("none") : join(out.selected, " + ")) + ") with calibrated constants.\n" +
+         "# Data: " + opt.data_path + "\n" + fitted.to_toml();
+}
+
+/// The baseline and the rounds of forward selection (selection_round) on `s`. `have_baseline` is set
+/// as soon as the baseline is recorded (a failure after it keeps it: write_what_was_done).
+void run_rounds(Selection& s, const DiagnoseOptions& opt, std::chrono::steady_clock::time_point t0, bool& have_baseline) {
+  const Comparison base = s.metrics(s.cal_scene);
+  ++s.rom_runs;
+  record_baseline(base, opt, s.out);
+  have_baseline = true;
+  s.sig = signature_of(base);
+  s.out.baseline_growth = {s.sig.growth_trials, s.sig.top_growth_deg, s.sig.rest_growth_deg};
+  if (opt.progress && s.sig.growth_trials >= 2)
+    std::fprintf(stderr, "diagnose: baseline, %s\n", growth_split_text(s.sig).c_str());
+  s.current = base;
+  s.current_rss = base.rss_deg2;
+  s.current_static = fit_static_discrepancy(base.frames);
+  for (int round = 1; round <= opt.max_effects; ++round) {
+    const bool more = selection_round(s, round, t0);
+    if (round == opt.fail_after_round)
+      throw std::runtime_error("diagnose: injected failure after round " + std::to_string(round) + " (fail_after_round)");
+    if (!more) break;
+  }
+}
+
+/// A late failure (hours into the fitting) keeps what was done: the rounds so far, the history and a
+/// diagnosis.json whose status says it failed and why (the caller then throws the error on).
+void write_what_was_done(const Scene& scene, const Recording& rec, const PathModelEvaluator& rom, const Selection& s,
+                         const DiagnoseOptions& opt, bool rounds_closed, bool have_baseline, DiagnosisResult& out) {
+  try {
+    if (!rounds_closed && have_baseline) close_rounds(s, opt, out);
+    const Scene fitted = scene.with(s.selected_sets);
+    out.fitted_toml = fitted_toml_text(fitted, out, opt);
+    write_diagnosis(scene, fitted, rec, rom, s.chosen, opt, out);
+    std::fprintf(stderr, "diagnose: failed with %d effect(s) selected; what was done is in %s (diagnosis.json: \"status\": \"failed\")\n",
+                 static_cast<int>(out.after_round.size()), opt.out_dir.c_str());
+  } catch (const std::exception& w) {
+    std::fprintf(stderr, "diagnose: failed, and writing what was done failed too: %s\n", w.what());
+  }
+}
+
+}  // namespace
+
+DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const DiagnoseOptions opt = checked_options(scene, opt_in);
   std::vector<const CandidateEffect*> cands = candidates_to_try(opt);
   std::unique_ptr<tbb::global_control> gc;
   if (opt.threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
@@ -1052,103 +1155,35 @@ DiagnosisResult run_diagnosis(const Scene& scene, const DiagnoseOptions& opt_in)
   if (opt.progress)
     std::fprintf(stderr, "diagnose: tracing the elastic path%s ...\n",
                  opt.calibration_h_mm > 0.0 ? " (calibration mesh) and sweeping the scene's mesh" : "");
-  std::unique_ptr<const PathModelEvaluator> rom_made;
-  try {
-    rom_made = std::make_unique<const PathModelEvaluator>(cal_scene, rec, frames, opt.rom_points,
-                                                          opt.calibration_h_mm > 0.0 ? &scene : nullptr, opt.cache_dir);
-  } catch (const InputError&) {
-    throw;  // bad input (an unusable --cache, a scene the FEM refuses): nothing is written
-  } catch (const std::exception& e) {
-    // Minutes of elastic FEM and no round yet: diagnosis.json says that it failed, where and why.
-    json::Object root;
-    root.add_str("version", version_string()).add_str("command", opt.command_line).add_str("data", opt.data_path);
-    root.add_str("status", std::string("failed: ") + e.what());
-    root.add_str("failed_in", "tracing the elastic path, before the baseline and any round");
-    root.add("candidates", "[]").add("selected", "[]");
-    try {
-      write_file_atomic((std::filesystem::path(opt.out_dir) / "diagnosis.json").string(), root.str() + "\n");
-    } catch (const std::exception&) {
-      // the original error matters more than this one
-    }
-    throw;
-  }
+  const std::unique_ptr<const PathModelEvaluator> rom_made = trace_elastic_path(scene, cal_scene, rec, frames, opt);
   const PathModelEvaluator& rom = *rom_made;
   if (opt.progress) print_elastic_path(rom, t0);
 
   DiagnosisResult out;
   out.elastic_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Selection s(cal_scene, rec, frames, segment, rom, opt, std::move(cands), out);
-  // The final model of the rounds done so far, and the scene with their effects.
-  auto close_rounds = [&] {
-    out.final_nrmse = s.current.nrmse;
-    out.final_nrmse_per_trial.clear();
-    out.final_rmse_deg_per_trial.clear();
-    for (const TrialComparison& t : s.current.trials) {
-      out.final_nrmse_per_trial.push_back(t.nrmse);
-      out.final_rmse_deg_per_trial.push_back(t.rmse_deg);
-    }
-    describe_static_remainder(s.current, s.current_static, opt, out);
-    out.final_parameters = 0;
-    out.final_constants.clear();
-    for (const auto& [e, v] : s.chosen) {
-      out.final_parameters += static_cast<int>(v.size());
-      out.final_constants.push_back(v);
-    }
-    out.equivalent_models = equivalent_models(out);
-  };
-  auto fitted_toml = [&](const Scene& fitted) {
-    const std::string head = out.failure.empty() ? "# pneufem diagnose: the input scene plus the selected effects ("
-                                                 : "# pneufem diagnose FAILED (" + out.failure +
-                                                       "); the input scene plus the effects selected before it failed (";
-    return head + (out.selected.empty() ? std::string("none") : join(out.selected, " + ")) + ") with calibrated constants.\n" +
-           "# Data: " + opt.data_path + "\n" + fitted.to_toml();
-  };
   std::vector<Series> fitted_fem;  // the FEM traces of the refined constants, when a refinement ran them
   bool rounds_closed = false, have_baseline = false;
   try {
-    const Comparison base = s.metrics(cal_scene);
-    ++s.rom_runs;
-    record_baseline(base, opt, out);
-    have_baseline = true;
-    s.sig = signature_of(base);
-    s.current = base;
-    s.current_rss = base.rss_deg2;
-    s.current_static = fit_static_discrepancy(base.frames);
-    for (int round = 1; round <= opt.max_effects; ++round) {
-      const bool more = selection_round(s, round, t0);
-      if (round == opt.fail_after_round)
-        throw std::runtime_error("diagnose: injected failure after round " + std::to_string(round) + " (fail_after_round)");
-      if (!more) break;
-    }
-    close_rounds();
+    run_rounds(s, opt, t0, have_baseline);
+    close_rounds(s, opt, out);
     rounds_closed = true;
 
     refine_with_fem(scene, cal_scene, rec, frames, rom, opt, s.chosen, s.selected_sets, s.rom_runs, out, &fitted_fem);
     out.rom_runs = s.rom_runs;
 
     const Scene fitted = scene.with(s.selected_sets);
-    out.fitted_toml = fitted_toml(fitted);
+    out.fitted_toml = fitted_toml_text(fitted, out, opt);
 
     const bool fem_refined = opt.refine > 0 && opt.refine_model == DiagnoseOptions::RefineModel::Full;
     if (opt.verify || fem_refined || opt.fem_calibration_runs > 0) verify_with_fem(scene, fitted, rec, opt, out, &fitted_fem);
   } catch (const InputError&) {
     throw;  // the recording is not what the model can be fitted to (e.g. the other sign convention): the fix, nothing written
   } catch (const std::exception& e) {
-    // A late failure (hours into the fitting) keeps what was done: the rounds so far, the history
-    // and a diagnosis.json whose status says it failed and why; then the error goes on as before.
     out.failure = e.what();
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.rom_runs = s.rom_runs;
-    try {
-      if (!rounds_closed && have_baseline) close_rounds();
-      const Scene fitted = scene.with(s.selected_sets);
-      out.fitted_toml = fitted_toml(fitted);
-      write_diagnosis(scene, fitted, rec, rom, s.chosen, opt, out);
-      std::fprintf(stderr, "diagnose: failed with %d effect(s) selected; what was done is in %s (diagnosis.json: \"status\": \"failed\")\n",
-                   static_cast<int>(out.after_round.size()), opt.out_dir.c_str());
-    } catch (const std::exception& w) {
-      std::fprintf(stderr, "diagnose: failed, and writing what was done failed too: %s\n", w.what());
-    }
+    write_what_was_done(scene, rec, rom, s, opt, rounds_closed, have_baseline, out);
     throw;
   }
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

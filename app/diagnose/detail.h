@@ -22,8 +22,8 @@
 
 #include "analysis/measurements.h"
 #include "analysis/model_vs_measured.h"
-#include "app/diagnose/command.h"
 #include "app/diagnose/effect_catalog.h"
+#include "app/diagnose/options_and_results.h"
 #include "scenes/scene.h"
 
 namespace pneufem::diagnose_detail {
@@ -141,9 +141,22 @@ struct Signature {
   double early_deg = 0.0, late_deg = 0.0;  ///< mean residual in the first 0.5 s of steps / after the mark
   double rest_deg = 0.0;              ///< mean residual on steps at (near) zero pressure
   double proportional = 0.0;          ///< correlation of mark residual with the measured mark angle
+  /// Where the angle grows over the trials (issue 35: creep against fatigue): the growth from trial 2
+  /// to the last trial (least-squares slope of the per-trial mean x (trials - 2)) of the mean
+  /// residual measured - model over the top holds (the steps at the highest level, within 5 %) and
+  /// over the steps at rest (|level| < 5 % of it). Trial 1 is left out: its rest is the virgin state. A creep that
+  /// recovers slower than the rests grows the rest angle as much as the top one; a permanent
+  /// softening (fatigue) grows the top and barely the rest (tests/data/othermeans/components.py).
+  /// 0 with fewer than three trials having both.
+  double top_growth_deg = 0.0, rest_growth_deg = 0.0;
+  int growth_trials = 0;              ///< trials the two growths are taken over (0: not computed)
 };
 
 Signature signature_of(const Comparison& c);
+
+/// The growth split in words: "over the 5 trials after the first the residual (measured - model)
+/// grows by +0.43 deg at the top holds and +0.06 deg at rest"; "" when not computed.
+std::string growth_split_text(const Signature& s);
 
 /// The sentence about the residual feature that `effect` explains. Every word of direction in it
 /// (grows / falls / stays flat, more / less / as modelled, ...) is read off the numbers it quotes:

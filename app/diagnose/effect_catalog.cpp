@@ -176,6 +176,10 @@ std::array<double, 2> broad_tau_range(const EffectParameter& term, const std::ve
   return {term.lo / *hi_ratio, term.hi / *lo_ratio};
 }
 
+// Over 100 lines on purpose: the catalog as a table written in code, one block per candidate (its
+// name, family, constants with their ranges and starts, and the lambdas that turn them into scene
+// overrides), in the order the diagnosis tries them; split per candidate it would scatter the one
+// place a reader looks up what diagnose can name.
 std::vector<CandidateEffect> builtin_candidates() {
   std::vector<CandidateEffect> c;
   // stiffness, pressure_lag and gravity are not material effects: their ranges are declared here.

@@ -155,12 +155,8 @@ bool PathModelEvaluator::uses_fem_sweeps(const Scene& variant) const {
   return !has_history(bm->model) && bm->model.gravity_m_s2.norm() > 0.0;
 }
 
-std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& variant, bool kept_only) const {
-  const std::unique_ptr<BuiltModel> bm = build_model(variant);
-  const PressureLag lag = scene_pressure_lag(variant);  // first or second order (load.pressure_lag2_s)
-  const LoadHistory load = lag.on() ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
+std::vector<std::vector<double>> PathModelEvaluator::sample_times(bool kept_only) const {
   const std::size_t nt = rec_.trials.size();
-  // Engine times of the requested samples, per trial.
   std::vector<std::vector<double>> times(nt);
   if (kept_only) {
     for (const ComparedFrame& f : frames_) times[f.trial_index].push_back(f.t_s - offset_[f.trial_index]);
@@ -168,41 +164,49 @@ std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& varia
     for (std::size_t k = 0; k < nt; ++k)
       for (double t : rec_.trials[k].angle_deg.t_s) times[k].push_back(t - offset_[k]);
   }
+  return times;
+}
+
+std::vector<std::vector<double>> PathModelEvaluator::simulate_elastic(const Scene& variant, const BuiltModel& bm,
+                                                                      const LoadHistory& load,
+                                                                      const std::vector<std::vector<double>>& times) const {
+  // Elastic (stiffness, gravity, lag): the angle is a function of the chamber pressure alone:
+  // one sweep 0 -> max pressure, then a lookup per sample. Without gravity the reduced model
+  // gives the sweep (exact for the reference, ~1 % for a uniform stiffness change: see
+  // tests/engine/test_path_model.cpp); gravity loads a different deformation mode, which the
+  // 1-dof reduced model cannot represent, so then the sweep is the full static FEM (fewer
+  // points, quadratic interpolation; cached by scene without the lag).
+  // Curves span the reference peak, above the inlet's peak pressure, which a lagged chamber
+  // pressure never exceeds, so every lag shares one curve per scene (the cache key leaves the lag out).
+  const std::size_t nt = rec_.trials.size();
   std::vector<std::vector<double>> out(nt);
-  if (!has_history(bm->model)) {
-    // Elastic (stiffness, gravity, lag): the angle is a function of the chamber pressure alone:
-    // one sweep 0 -> max pressure, then a lookup per sample. Without gravity the reduced model
-    // gives the sweep (exact for the reference, ~1 % for a uniform stiffness change: see
-    // tests/engine/test_path_model.cpp); gravity loads a different deformation mode, which the
-    // 1-dof reduced model cannot represent, so then the sweep is the full static FEM (fewer
-    // points, quadratic interpolation; cached by scene without the lag).
-    // Curves span the reference peak, above the inlet's peak pressure, which a lagged chamber
-    // pressure never exceeds, so every lag shares one curve per scene (the cache key leaves the lag out).
-    const double hi = chamber(reference_peak_Pa_);
-    const bool fem = bm->model.gravity_m_s2.norm() > 0.0;
-    const int n = fem ? kFemCurvePoints : 120;
-    std::vector<double> th;
-    if (fem) {
-      th = elastic_curve(variant, bm.get(), hi, n);
-    } else {
-      PathLoad pl;
-      for (int i = 0; i <= n; ++i) {
-        pl.t_s.push_back(i * 0.1);
-        pl.p_Pa.push_back(hi * i / n);
-      }
-      th = path_->run(bm->model, pl);
+  const double hi = chamber(reference_peak_Pa_);
+  const bool fem = bm.model.gravity_m_s2.norm() > 0.0;
+  const int n = fem ? kFemCurvePoints : 120;
+  std::vector<double> th;
+  if (fem) {
+    th = elastic_curve(variant, &bm, hi, n);
+  } else {
+    PathLoad pl;
+    for (int i = 0; i <= n; ++i) {
+      pl.t_s.push_back(i * 0.1);
+      pl.p_Pa.push_back(hi * i / n);
     }
-    for (std::size_t k = 0; k < nt; ++k) {
-      const TrialLoad& tr = load.trials[k];
-      for (double t : times[k]) {
-        out[k].push_back(curve_at(th, hi, chamber(tr.pressure(std::clamp(t, 0.0, tr.duration())))));
-      }
-    }
-    return out;
+    th = path_->run(bm.model, pl);
   }
-  // History: one continuous replay of all trials (internal variables carry over).
+  for (std::size_t k = 0; k < nt; ++k) {
+    const TrialLoad& tr = load.trials[k];
+    for (double t : times[k]) {
+      out[k].push_back(curve_at(th, hi, chamber(tr.pressure(std::clamp(t, 0.0, tr.duration())))));
+    }
+  }
+  return out;
+}
+
+PathLoad PathModelEvaluator::continuous_replay(const LoadHistory& load, std::vector<double>& start) const {
+  const std::size_t nt = rec_.trials.size();
   PathLoad pl;
-  std::vector<double> start(nt);
+  start.assign(nt, 0.0);
   double g = 0.0;
   for (std::size_t k = 0; k < nt; ++k) {
     const TrialLoad& tr = load.trials[k];
@@ -225,39 +229,59 @@ std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& varia
     }
     g += rest;
   }
+  return pl;
+}
+
+std::vector<double> PathModelEvaluator::gravity_offset(const Scene& variant, const BuiltModel& bm, double hi) const {
+  // Gravity loads a deformation mode the 1-dof reduced model cannot carry: add the elastic
+  // FEM's gravity offset at the same pressure, theta_g(p) - theta_0(p) (exact for the elastic
+  // model; for history effects it neglects how their softening changes the sag, a second-order
+  // term). Static sweeps, cached: one per gravity vector, or, for a rig angle phi, one per node
+  // of the rig-angle interpolation (app/diagnose/elastic_curve.h), the offset being sum_j w_j(phi)
+  // offset(phi_j). Why interpolate: calibrating the rig angle on top of a history effect
+  // otherwise costs a static FEM sweep per evaluation (measured: 24 runs, 56 s of a 84 s
+  // diagnosis on the 5-chamber test actuator); five sweeps serve every angle, within ~1e-4 deg
+  // of the direct sweep (RigAngleInterpolation.MatchesDirectFemSweepsBetweenNodes).
+  const Scene el = elastic_reference_scene(variant);
+  const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
+  std::vector<double> off(c0.size(), 0.0);
+  const double rig_deg = variant.has("gravity.rig_angle_deg") ? variant.number("gravity.rig_angle_deg") : -1.0;
+  if (rig_deg >= 0.0) {
+    const auto w = rig_angle_weights(rig_deg * std::numbers::pi / 180.0);
+    for (int j = 0; j < kRigAngleNodes; ++j) {
+      const std::vector<double> cj =
+          elastic_curve(el.with({"gravity.rig_angle_deg=" + fmt("%.17g", rig_angle_node_rad(j) * 180.0 / std::numbers::pi)}),
+                        nullptr, hi, kFemCurvePoints);
+      for (std::size_t i = 0; i < off.size(); ++i) off[i] += w[j] * (cj[i] - c0[i]);
+    }
+  } else {
+    const Vec3 gv = bm.model.gravity_m_s2;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
+    const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
+    for (std::size_t i = 0; i < off.size(); ++i) off[i] = cg[i] - c0[i];
+  }
+  return off;
+}
+
+std::vector<std::vector<double>> PathModelEvaluator::simulate(const Scene& variant, bool kept_only) const {
+  const std::unique_ptr<BuiltModel> bm = build_model(variant);
+  const PressureLag lag = scene_pressure_lag(variant);  // first or second order (load.pressure_lag2_s)
+  const LoadHistory load = lag.on() ? apply_pressure_lag(inlet_, lag, 1e-4 * p_max_Pa_) : inlet_;
+  const std::vector<std::vector<double>> times = sample_times(kept_only);
+  if (!has_history(bm->model)) return simulate_elastic(variant, *bm, load, times);
+  // History: one continuous replay of all trials (internal variables carry over).
+  std::vector<double> start;
+  const PathLoad pl = continuous_replay(load, start);
   std::vector<double> th = path_->run(bm->model, pl);
   if (bm->model.gravity_m_s2.norm() > 0.0) {
-    // Gravity loads a deformation mode the 1-dof reduced model cannot carry: add the elastic
-    // FEM's gravity offset at the same pressure, theta_g(p) - theta_0(p) (exact for the elastic
-    // model; for history effects it neglects how their softening changes the sag, a second-order
-    // term). Static sweeps, cached: one per gravity vector, or, for a rig angle phi, one per node
-    // of the rig-angle interpolation (app/diagnose/elastic_curve.h), the offset being sum_j w_j(phi)
-    // offset(phi_j). Why interpolate: calibrating the rig angle on top of a history effect
-    // otherwise costs a static FEM sweep per evaluation (measured: 24 runs, 56 s of a 84 s
-    // diagnosis on the 5-chamber test actuator); five sweeps serve every angle, within ~1e-4 deg
-    // of the direct sweep (RigAngleInterpolation.MatchesDirectFemSweepsBetweenNodes).
-    const Scene el = elastic_reference_scene(variant);
     const double hi = chamber(reference_peak_Pa_);  // pl holds mapped pressures
-    const std::vector<double> c0 = elastic_curve(el, nullptr, hi, kFemCurvePoints);
-    std::vector<double> off(c0.size(), 0.0);
-    const double rig_deg = variant.has("gravity.rig_angle_deg") ? variant.number("gravity.rig_angle_deg") : -1.0;
-    if (rig_deg >= 0.0) {
-      const auto w = rig_angle_weights(rig_deg * std::numbers::pi / 180.0);
-      for (int j = 0; j < kRigAngleNodes; ++j) {
-        const std::vector<double> cj =
-            elastic_curve(el.with({"gravity.rig_angle_deg=" + fmt("%.17g", rig_angle_node_rad(j) * 180.0 / std::numbers::pi)}),
-                          nullptr, hi, kFemCurvePoints);
-        for (std::size_t i = 0; i < off.size(); ++i) off[i] += w[j] * (cj[i] - c0[i]);
-      }
-    } else {
-      const Vec3 gv = bm->model.gravity_m_s2;
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "gravity.g_m_s2=[%.17g, %.17g, %.17g]", gv.x(), gv.y(), gv.z());
-      const std::vector<double> cg = elastic_curve(el.with({buf}), nullptr, hi, kFemCurvePoints);
-      for (std::size_t i = 0; i < off.size(); ++i) off[i] = cg[i] - c0[i];
-    }
+    const std::vector<double> off = gravity_offset(variant, *bm, hi);
     for (std::size_t i = 0; i < th.size(); ++i) th[i] += curve_at(off, hi, pl.p_Pa[i]);
   }
+  // Each sample by linear interpolation in the replay's time.
+  const std::size_t nt = rec_.trials.size();
+  std::vector<std::vector<double>> out(nt);
   for (std::size_t k = 0; k < nt; ++k) {
     const TrialLoad& tr = load.trials[k];
     for (double t : times[k]) {

@@ -84,6 +84,16 @@ class PathModelEvaluator {
  private:
   /// Per trial, the model angle at the kept frames (kept_only) or at every angle sample.
   std::vector<std::vector<double>> simulate(const Scene& variant, bool kept_only) const;
+  /// simulate()'s parts. Engine times of the requested samples, per trial.
+  std::vector<std::vector<double>> sample_times(bool kept_only) const;
+  /// Without history: the angle as a function of the chamber pressure, one sweep then a lookup per sample.
+  std::vector<std::vector<double>> simulate_elastic(const Scene& variant, const BuiltModel& bm, const LoadHistory& load,
+                                                    const std::vector<std::vector<double>>& times) const;
+  /// With history: the chamber pressures of one continuous replay of every trial and the rests
+  /// between them; `start` gets each trial's start time in it.
+  PathLoad continuous_replay(const LoadHistory& load, std::vector<double>& start) const;
+  /// With gravity: the elastic FEM's gravity offset theta_g(p) - theta_0(p) at p = hi i / n.
+  std::vector<double> gravity_offset(const Scene& variant, const BuiltModel& bm, double hi) const;
 
   static constexpr int kFemCurvePoints = 16;
   /// Sweep points of the scene mesh for the pressure map (one static continuation of that mesh;

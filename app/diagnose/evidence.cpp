@@ -9,6 +9,44 @@
 
 namespace pneufem::diagnose_detail {
 
+namespace {
+
+/// Least-squares growth of y over its index range (slope x (n - 1)); 0 for fewer than two points.
+double growth_over(const std::vector<double>& y) {
+  const std::size_t n = y.size();
+  if (n < 2) return 0.0;
+  double mx = 0.5 * static_cast<double>(n - 1), my = 0.0;
+  for (double v : y) my += v / static_cast<double>(n);
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sxy += (static_cast<double>(i) - mx) * (y[i] - my), sxx += sq(static_cast<double>(i) - mx);
+  return sxy / sxx * static_cast<double>(n - 1);
+}
+
+/// Signature::top_growth_deg and rest_growth_deg of `c` (see there).
+constexpr double kTopHold = 0.95;  // a top hold: at the highest level (a commanded level, within 5 %)
+void add_growth_split(const Comparison& c, double lvl_max, Signature& s) {
+  std::vector<double> top, rest;
+  for (std::size_t k = 1; k < c.trials.size(); ++k) {
+    double t = 0.0, r = 0.0;
+    long nt = 0, nr = 0;
+    for (const StepComparison& st : c.trials[k].steps) {
+      if (!std::isfinite(st.mean_residual_deg) || st.frames <= 0) continue;
+      const double w = static_cast<double>(st.frames);
+      if (st.level_kPa >= kTopHold * lvl_max) t -= st.mean_residual_deg * w, nt += st.frames;
+      if (std::abs(st.level_kPa) < 0.05 * lvl_max) r -= st.mean_residual_deg * w, nr += st.frames;
+    }
+    if (nt == 0 || nr == 0) continue;
+    top.push_back(t / static_cast<double>(nt));
+    rest.push_back(r / static_cast<double>(nr));
+  }
+  if (top.size() < 2 || c.trials.size() < 3) return;
+  s.top_growth_deg = growth_over(top);
+  s.rest_growth_deg = growth_over(rest);
+  s.growth_trials = static_cast<int>(top.size());
+}
+
+}  // namespace
+
 Signature signature_of(const Comparison& c) {
   Signature s;
   double top = 0.0, low = 0.0;
@@ -62,6 +100,7 @@ Signature signature_of(const Comparison& c) {
   s.early_deg = ne ? e / ne : 0.0;
   s.late_deg = nl ? l / nl : 0.0;
   s.rest_deg = nrest ? rest / nrest : 0.0;
+  if (lvl_max > 0.0) add_growth_split(c, lvl_max, s);
   if (xs.size() > 2) {
     double mx = 0, my = 0;
     for (std::size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += ys[i];
@@ -197,10 +236,18 @@ std::string rest_sentence(const Signature& s) {
 
 }  // namespace
 
+std::string growth_split_text(const Signature& s) {
+  if (s.growth_trials < 2) return "";
+  return "over the " + std::to_string(s.growth_trials) + " trials after the first the residual (measured - model) grows by " +
+         fmt("%+.2f", s.top_growth_deg) + " deg at the top holds and " + fmt("%+.2f", s.rest_growth_deg) + " deg at rest";
+}
+
 std::string evidence(const std::string& effect, const Signature& s) {
-  if (effect == "fatigue" || effect == "fatigue_saturating") return growth_sentence(s) + ", and " + top_creep_sentence(s);
+  const std::string split = growth_split_text(s);
+  if (effect == "fatigue" || effect == "fatigue_saturating" || effect == "fatigue_uniform")
+    return growth_sentence(s) + ", and " + top_creep_sentence(s) + (split.empty() ? "" : "; " + split);
   if (effect == "viscoelastic" || effect == "viscoelastic_instantaneous" || effect == "viscoelastic_broad")
-    return hold_creep_sentence(s);
+    return hold_creep_sentence(s) + (split.empty() ? "" : "; " + split);
   if (effect == "mullins") return first_trial_sentence(s);
   if (effect == "stiffness") return proportional_sentence(s);
   if (effect == "pressure_lag") return step_lag_sentence(s);

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "app/compare/history.h"
+#include "app/diagnose/command.h"
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
 #include "core/atomic_file.h"
@@ -20,6 +21,14 @@ namespace fs = std::filesystem;
 namespace pneufem::diagnose_detail {
 
 namespace {
+
+/// A growth split (DiagnosisResult::baseline_growth, final_growth): the trials it is taken over and
+/// the growth (deg) of measured - model at the top holds and at rest.
+std::string growth_split_json(const GrowthSplit& g) {
+  json::Object o;
+  o.add("trials", g.trials).add("top_deg", g.top_deg).add("rest_deg", g.rest_deg);
+  return o.str(4);
+}
 
 /// diagnosis.json's "intervals": per round, each selected constant's value, interval and whether
 /// the recording identifies it.
@@ -162,6 +171,7 @@ std::string diagnosis_json(const Scene& scene, const PathModelEvaluator& rom, co
   b.add("nrmse", out.baseline_nrmse).add("nrmse_per_trial", json::array(out.baseline_nrmse_per_trial));
   b.add("rmse_deg_per_trial", json::array(out.baseline_rmse_deg_per_trial));
   if (out.verified_baseline_nrmse >= 0) b.add("nrmse_fem", out.verified_baseline_nrmse);
+  if (out.baseline_growth.trials > 0) b.add("growth_split", growth_split_json(out.baseline_growth));
   root.add("baseline", b.str(2));
   root.add("candidates", candidates_json(out.candidates));
   root.add("missing_effect", out.missing_effect.empty() ? "null" : json::quote(out.missing_effect));
@@ -184,6 +194,7 @@ std::string diagnosis_json(const Scene& scene, const PathModelEvaluator& rom, co
   root.add("final_nrmse_per_trial", json::array(out.final_nrmse_per_trial));
   root.add("final_rmse_deg_per_trial", json::array(out.final_rmse_deg_per_trial));
   if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
+  if (out.final_growth.trials > 0) root.add("final_growth_split", growth_split_json(out.final_growth));
   json::Object sr;
   sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
   root.add("static_remainder", sr.str(2));

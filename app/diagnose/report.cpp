@@ -8,6 +8,7 @@
 #include <string>
 
 #include "app/compare/history.h"
+#include "app/diagnose/command.h"
 #include "app/diagnose/detail.h"
 #include "app/diagnose/evaluator.h"
 #include "core/version.h"
@@ -199,6 +200,17 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
   for (const std::string& e : out.equivalents) s += "Equally good: " + e + ".\n\n";
   for (const EquivalentModel& m : out.equivalent_models) s += "Equivalent model: " + equivalent_model_text(m, out) + ".\n\n";
   if (!out.static_note.empty()) s += "What is left: " + out.static_note + ".\n\n";
+  if (out.baseline_growth.trials > 0) {
+    // Where the angle grows over the trials: a creep grows the top holds and the rests alike, a
+    // permanent softening (fatigue) the top holds only.
+    const auto split = [](const GrowthSplit& g) {
+      return fmt("%+.2f", g.top_deg) + " deg at the top holds, " + fmt("%+.2f", g.rest_deg) + " deg at rest";
+    };
+    s += "Growth over the " + std::to_string(out.baseline_growth.trials) +
+         " trials after the first (measured - model): baseline " + split(out.baseline_growth) +
+         (out.final_growth.trials > 0 && !out.selected.empty() ? "; final model " + split(out.final_growth) : std::string()) +
+         ". A creep that recovers slower than the rests grows both, a permanent softening (fatigue) the top holds.\n\n";
+  }
   if (!out.fem_error.empty()) s += "Refinement / full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"
        "- `diagnosis.json`: every number of this report (schema in the README).\n"

@@ -64,9 +64,6 @@ def runs(tests, why):
 
 
 _CLI = "registration only (the command's options to its Options struct); run through the executable by "
-_DIAG = ("app/diagnose is being reorganised (issue 34); its tests are in tests/app/diagnose/, named after "
-         "the diagnosis's steps, ")
-
 # Units tested under another name, with the test files that test them and why they are not mirrored.
 # Keep it short: where a test file tests exactly one unit, rename it to the mirrored name instead; a
 # new unit gets its mirrored test file, not an entry here.
@@ -87,18 +84,21 @@ MAPPED = {
     "app/simulate/command.cpp": by(["tests/app/simulate/test_console.cpp", "tests/app/simulate/test_reduced.cpp"],
                                    "run_simulation is tested by what it prints (test_console.cpp), by its "
                                    "reduced-model path (test_reduced.cpp) and through the executable (test_cli.cpp)"),
-    # app/diagnose: being reorganised in parallel (issue 34); its tests are named after the diagnosis's steps
-    "app/diagnose/detail.h": by(["tests/app/diagnose/test_calibrate.cpp", "tests/app/diagnose/test_evidence.cpp"],
-                                _DIAG + "the shared helpers through calibration and evidence"),
-    "app/diagnose/evaluator.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
-                                     _DIAG + "the evaluator through the outputs"),
-    "app/diagnose/fem.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
-                               _DIAG + "the FEM runs of a diagnosis through the outputs",
+    # app/diagnose: these need a whole diagnosis (minutes of FEM for the elastic path), which
+    # test_output.cpp runs once for the files written and the report (a suite fixture: two recordings)
+    "app/diagnose/evaluator.cpp": by(["tests/app/diagnose/test_output.cpp"],
+                                     "the reduced-model replay and its cache are tested through diagnoses: its "
+                                     "cache through test_output.cpp's second recording, its replays by every "
+                                     "diagnosis test (test_command.cpp); a test of its own would trace an elastic path"),
+    "app/diagnose/fem.cpp": by(["tests/app/diagnose/test_output.cpp"],
+                               "refine_with_fem and verify_with_fem run inside run_diagnosis; --fem-calibrate and "
+                               "--refine are tested by DiagnoseFem.* and DiagnoseRefinement.* of test_command.cpp "
+                               "(they share its hidden-dataset helpers and FEM cache), their absence here",
                                through="app/diagnose/evaluator.h"),
-    "app/diagnose/output.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
-                                  _DIAG + "the files written", through="app/diagnose/evaluator.h"),
-    "app/diagnose/report.cpp": by(["tests/app/diagnose/test_outputs.cpp"],
-                                  _DIAG + "the report through the outputs", through="app/diagnose/evaluator.h"),
+    "app/diagnose/report.cpp": by(["tests/app/diagnose/test_output.cpp"],
+                                  "report.md is one of the files written: its test shares test_output.cpp's "
+                                  "diagnoses (ReportHoldsThePerTrialTableOfDiagnosisJson)",
+                                  through="app/diagnose/evaluator.h"),
     # engine/
     "engine/quasi_static.cpp": by(["tests/engine/test_pneunet_solvers.cpp", "tests/engine/test_creep.cpp",
                                    "tests/engine/test_cycle_jump.cpp"],

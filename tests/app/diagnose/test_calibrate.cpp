@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "app/diagnose/command.h"
 #include "app/diagnose/detail.h"
 
 namespace pneufem::diagnose_detail {

@@ -108,5 +108,34 @@ TEST(Evidence, LagOffsetAndProportionalErrorFollowTheirNumbers) {
   EXPECT_TRUE(says(evidence("stiffness", s), "barely follows the angle")) << evidence("stiffness", s);
 }
 
+// Where the angle grows over the trials (Signature::top_growth_deg / rest_growth_deg): a comparison
+// made by hand, four trials of a 0-10-20-30 kPa staircase whose measured angle grows beyond the model
+// by 0.1 deg per trial at 30 kPa and 0.02 deg per trial at rest (mean residual model - measured). Trial
+// 1 is left out (its rest is the virgin state), so it may hold anything.
+TEST(Evidence, GrowthSplitSeparatesTheTopHoldsFromTheRests) {
+  Comparison c;
+  for (int k = 0; k < 4; ++k) {
+    TrialComparison t;
+    t.trial = k + 1;
+    for (double level : {0.0, 10.0, 20.0, 30.0}) {
+      StepComparison st;
+      st.level_kPa = level, st.frames = 90;
+      st.mean_residual_deg = level == 30.0 ? -0.1 * k : level == 0.0 ? -0.02 * k : 0.0;
+      if (k == 0) st.mean_residual_deg = 5.0;
+      t.steps.push_back(st);
+    }
+    c.trials.push_back(t);
+  }
+  const Signature s = signature_of(c);
+  EXPECT_EQ(s.growth_trials, 3);
+  EXPECT_NEAR(s.top_growth_deg, 0.2, 1e-12);   // trials 2 -> 4: two steps of 0.1
+  EXPECT_NEAR(s.rest_growth_deg, 0.04, 1e-12);
+  EXPECT_TRUE(says(evidence("fatigue_uniform", s), "grows by +0.20 deg at the top holds and +0.04 deg at rest"))
+      << evidence("fatigue_uniform", s);
+  c.trials.resize(2);  // one trial after the first: no growth to take
+  EXPECT_EQ(signature_of(c).growth_trials, 0);
+  EXPECT_FALSE(says(evidence("fatigue_uniform", signature_of(c)), "at rest"));
+}
+
 }  // namespace
 }  // namespace pneufem::diagnose_detail

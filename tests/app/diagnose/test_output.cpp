@@ -1,4 +1,5 @@
-// What `pneufem diagnose` leaves for a user who diagnoses a second recording of one protocol
+// The files `pneufem diagnose` writes (app/diagnose/output.cpp, and report.md of report.cpp, which
+// needs the same diagnosis): what it leaves for a user who diagnoses a second recording of one protocol
 // (issue 28, item 5): the cache of the first recording's elastic FEM work is reused, history.jsonl
 // carries the error per trial of every model, and report.md tells the diagnosis with the numbers of
 // diagnosis.json. One case for all of them (a suite fixture: the whole file is one ctest test):
