@@ -150,7 +150,7 @@ int run_diagnose_command(DiagnoseCommand& c, const std::string& command_line) {
               c.options.out_dir.c_str());
   if (c.options.cache_dir.empty() && r.elastic_wall_s > 20.0)
     std::printf("note: %.0f s of this run was elastic FEM work that depends only on the actuator and the peak pressure; "
-                "--cache DIR keeps it for re-runs (README, \"Re-runs\")\n",
+                "--cache DIR keeps it for re-runs (docs/commands.md, \"Re-runs\")\n",
                 r.elastic_wall_s);
   return 0;
 }
