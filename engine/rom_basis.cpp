@@ -114,14 +114,12 @@ std::vector<std::vector<int>> soft_clusters(const Model& model, const std::vecto
   return out;
 }
 
-/// Internal force of element e (3 npe) at u with its (elastic) material, the whole stress and its
-/// isochoric part.
-void element_force(const Model& model, const ElementGeometry& geom, int e, const Eigen::VectorXd& u, Eigen::VectorXd& f,
-                   Eigen::VectorXd& f_iso) {
+/// The deformation gradients of element e's quadrature points at u and its (elastic) material's
+/// response there.
+void element_points(const Model& model, const ElementGeometry& geom, int e, const Eigen::VectorXd& u, std::array<Mat3, 4>& F,
+                    std::array<PointResponse, 4>& resp) {
   const int npe = geom.npe, nqp = geom.nqp;
   const int* n = model.mesh.element(e);
-  std::array<Mat3, 4> F;
-  std::array<PointResponse, 4> resp;
   for (int q = 0; q < nqp; ++q) {
     const double* g = geom.grad(e, q);
     F[q] = Mat3::Identity();
@@ -129,6 +127,16 @@ void element_force(const Model& model, const ElementGeometry& geom, int e, const
   }
   model.material_of(e).evaluate(std::span<const Mat3>(F.data(), nqp), TimeStep{}, {}, {},
                                 std::span<PointResponse>(resp.data(), nqp), false);
+}
+
+/// Internal force of element e (3 npe) at u with its (elastic) material, the whole stress and its
+/// isochoric part.
+void element_force(const Model& model, const ElementGeometry& geom, int e, const Eigen::VectorXd& u, Eigen::VectorXd& f,
+                   Eigen::VectorXd& f_iso) {
+  const int npe = geom.npe, nqp = geom.nqp;
+  std::array<Mat3, 4> F;
+  std::array<PointResponse, 4> resp;
+  element_points(model, geom, e, u, F, resp);
   f = Eigen::VectorXd::Zero(3 * npe);
   f_iso = Eigen::VectorXd::Zero(3 * npe);
   for (int q = 0; q < nqp; ++q) {
@@ -140,6 +148,22 @@ void element_force(const Model& model, const ElementGeometry& geom, int e, const
       f.segment<3>(3 * a) += w * P * ga;
       f_iso.segment<3>(3 * a) += w * Pi * ga;
     }
+  }
+}
+
+/// The frozen isochoric stress's force of element e at the reference configuration:
+/// int B_0^T S_iso(u) dV, S_iso = F^-1 P_iso the isochoric second Piola-Kirchhoff stress at u.
+void element_frozen_force(const Model& model, const ElementGeometry& geom, int e, const Eigen::VectorXd& u, Eigen::VectorXd& f) {
+  const int npe = geom.npe, nqp = geom.nqp;
+  std::array<Mat3, 4> F;
+  std::array<PointResponse, 4> resp;
+  element_points(model, geom, e, u, F, resp);
+  f = Eigen::VectorXd::Zero(3 * npe);
+  for (int q = 0; q < nqp; ++q) {
+    const Mat3 S = F[q].inverse() * resp[q].P_iso;
+    const double* g = geom.grad(e, q);
+    const double w = geom.w(e, q);
+    for (int a = 0; a < npe; ++a) f.segment<3>(3 * a) += w * S * Eigen::Map<const Eigen::Vector3d>(g + 3 * a);
   }
 }
 
@@ -455,14 +479,36 @@ struct CandidateShapes {
   std::vector<int> sample;
 };
 
+/// For each group of elements: the response du = K^-1 f to the sum of its elements' forces `fel`
+/// (solver: K factorised, constraints applied), without its part along t (theta's), appended to
+/// `out` with `sample`.
+void add_group_responses(const Assembler& A, const Model& reference, const LinearSolver& solver,
+                         const std::vector<std::vector<int>>& groups, const std::vector<Eigen::VectorXd>& fel, const Eigen::VectorXd& t,
+                         int sample, CandidateShapes& out) {
+  const Eigen::VectorXd& mass = A.lumped_mass();
+  const double tt = mass_dot(mass, t, t);
+  const int npe = A.geometry().npe;
+  for (const std::vector<int>& group : groups) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(reference.num_dofs());
+    for (int e : group) {
+      const int* n = reference.mesh.element(e);
+      for (int a = 0; a < npe; ++a) f.segment<3>(3 * n[a]) += fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
+    }
+    A.zero_fixed(f);
+    Eigen::VectorXd du = solver.solve(f);
+    A.zero_fixed(du);
+    du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
+    out.shape.push_back(std::move(du));
+    out.sample.push_back(sample);
+  }
+}
+
 /// The linear responses of the path at each mode sample k to softening one cluster of soft
 /// elements, du_c = K_T(theta_k)^-1 f_iso,c(theta_k) (see the header), without their part along the
 /// path tangent (theta's). A sample whose tangent cannot be factorised is skipped.
 void add_softening_responses(const Assembler& A, const Model& reference, const ReducedBasis& B,
                              const std::vector<std::vector<int>>& clusters, const std::vector<int>& mode_k, bool verbose,
                              CandidateShapes& out) {
-  const int ndof = reference.num_dofs();
-  const Eigen::VectorXd& mass = A.lumped_mass();
   const ElementGeometry& geom = A.geometry();
   for (int k : mode_k) {
     const Eigen::VectorXd uk = B.U.col(k);
@@ -473,35 +519,20 @@ void add_softening_responses(const Assembler& A, const Model& reference, const R
       if (verbose) std::fprintf(stderr, "reduced basis: tangent at %.3g kPa not positive definite, sample skipped\n", B.p[k] * 1e-3);
       continue;
     }
-    const Eigen::VectorXd t = B.dU.col(k);
-    const double tt = mass_dot(mass, t, t);
-    const std::size_t nc = clusters.size();
     // Per soft element: its isochoric force at the sample.
     std::vector<Eigen::VectorXd> fel(static_cast<std::size_t>(reference.mesh.num_elements()));
-    tbb::parallel_for(std::size_t(0), nc, [&](std::size_t c) {
+    tbb::parallel_for(std::size_t(0), clusters.size(), [&](std::size_t c) {
       Eigen::VectorXd fe;
       for (int e : clusters[c]) element_force(reference, geom, e, uk, fe, fel[static_cast<std::size_t>(e)]);
     });
-    for (std::size_t c = 0; c < nc; ++c) {
-      Eigen::VectorXd f = Eigen::VectorXd::Zero(ndof);
-      for (int e : clusters[c]) {
-        const int* n = reference.mesh.element(e);
-        for (int a = 0; a < geom.npe; ++a) f.segment<3>(3 * n[a]) += fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
-      }
-      A.zero_fixed(f);
-      Eigen::VectorXd du = solver.solve(f);
-      A.zero_fixed(du);
-      du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
-      out.shape.push_back(std::move(du));
-      out.sample.push_back(k);
-    }
+    add_group_responses(A, reference, solver, clusters, fel, B.dU.col(k), k, out);
   }
 }
 
-/// The linear responses of the unloaded actuator to the isochoric stress that each cluster of soft
-/// elements carries at the mode samples, frozen and applied at the reference configuration:
-/// du_c = K_T(0)^-1 int B_0^T S_iso,c(theta_k) dV (S_iso = F^-1 P_iso, the second Piola-Kirchhoff
-/// stress). Why: a history law that relaxes under load (a Prony series) leaves, after a release in
+/// The linear responses of the unloaded actuator to the isochoric stress that the whole soft body
+/// (at every path sample) and each cluster of soft elements (at the mode samples) carries on the
+/// path, frozen and applied at the reference configuration: du_c = K_T(0)^-1 int B_0^T
+/// S_iso,c(theta_k) dV (S_iso = F^-1 P_iso, the second Piola-Kirchhoff stress). Why: a history law that relaxes under load (a Prony series) leaves, after a release in
 /// zero time, a frozen stress of the loaded state's pattern (Simo 1987: the overstress jumps by
 /// gamma (S_0(F) - S_0(F_n)), so the total holds h_n - gamma S_0(F_n)); the released state is the
 /// response of the unloaded body to it, a small self-equilibrated shape no loaded response or
@@ -509,68 +540,35 @@ void add_softening_responses(const Assembler& A, const Model& reference, const R
 void add_release_responses(const Assembler& A, const Model& reference, const ReducedBasis& B,
                            const std::vector<std::vector<int>>& clusters, const std::vector<int>& mode_k, bool verbose,
                            CandidateShapes& out) {
-  const int ndof = reference.num_dofs();
-  const Eigen::VectorXd& mass = A.lumped_mass();
-  const ElementGeometry& geom = A.geometry();
-  SparseMatrix K = tangent(A, Eigen::VectorXd::Zero(ndof), 0.0);
+  SparseMatrix K = tangent(A, Eigen::VectorXd::Zero(reference.num_dofs()), 0.0);
   A.apply_constraints(K, 1.0);
   LinearSolver solver;
   if (!solver.factorize(K)) {
     if (verbose) std::fprintf(stderr, "reduced basis: the unloaded tangent is not positive definite, no release responses\n");
     return;
   }
+  // The whole soft body's response at every path sample (the frozen stress of a Prony term is the
+  // path's stress history weighted by a kernel of time alone: a combination of the whole body's
+  // stress fields at all angles), then each cluster's at the mode samples (a damage law weighs that
+  // history locally); each sample's element forces computed once for both.
+  const std::vector<std::vector<int>> whole(1, [&] {
+    std::vector<int> all;
+    for (const auto& c : clusters) all.insert(all.end(), c.begin(), c.end());
+    return all;
+  }());
   const Eigen::VectorXd t = B.dU.col(0);
-  const double tt = mass_dot(mass, t, t);
-  const int npe = geom.npe, nqp = geom.nqp;
-  // Every path sample (the frozen stress of a Prony term is the path's stress history weighted by a
-  // kernel of time alone: a combination of the whole body's stress fields at all angles), each as
-  // one response of the whole soft body, and the clusters' at the mode samples (a damage law weighs
-  // that history locally).
-  std::vector<int> ks;
-  for (int k = 1; k < B.num_samples(); ++k) ks.push_back(k);
-  std::vector<std::vector<int>> whole(1);
-  for (const auto& c : clusters) whole[0].insert(whole[0].end(), c.begin(), c.end());
-  for (std::size_t pass = 0; pass < 2; ++pass)
-  for (int k : pass == 0 ? ks : mode_k) {
-    const std::vector<std::vector<int>>& groups = pass == 0 ? whole : clusters;
+  CandidateShapes by_cluster;
+  for (int k = 1; k < B.num_samples(); ++k) {
     const Eigen::VectorXd uk = B.U.col(k);
     std::vector<Eigen::VectorXd> fel(static_cast<std::size_t>(reference.mesh.num_elements()));
-    tbb::parallel_for(std::size_t(0), groups.size(), [&](std::size_t c) {
-      for (int e : groups[c]) {
-        const int* n = reference.mesh.element(e);
-        std::array<Mat3, 4> F;
-        std::array<PointResponse, 4> resp;
-        for (int q = 0; q < nqp; ++q) {
-          const double* g = geom.grad(e, q);
-          F[q] = Mat3::Identity();
-          for (int a = 0; a < npe; ++a) F[q] += uk.segment<3>(3 * n[a]) * Eigen::Map<const Eigen::RowVector3d>(g + 3 * a);
-        }
-        reference.material_of(e).evaluate(std::span<const Mat3>(F.data(), nqp), TimeStep{}, {}, {},
-                                          std::span<PointResponse>(resp.data(), nqp), false);
-        Eigen::VectorXd& f = fel[static_cast<std::size_t>(e)];
-        f = Eigen::VectorXd::Zero(3 * npe);
-        for (int q = 0; q < nqp; ++q) {
-          const Mat3 S = F[q].inverse() * resp[q].P_iso;  // second Piola-Kirchhoff, isochoric
-          const double* g = geom.grad(e, q);
-          const double w = geom.w(e, q);
-          for (int a = 0; a < npe; ++a) f.segment<3>(3 * a) += w * S * Eigen::Map<const Eigen::Vector3d>(g + 3 * a);
-        }
-      }
+    tbb::parallel_for(std::size_t(0), clusters.size(), [&](std::size_t c) {
+      for (int e : clusters[c]) element_frozen_force(reference, A.geometry(), e, uk, fel[static_cast<std::size_t>(e)]);
     });
-    for (const auto& cl : groups) {
-      Eigen::VectorXd f = Eigen::VectorXd::Zero(ndof);
-      for (int e : cl) {
-        const int* n = reference.mesh.element(e);
-        for (int a = 0; a < npe; ++a) f.segment<3>(3 * n[a]) += fel[static_cast<std::size_t>(e)].segment<3>(3 * a);
-      }
-      A.zero_fixed(f);
-      Eigen::VectorXd du = solver.solve(f);
-      A.zero_fixed(du);
-      du -= (mass_dot(mass, t, du) / tt) * t;  // the part along the path is theta's
-      out.shape.push_back(std::move(du));
-      out.sample.push_back(0);
-    }
+    add_group_responses(A, reference, solver, whole, fel, t, 0, out);
+    if (std::find(mode_k.begin(), mode_k.end(), k) != mode_k.end()) add_group_responses(A, reference, solver, clusters, fel, t, 0, by_cluster);
   }
+  out.shape.insert(out.shape.end(), std::make_move_iterator(by_cluster.shape.begin()), std::make_move_iterator(by_cluster.shape.end()));
+  out.sample.insert(out.sample.end(), by_cluster.sample.begin(), by_cluster.sample.end());
 }
 
 /// Each state's departure from the path point of equal angle (bisection on the path's angle),
