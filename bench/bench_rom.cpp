@@ -1,7 +1,7 @@
 // Reduced-order model benchmark (not run in CI; results in BENCHMARKS.md): the reduced model of
 // engine/rom.h against the full quasi-static FEM on a scene's protocol.
 //   bench_rom SCENE.toml [--set key=value ...] [--work DIR] [--fem] [--threads N]
-//             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--no-hyper]
+//             [--model-set key=value ...] [--modes R] [--clusters C] [--mode-samples S] [--ecsw-tol T] [--ecsw-blocks N] [--no-hyper]
 //             [--softened N] [--softened-max S] [--snap-trials N] [--snap-set key=value ...] [--check] [--corrected reports|tops] [--corrected-in-run reports|tops] [--dump-points]
 //             [--dump-every] [--galerkin-theta] [--fabric-strain] [--rom-time-tol T] [--path-steps N]
 //             [--root-test] [--root-trials N] [--exact-fabric | --sampled-fabric] [--release-modes]
@@ -153,6 +153,7 @@ int main(int argc, char** argv) {
     else if (a == "--clusters") ro.clusters = std::stoi(next());
     else if (a == "--mode-samples") ro.mode_samples = std::stoi(next());
     else if (a == "--ecsw-tol") ro.ecsw_tolerance = std::stod(next());
+    else if (a == "--ecsw-blocks") ro.ecsw_blocks = std::stoi(next());
     else if (a == "--pod-tol") ro.pod_tolerance = std::stod(next());
     else if (a == "--no-hyper") ro.hyper_reduce = false;
     else if (a == "--galerkin-theta") ro.galerkin_theta_row = true;  // the theta row tested with the path tangent
@@ -279,6 +280,7 @@ int main(int argc, char** argv) {
     if (!extra_snapshots.empty()) snap_key += "extra:" + extra_snapshots;
     if (ro.galerkin_theta_row) snap_key += "galerkin-theta";
     if (ro.tangent_free_modes) snap_key += "tangent-free";
+    if (ro.ecsw_blocks > 0) snap_key += "ecsw-blocks:" + std::to_string(ro.ecsw_blocks);
     if (ro.release_responses) snap_key += "release-modes-v2";  // v2: the whole body at every path sample, own POD
     if (ro.stiff_parts == RomBasisOptions::StiffParts::exact) snap_key += "exact-fabric";
     if (ro.stiff_parts == RomBasisOptions::StiffParts::sampled) snap_key += "sampled-fabric";

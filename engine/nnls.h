@@ -25,4 +25,17 @@ struct NnlsResult {
 /// outer iterations (0 = 3 * columns).
 NnlsResult nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double rel_tol, int max_iterations = 0);
 
+/// The same problem given by its normal equations, AtA = A^T A, Atb = A^T b, btb = b^T b (the
+/// fast NNLS of Bro & De Jong 1997, "A fast non-negativity-constrained least squares algorithm",
+/// J. Chemometrics 11, 393-401): the active-set steps of Lawson-Hanson above, with the passive
+/// least squares solved by a Cholesky factor of AtA's passive block that grows by one row per column
+/// brought in (O(k^2)) and is rebuilt only when columns leave, and the residual from
+/// ||A x - b||^2 = btb - 2 Atb.x + x.AtA x. After the Gram matrix (O(m n^2), once) a fit of k columns
+/// costs O(n k^2), where the QR form costs O(m k^3): what lets ECSW fit a block of thousands of
+/// elements against 10^4-10^5 training rows. A column whose passive block would be singular (its
+/// Cholesky pivot below 1e-10 of its diagonal: numerically a combination of the passive columns)
+/// is not brought in. The Gram form squares the condition number: fine for ECSW's tolerances
+/// (1e-2-1e-4), not for rel_tol near machine precision (use nnls there).
+NnlsResult nnls_normal(const Eigen::MatrixXd& AtA, const Eigen::VectorXd& Atb, double btb, double rel_tol, int max_iterations = 0);
+
 }  // namespace pneufem

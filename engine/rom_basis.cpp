@@ -421,10 +421,10 @@ void pressure_second_order(const Assembler& A, ReducedBasis& B) {
 
 void check_basis_options(const RomBasisOptions& opt) {
   if (opt.clusters < 1 || opt.mode_samples < 1 || opt.max_modes < 1 || !(opt.pod_tolerance > 0.0 && opt.pod_tolerance < 1.0) ||
-      !(opt.ecsw_tolerance > 0.0 && opt.ecsw_tolerance < 1.0) || opt.training_fields < 0 ||
+      !(opt.ecsw_tolerance > 0.0 && opt.ecsw_tolerance < 1.0) || opt.training_fields < 0 || opt.ecsw_blocks < 0 ||
       !(opt.training_softening > 0.0 && opt.training_softening <= 1.0))
-    throw InputError("reduced model: basis options out of range (clusters, mode_samples, max_modes >= 1; pod_tolerance and "
-                     "ecsw_tolerance in (0, 1); training_softening in (0, 1])");
+    throw InputError("reduced model: basis options out of range (clusters, mode_samples, max_modes >= 1; ecsw_blocks >= 0; "
+                     "pod_tolerance and ecsw_tolerance in (0, 1); training_softening in (0, 1])");
 }
 
 /// The path's samples in B: pressures, displacements, their angles (unwrapped, strictly increasing)
@@ -829,7 +829,18 @@ std::vector<std::pair<int, double>> ecsw_fit(Eigen::MatrixXd& G, int ncomp, cons
       target[row] /= scale;
     }
   }
-  const NnlsResult res = nnls(G, target, tolerance);
+  // A block of many elements in the normal-equations form: its cost grows with the picked
+  // elements, not with the rows times their cube (nnls_normal). Small blocks keep the QR form.
+  constexpr Eigen::Index kNormalFormColumns = 256;
+  NnlsResult res;
+  if (G.cols() > kNormalFormColumns) {
+    Eigen::MatrixXd GtG = Eigen::MatrixXd::Zero(G.cols(), G.cols());
+    GtG.selfadjointView<Eigen::Lower>().rankUpdate(G.transpose());
+    GtG.triangularView<Eigen::StrictlyUpper>() = GtG.transpose();
+    res = nnls_normal(GtG, G.transpose() * target, target.squaredNorm(), tolerance);
+  } else {
+    res = nnls(G, target, tolerance);
+  }
   residual = res.residual / std::max(target.norm(), 1e-300);
   std::vector<std::pair<int, double>> picked;
   for (std::size_t j = 0; j < el.size(); ++j)
@@ -926,9 +937,11 @@ std::vector<std::pair<int, double>> ecsw_remainder_weights(const Model& referenc
 /// The sampled elements and their weights (B.elements, B.weights, sorted by element): ECSW per
 /// cluster, or every soft element at weight 1 without hyper-reduction; and the stiff parts' elements
 /// as RomBasisOptions::stiff_parts asks (every one at weight 1, or ECSW on their remainder).
-void set_sampled_elements(const Model& reference, const ElementGeometry& geom, const std::vector<std::vector<int>>& clusters,
+void set_sampled_elements(const Model& reference, const ElementGeometry& geom, const std::vector<std::vector<int>>& softening_clusters,
                           const std::vector<TrainingState>& train, const std::vector<RemainderState>& remainder_train,
                           const RomBasisOptions& opt, ReducedBasis& B) {
+  const std::vector<std::vector<int>> clusters =
+      opt.ecsw_blocks > 0 ? soft_clusters(reference, B.stiff_part, opt.ecsw_blocks) : softening_clusters;
   std::vector<std::vector<std::pair<int, double>>> picked(clusters.size());
   std::vector<double> cluster_residual(clusters.size(), 0.0);
   if (!opt.hyper_reduce) {
@@ -948,7 +961,7 @@ void set_sampled_elements(const Model& reference, const ElementGeometry& geom, c
     for (int e = 0; e < reference.mesh.num_elements(); ++e)
       if (B.stiff_part[reference.element_part[e]]) all.push_back({e, 1.0});
   if (opt.stiff_parts == RomBasisOptions::StiffParts::sampled) {
-    const std::vector<std::vector<int>> stiff = stiff_clusters(reference, B.stiff_part, opt.clusters);
+    const std::vector<std::vector<int>> stiff = stiff_clusters(reference, B.stiff_part, opt.ecsw_blocks > 0 ? 4 * opt.ecsw_blocks : opt.clusters);
     std::vector<std::vector<std::pair<int, double>>> pick(stiff.size());
     std::vector<double> res(stiff.size(), 0.0);
     tbb::parallel_for(std::size_t(0), stiff.size(), [&](std::size_t c) {

@@ -122,6 +122,10 @@ std::unique_ptr<ReducedSetup> reduced_setup(const Scene& scene, double p_max_Pa,
   if (options.stiff_parts == RomBasisOptions::StiffParts::exact) h.str("stiff parts exact");      // likewise
   if (options.stiff_parts == RomBasisOptions::StiffParts::sampled) h.str("stiff parts sampled");  // likewise
   if (options.release_responses) h.str("release responses");  // likewise
+  if (options.ecsw_blocks > 0) {  // likewise
+    h.str("ecsw blocks");
+    h.num(options.ecsw_blocks);
+  }
   auto build = [&] { return build_reduced_basis(ref, path, options).to_doubles(); };
   out->basis = ReducedBasis::from_doubles(cache_dir.empty() ? (out->basis_source = "computed", build())
                                                             : cached_doubles(cache_dir, "rom_basis", h.hex(), build, &out->basis_source));

@@ -1,6 +1,7 @@
 // engine/nnls.h: Lawson-Hanson non-negative least squares (the reduced model's element sampling)
 // against its truths: a case solved by hand, the exact optimum of an enumeration of every active
-// set, the recovery of a sparse non-negative solution, and the early stop at rel_tol.
+// set, the recovery of a sparse non-negative solution, and the early stop at rel_tol; and its
+// normal-equations form (nnls_normal) against the QR form on the same problems.
 #include "engine/nnls.h"
 
 #include <cmath>
@@ -160,6 +161,65 @@ TEST(Nnls, RecoversASparseNonNegativeCombinationAndStopsEarly) {
   EXPECT_TRUE(early.converged);
   EXPECT_LE(early.residual, 0.2 * b.norm());
   EXPECT_LE((early.x.array() > 0.0).count(), 3);
+}
+
+/// nnls_normal is the same algorithm on A^T A: on well-conditioned random problems it reaches the
+/// same KKT point as nnls (weights to 1e-8: the Gram matrix squares the condition number, ~1e2
+/// here, so its solves lose ~4 more digits than the QR's), with the same columns in, and the same
+/// early stop (the same columns picked while the residual falls to the tolerance).
+TEST(Nnls, TheNormalEquationsFormReachesTheSamePoint) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> N;
+  for (int trial = 0; trial < 30; ++trial) {
+    const int m = 20 + trial % 11, n = 4 + (trial * 5) % 15;
+    Eigen::MatrixXd A(m, n);
+    Eigen::VectorXd b(m);
+    for (int i = 0; i < m; ++i) {
+      b[i] = N(rng);
+      for (int j = 0; j < n; ++j) A(i, j) = N(rng);
+    }
+    const NnlsResult qr = nnls(A, b, 1e-14);
+    const NnlsResult ne = nnls_normal(A.transpose() * A, A.transpose() * b, b.squaredNorm(), 1e-14);
+    ASSERT_EQ(ne.x.size(), n);
+    EXPECT_LT((ne.x - qr.x).norm(), 1e-8 * (1.0 + qr.x.norm())) << "trial " << trial;
+    for (int j = 0; j < n; ++j) EXPECT_EQ(ne.x[j] > 0.0, qr.x[j] > 0.0) << "trial " << trial << " column " << j;
+    EXPECT_NEAR(ne.residual, (A * ne.x - b).norm(), 1e-8 * (1.0 + b.norm())) << "trial " << trial;
+  }
+  // A non-negative combination of 3 of 40 columns, and the early stop: the same picks as the QR form.
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  Eigen::MatrixXd A(60, 40);
+  for (int i = 0; i < A.rows(); ++i)
+    for (int j = 0; j < A.cols(); ++j) A(i, j) = U(rng);
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(40);
+  x0[4] = 1.5, x0[17] = 0.25, x0[31] = 2.0;
+  const Eigen::VectorXd b = A * x0;
+  const Eigen::MatrixXd AtA = A.transpose() * A;
+  const Eigen::VectorXd Atb = A.transpose() * b;
+  const NnlsResult exact = nnls_normal(AtA, Atb, b.squaredNorm(), 1e-9);
+  EXPECT_TRUE(exact.converged);
+  EXPECT_LT((exact.x - x0).norm(), 1e-6);  // the Gram form's accuracy: cond(A)^2 ~1e4 times eps, times |x|
+  for (double tol : {0.3, 0.1, 0.02}) {
+    const NnlsResult early = nnls_normal(AtA, Atb, b.squaredNorm(), tol), early_qr = nnls(A, b, tol);
+    EXPECT_TRUE(early.converged);
+    EXPECT_LE((A * early.x - b).norm(), tol * b.norm() * (1.0 + 1e-9));
+    EXPECT_EQ(early.iterations, early_qr.iterations) << tol;
+    for (int j = 0; j < 40; ++j) EXPECT_EQ(early.x[j] > 0.0, early_qr.x[j] > 0.0) << tol << " column " << j;
+  }
+}
+
+/// A column that is a combination of the passive ones is not brought in (its Cholesky pivot
+/// vanishes), and the fit still reaches the optimum of the independent columns.
+TEST(Nnls, TheNormalEquationsFormSkipsADependentColumn) {
+  Eigen::MatrixXd A = random_matrix(12, 4, 21);
+  A.col(3) = 0.5 * A.col(0) + 0.5 * A.col(1);  // dependent on columns 0 and 1
+  Eigen::VectorXd x0(4);
+  x0 << 1.0, 1.0, 0.5, 0.0;
+  const Eigen::VectorXd b = A * x0;
+  const NnlsResult r = nnls_normal(A.transpose() * A, A.transpose() * b, b.squaredNorm(), 1e-10);
+  EXPECT_TRUE(r.converged);
+  EXPECT_GE(r.x.minCoeff(), 0.0);
+  EXPECT_LT((A * r.x - b).norm(), 1e-7 * b.norm());
+  EXPECT_LE((r.x.array() > 0.0).count(), 3);  // never all four: the fourth adds nothing independent
 }
 
 }  // namespace
