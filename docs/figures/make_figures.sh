@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the figures of the user guide (docs/user_guide.md) and the README by running its
-# tutorial on the small actuator of the test recordings: a compare of the hidden-creep recording,
+# tutorial on the small actuator of the test recordings: ParaView's views of the first simulation
+# (when pvbatch is installed), a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve.
 # About 7 min on 2 cores (the diagnose about 5 of them).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
@@ -11,6 +12,12 @@ RUN=out/tutorial
 DATA=tests/data/hidden/viscoelastic.csv
 rm -rf "$RUN"
 "$EXE" simulate scenes/examples/small_actuator.toml --out "$RUN/first"
+if command -v pvbatch > /dev/null; then  # ParaView's standard views (scripts/install-paraview.sh)
+  pvbatch viz/paraview/open_run.py "$RUN/first"
+  cp "$RUN/first/views.png" docs/figures/tutorial_paraview_views.png
+else
+  echo "pvbatch not found: docs/figures/tutorial_paraview_views.png kept (scripts/install-paraview.sh)"
+fi
 "$EXE" compare scenes/examples/small_actuator.toml --data "$DATA" --out "$RUN/study"
 cp "$RUN/study/fig_trial_1.svg" docs/figures/tutorial_compare_trial_1.svg
 cp "$RUN/study/fig_trial_1.csv" docs/figures/tutorial_compare_trial_1.csv
