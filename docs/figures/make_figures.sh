@@ -3,7 +3,8 @@
 # tutorial on the small actuator of the test recordings: ParaView's views of the first simulation
 # (when pvbatch is installed), a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve;
-# and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data.
+# and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data and the
+# gmsh deck against CalculiX.
 # About 7 min on 2 cores (the diagnose about 5 of them).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
@@ -41,4 +42,7 @@ done
   planar:"$RUN/treloar/pureshear.csv" --model ogden3 --out "$RUN/treloar/fit"
 cp "$RUN/treloar/fit/fit.svg" docs/figures/verification_treloar_ogden3.svg
 cp "$RUN/treloar/fit/fit.csv" docs/figures/verification_treloar_ogden3.csv
+# ... and of CalculixReference: the gmsh deck of tests/data/ccx_gmsh bent by pneufem against CalculiX.
+"$EXE" simulate tests/data/ccx_gmsh/scene.toml --out "$RUN/ccx_gmsh"
+/usr/bin/python3 docs/figures/calculix_gmsh.py "$RUN/ccx_gmsh/angles.csv" docs/figures/verification_calculix_gmsh.svg
 echo "figures written to docs/figures (runs in $RUN)"
