@@ -36,8 +36,11 @@ def most_bent_time(run, times):
     path = os.path.join(run, "states.csv")
     if not times or not os.path.exists(path):
         return times[-1] if times else None
-    with open(path) as f:
-        rows = [(float(r["global_time_s"]), abs(float(r["angle_deg"]))) for r in csv.DictReader(f)]
+    try:
+        with open(path) as f:
+            rows = [(float(r["global_time_s"]), abs(float(r["angle_deg"]))) for r in csv.DictReader(f)]
+    except (KeyError, TypeError, ValueError):  # a states.csv of another layout (an older run): the last state
+        rows = []
     if not rows:
         return times[-1]
     angle = {t: min(rows, key=lambda r: abs(r[0] - t))[1] for t in times}
