@@ -16,14 +16,16 @@
 //  * an empty state_new means "do not write the trial state" (the engine's energy-only passes).
 //
 // The forwarding that a layer does not change lives once, in MaterialDecorator below (Mullins,
-// FatigueDamage and UniformFatigue derive from it): the name "effect(base)", the state size
-// own + base, the small-strain moduli, the linear-drive history and the non-local driver (each
+// FatigueDamage, UniformFatigue and Viscoelastic derive from it): the name "effect(base)", the state
+// size own + base, the small-strain moduli, the linear-drive history and the non-local driver (each
 // handed the base's slice of the block), and the base itself. A layer overrides only what it
-// changes (FatigueDamage its non-local driver). Cycle jumping is deliberately NOT forwarded: a layer
+// changes (FatigueDamage its non-local driver; Viscoelastic the shear modulus, its instantaneous one,
+// and the linear drive, its own branches'). Cycle jumping is deliberately NOT forwarded: a layer
 // that does not say how its own history extrapolates must refuse (Material's default for a law with
-// state), so Mullins and FatigueDamage override jumps_cycles/jump_cycles/jump_error and UniformFatigue
-// does not jump. Viscoelastic (viscoelastic.h) still spells the same forwarding out; its own state
-// size, 6 (1 + terms), is known only once its constructor has checked the Prony terms.
+// state), so Mullins, FatigueDamage and Viscoelastic override jumps_cycles/jump_cycles/jump_error and
+// UniformFatigue does not jump. A layer whose own size depends on its parameters (fatigue: 1 or 2,
+// Viscoelastic: 6 (1 + terms)) computes it for the base class before checking them; a bad parameter
+// then throws from its constructor, after the shared split-base check.
 //
 // evaluate() calls the base one point at a time (one virtual call per point and layer, since the
 // base's slices are strided by the full block): the price of composability, paid where the tangent

@@ -111,9 +111,11 @@ ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<do
   return p;
 }
 
-Viscoelastic::Viscoelastic(MaterialPtr base, const ViscoParams& p) : base_(std::move(base)) {
-  const std::string me = "viscoelastic";
-  detail::require_split_base(base_, me);
+// The own state size, 6 (1 + terms), is handed to the base class before the terms are checked: a bad count
+// throws below, after the shared constructor's split-base check, in the order the checks had before.
+Viscoelastic::Viscoelastic(MaterialPtr base, const ViscoParams& p)
+    : MaterialDecorator(std::move(base), "viscoelastic", 6 * (1 + static_cast<int>(p.gamma.size()))) {
+  const std::string& me = effect();
   const std::size_t n = p.gamma.size();
   detail::require(n >= 1 && n <= kMaxTerms && p.tau_s.size() == n, me,
                   "gamma and tau need the same number of Prony terms, 1 to 3; got " + std::to_string(n) +
@@ -134,20 +136,19 @@ Viscoelastic::Viscoelastic(MaterialPtr base, const ViscoParams& p) : base_(std::
   // is gamma_i bit for bit in the long-term convention (the arithmetic before the choice existed).
   beta_ = moduli_ == ViscoModuli::instantaneous ? 1.0 / (1.0 + gamma_sum_) : 1.0;
   for (int i = 0; i < n_; ++i) a_[i] = moduli_ == ViscoModuli::instantaneous ? beta_ * gamma_[i] : gamma_[i];
-  mu_base_ = base_->initial_shear_modulus();
+  mu_base_ = this->base()->initial_shear_modulus();  // this->: the parameter `base` was moved from
 }
 
 void Viscoelastic::init_state(std::span<double> state) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
-  for (std::size_t i = 0; i < own; ++i) state[i] = 0.0;  // S0 = 0 and Q_i = 0 in the virgin state
-  base_->init_state(state.subspan(own));
+  for (std::size_t i = 0; i < own_size(); ++i) state[i] = 0.0;  // S0 = 0 and Q_i = 0 in the virgin state
+  base()->init_state(base_state(state));
 }
 
 void Viscoelastic::jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                                std::span<double> out) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
+  const std::size_t own = own_size();
   std::copy(after.begin(), after.begin() + static_cast<std::ptrdiff_t>(own), out.begin());  // set by the last rest
-  base_->jump_cycles(before.subspan(own), after.subspan(own), cycles, out.subspan(own));
+  base()->jump_cycles(base_state(before), base_state(after), cycles, base_state(out));
 }
 
 struct Viscoelastic::Increment {
@@ -175,12 +176,12 @@ Viscoelastic::Increment Viscoelastic::increment(double dt_s) const {
 void Viscoelastic::evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                             std::span<double> state_new, std::span<PointResponse> out, bool tangent) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
+  const std::size_t own = own_size(), nb = static_cast<std::size_t>(base()->state_size());
   const Increment inc = increment(step.dt_s);
   for (std::size_t q = 0; q < F.size(); ++q) {
     const detail::PointState ps = detail::point_state(state_old, state_new, q, own, nb);
     PointResponse& r = out[q];
-    detail::evaluate_base(*base_, F[q], step, ps, r, tangent);
+    detail::evaluate_base(*base(), F[q], step, ps, r, tangent);
     const bool virgin = ps.own_old.empty();
 
     const Mat3 S0_trial = F[q].inverse() * r.P_iso;
@@ -213,8 +214,8 @@ void Viscoelastic::evaluate(std::span<const Mat3> F, const TimeStep& step, std::
 void Viscoelastic::stress(StressBatch& b, const TimeStep& step, std::span<const double> state_old,
                           std::span<double> state_new) const {
   assert(step.dt_s >= 0.0);
-  const std::size_t own = static_cast<std::size_t>(own_state_size()), nb = static_cast<std::size_t>(base_->state_size());
-  if (!detail::stress_base(*base_, b, step, state_old, state_new, own))
+  const std::size_t own = own_size(), nb = static_cast<std::size_t>(base()->state_size());
+  if (!detail::stress_base(*base(), b, step, state_old, state_new, own))
     return Material::stress(b, step, state_old, state_new);
   const std::size_t block = own + nb;
   const Increment inc = increment(step.dt_s);
@@ -253,8 +254,7 @@ void Viscoelastic::stress(StressBatch& b, const TimeStep& step, std::span<const 
 }
 
 PointFields Viscoelastic::fields(std::span<const double> state) const {
-  const std::size_t own = static_cast<std::size_t>(own_state_size());
-  PointFields f = base_->fields(state.subspan(own));
+  PointFields f = base()->fields(base_state(state));
   Mat3 Q = Mat3::Zero();
   for (int i = 0; i < n_; ++i) Q += unpack(state.subspan(6 * (i + 1), 6));
   f.viscous_strain = Q.norm() / (2.0 * long_term_shear_modulus());

@@ -62,6 +62,7 @@
 #include <string>
 #include <vector>
 
+#include "damage/decorator.h"
 #include "materials/material.h"
 
 namespace pneufem {
@@ -88,16 +89,17 @@ struct ViscoParams {
 ViscoParams prony_from_abaqus(const std::vector<double>& g, const std::vector<double>& tau_s,
                               ViscoModuli moduli = ViscoModuli::instantaneous);
 
-class Viscoelastic final : public Material {
+/// The Prony decorator above, on MaterialDecorator (damage/decorator.h): the name "viscoelastic(base)", the
+/// state size own + base (own = 6 (1 + terms)), the bulk modulus and the non-local driver (a fatigue law
+/// inside keeps its own) are the shared forwarding; this layer overrides the shear modulus (the
+/// instantaneous one), the linear drive (its own branches, not the base's) and cycle jumping.
+class Viscoelastic final : public MaterialDecorator {
  public:
   static constexpr int kMaxTerms = 3;
 
   Viscoelastic(MaterialPtr base, const ViscoParams& p);
 
-  std::string name() const override { return "viscoelastic(" + base_->name() + ")"; }
   bool isochoric_energy_is_potential() const override { return false; }
-  int own_state_size() const { return 6 * (1 + n_); }
-  int state_size() const override { return own_state_size() + base_->state_size(); }
   void init_state(std::span<double> state) const override;
   void evaluate(std::span<const Mat3> F, const TimeStep& step, std::span<const double> state_old,
                 std::span<double> state_new, std::span<PointResponse> out, bool tangent) const override;
@@ -109,7 +111,7 @@ class Viscoelastic final : public Material {
   /// The Prony update above is exact for a linearly varying S0 (Material::LinearDrive): D = S0 / (2 mu_inf)
   /// (strain units, the scale of viscous_strain), a_i and tau_i the branches', recovery = 1 / beta:
   /// at fixed load the isochoric stress beta S0 + sum Q_i is fixed, so while the branches relax
-  /// fully S0 changes by |sum Q_i| / beta, i.e. D by viscous_strain / beta.
+  /// fully S0 changes by |sum Q_i| / beta, i.e. D by viscous_strain / beta. Not the base's drive.
   LinearDrive linear_drive() const override;
   void linear_drive_value(std::span<const double> state, std::span<double> out) const override;
   /// The INSTANTANEOUS shear modulus (beta + sum a_i) mu_base = (1 + sum gamma) mu_inf: stable-step
@@ -117,36 +119,24 @@ class Viscoelastic final : public Material {
   double initial_shear_modulus() const override {
     return moduli_ == ViscoModuli::instantaneous ? mu_base_ : (1.0 + gamma_sum_) * mu_base_;
   }
-  double initial_bulk_modulus() const override { return base_->initial_bulk_modulus(); }
   /// Cycle jumping (Material::jump_cycles): the branches Q_i and S0 are NOT extrapolated. They
   /// follow the load within a cycle and relax during the rest that ends it, so after a jump they are
   /// the last computed cycle's (the first computed cycle after the jump starts from them). The
   /// base's history is extrapolated by the base; jump_error is the base's.
-  bool jumps_cycles() const override { return base_->jumps_cycles(); }
+  bool jumps_cycles() const override { return base()->jumps_cycles(); }
   void jump_cycles(std::span<const double> before, std::span<const double> after, double cycles,
                    std::span<double> out) const override;
   double jump_error(std::span<const double> predicted, std::span<const double> computed) const override {
-    const std::size_t own = static_cast<std::size_t>(own_state_size());
-    return base_->jump_error(predicted.subspan(own), computed.subspan(own));
-  }
-  /// Forwarded to the base (its slice of the state): a fatigue law inside keeps its non-local driver.
-  NonlocalSpec nonlocal() const override { return base_->nonlocal(); }
-  double nonlocal_driver(const Mat3& F, std::span<const double> state) const override {
-    return base_->nonlocal_driver(F, state.subspan(static_cast<std::size_t>(own_state_size())));
-  }
-  void set_nonlocal_driver(std::span<double> state, double local, double average) const override {
-    base_->set_nonlocal_driver(state.subspan(static_cast<std::size_t>(own_state_size())), local, average);
+    return base()->jump_error(base_state(predicted), base_state(computed));
   }
 
   int terms() const { return n_; }
-  const MaterialPtr& base() const { return base_; }
   ViscoModuli moduli() const { return moduli_; }
   /// Long-term (equilibrium) shear modulus beta mu_base: the base's (long_term), (1 - sum g) times it
   /// (instantaneous).
   double long_term_shear_modulus() const { return beta_ * mu_base_; }
 
  private:
-  MaterialPtr base_;
   int n_ = 0;
   ViscoModuli moduli_ = ViscoModuli::long_term;
   std::array<double, kMaxTerms> gamma_{}, tau_{};

@@ -5,7 +5,7 @@
 
 #include <Eigen/SVD>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -14,8 +14,8 @@
 #include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
 
+#include "core/errors.h"
 #include "engine/nonlocal.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 

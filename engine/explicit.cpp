@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "core/errors.h"
 #include "core/number_text.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 

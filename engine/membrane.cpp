@@ -2,29 +2,21 @@
 
 #include <array>
 #include <cmath>
-#include <sstream>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "core/errors.h"
+#include "core/number_text.h"
 #include "engine/tet_element.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 
-namespace {
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-}  // namespace
-
 PlaneStressSVK::PlaneStressSVK(double E_Pa, double nu) : E_(E_Pa), nu_(nu) {
   if (!(std::isfinite(E_Pa) && E_Pa > 0.0))
-    throw InputError("membrane: Young's modulus E must be a finite number > 0, got " + num(E_Pa) + " Pa");
+    throw InputError("membrane: Young's modulus E must be a finite number > 0, got " + short_num(E_Pa) + " Pa");
   if (!(nu > -1.0 && nu < 0.5))
-    throw InputError("membrane: Poisson ratio must lie in (-1, 0.5), got " + num(nu));
+    throw InputError("membrane: Poisson ratio must lie in (-1, 0.5), got " + short_num(nu));
   lambda_s_ = E_Pa * nu / (1.0 - nu * nu);
   mu_ = E_Pa / (2.0 * (1.0 + nu));
 }

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -10,7 +10,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

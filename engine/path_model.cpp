@@ -10,12 +10,12 @@
 #include <string>
 #include <utility>
 
+#include "core/errors.h"
 #include "engine/angle.h"
 #include "engine/assembly.h"
 #include "engine/nonlocal.h"
 #include "engine/path_spline.h"
 #include "engine/tet_element.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 

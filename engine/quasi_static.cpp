@@ -9,9 +9,9 @@
 #include <ostream>
 #include <sstream>
 
+#include "core/errors.h"
 #include "engine/angle.h"
 #include "engine/history_step.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 

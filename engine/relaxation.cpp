@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/errors.h"
 #include "engine/static_solver.h"
-#include "materials/errors.h"
 
 namespace pneufem {
 

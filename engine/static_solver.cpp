@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <sstream>
 
-#include "materials/errors.h"
+#include "core/errors.h"
 
 namespace pneufem {
 

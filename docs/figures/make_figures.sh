@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Regenerates the figures of the user guide (docs/user_guide.md) and the README by running its
-# tutorial on the small actuator of the test recordings: a compare of the hidden-creep recording,
-# a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve.
+# tutorial on the small actuator of the test recordings: ParaView's views of the first simulation
+# (when pvbatch is installed), a compare of the hidden-creep recording,
+# a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve;
+# and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data and the
+# gmsh deck against CalculiX.
 # About 7 min on 2 cores (the diagnose about 5 of them).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
@@ -11,6 +14,12 @@ RUN=out/tutorial
 DATA=tests/data/hidden/viscoelastic.csv
 rm -rf "$RUN"
 "$EXE" simulate scenes/examples/small_actuator.toml --out "$RUN/first"
+if command -v pvbatch > /dev/null; then  # ParaView's standard views (scripts/install-paraview.sh)
+  pvbatch viz/paraview/open_run.py "$RUN/first"
+  cp "$RUN/first/views.png" docs/figures/tutorial_paraview_views.png
+else
+  echo "pvbatch not found: docs/figures/tutorial_paraview_views.png kept (scripts/install-paraview.sh)"
+fi
 "$EXE" compare scenes/examples/small_actuator.toml --data "$DATA" --out "$RUN/study"
 cp "$RUN/study/fig_trial_1.svg" docs/figures/tutorial_compare_trial_1.svg
 cp "$RUN/study/fig_trial_1.csv" docs/figures/tutorial_compare_trial_1.csv
@@ -23,4 +32,17 @@ cp "$RUN/study/fig_history.csv" docs/figures/tutorial_history.csv
 "$EXE" fit-material uniaxial:tests/data/soro-materials-db/ecoflex_00-50.csv --max-strain 2 --out "$RUN/material"
 cp "$RUN/material/fit.svg" docs/figures/fit_material_ecoflex.svg
 cp "$RUN/material/fit.csv" docs/figures/fit_material_ecoflex.csv
+# The verification manual's figure of TreloarOgden3: Treloar's three modes (tests/data/treloar1944,
+# stretch and nominal stress in MPa) and the Ogden-3 fit of all three at once.
+mkdir -p "$RUN/treloar"
+for mode in uniaxial equibiaxial pureshear; do
+  awk 'BEGIN { print "stretch,stress_MPa" } NF == 2 { print $1 "," $2 }' "tests/data/treloar1944/treloar_$mode.dat" > "$RUN/treloar/$mode.csv"
+done
+"$EXE" fit-material uniaxial:"$RUN/treloar/uniaxial.csv" biaxial:"$RUN/treloar/equibiaxial.csv" \
+  planar:"$RUN/treloar/pureshear.csv" --model ogden3 --out "$RUN/treloar/fit"
+cp "$RUN/treloar/fit/fit.svg" docs/figures/verification_treloar_ogden3.svg
+cp "$RUN/treloar/fit/fit.csv" docs/figures/verification_treloar_ogden3.csv
+# ... and of CalculixReference: the gmsh deck of tests/data/ccx_gmsh bent by pneufem against CalculiX.
+"$EXE" simulate tests/data/ccx_gmsh/scene.toml --out "$RUN/ccx_gmsh"
+/usr/bin/python3 docs/figures/calculix_gmsh.py "$RUN/ccx_gmsh/angles.csv" docs/figures/verification_calculix_gmsh.svg
 echo "figures written to docs/figures (runs in $RUN)"

@@ -3,6 +3,7 @@
 #include "analysis/paper_metrics.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "core/json_writer.h"
 
 namespace pneufem {
 namespace {
@@ -70,6 +72,24 @@ TEST(PaperMetrics, JsonOfTheTrials) {
             "    {\"trial\": 3, \"nrmse\": 0.125, \"abs_error_deg\": [1.5, null], \"spread_deg\": [0.25], "
             "\"angle_at_mark_deg\": [3], \"reference_at_mark_deg\": [2], \"extrapolated\": true}\n"
             "  ],\n  \"levels_kPa\": [0, 5]\n}\n");
+}
+
+// metrics.json keeps every digit that reads back the same double (issue 34: round-trip precision in every
+// JSON file; it had 6 significant digits): 1/3 and 0.1 + 0.2 come back bit for bit.
+TEST(PaperMetrics, JsonNumbersReadBackExactly) {
+  TrialMetrics t;
+  t.trial = 1;
+  t.nrmse = 1.0 / 3.0;
+  t.abs_error_deg = {0.1 + 0.2};
+  t.spread_deg = {2.0 / 3.0};
+  t.mark_deg = {1e-7 / 3.0};
+  t.reference_deg = {12345.678901234567};
+  const std::string j = metrics_json({t}, {std::sqrt(2.0)});
+  for (const double v : {t.nrmse, t.abs_error_deg[0], t.spread_deg[0], t.mark_deg[0], t.reference_deg[0], std::sqrt(2.0)}) {
+    const std::string text = json::num(v);
+    ASSERT_NE(j.find(text), std::string::npos) << text << " not in " << j;
+    EXPECT_EQ(std::strtod(text.c_str(), nullptr), v) << text;
+  }
 }
 
 }  // namespace

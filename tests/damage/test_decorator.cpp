@@ -5,7 +5,9 @@
 // files and the derivative battery.
 #include "damage/decorator.h"
 
+#include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,6 +16,7 @@
 #include "damage/fatigue.h"
 #include "damage/fatigue_uniform.h"
 #include "damage/mullins.h"
+#include "damage/viscoelastic.h"
 #include "materials/hyperelastic.h"
 #include "tests/support/input_error.h"
 
@@ -128,6 +131,45 @@ TEST(Decorator, ForwardsWhatTheLayerDoesNotChangeButNotCycleJumping) {
   EXPECT_FALSE(uniform->jumps_cycles());
   // The shared constructor's check names the layer.
   EXPECT_NE(pneufem::test::error_of([] { Mullins(nullptr, MullinsParams{2.0, 1e3, 0.1}); }).find("mullins: no base material"),
+            std::string::npos);
+}
+
+// Viscoelastic is on the same base (decorator.h): the shared forwarding (the name, the [own | base]
+// sizes with own = 6 (1 + terms), the bulk modulus, the non-local driver of a fatigue law inside, reading
+// and writing the base's slice, base()) and its own overrides (the instantaneous shear modulus, its
+// branches' linear drive rather than the base's, cycle jumping as the base's).
+TEST(Decorator, ViscoelasticForwardsTheNonlocalDriverButNotItsDriveOrShearModulus) {
+  static_assert(std::is_base_of_v<MaterialDecorator, Viscoelastic>);
+  const MaterialPtr base = yeoh();
+  FatigueParams fp{100.0, 10.0};
+  fp.nonlocal_radius_m = 0.004;
+  const auto fatigue = std::make_shared<const FatigueDamage>(base, fp);
+  const auto visco =
+      std::make_shared<const Viscoelastic>(fatigue, ViscoParams{{0.5, 0.25}, {1.0, 10.0}, ViscoModuli::long_term});
+  EXPECT_EQ(visco->name(), "viscoelastic(fatigue(" + base->name() + "))");
+  EXPECT_EQ(visco->own_state_size(), 6 * (1 + 2));
+  EXPECT_EQ(visco->state_size(), 18 + fatigue->state_size());
+  EXPECT_EQ(visco->base(), fatigue);
+  EXPECT_EQ(visco->initial_bulk_modulus(), base->initial_bulk_modulus());
+  EXPECT_EQ(visco->initial_shear_modulus(), 1.75 * base->initial_shear_modulus());  // (1 + sum gamma) mu
+  EXPECT_EQ(visco->linear_drive().terms, 2);  // its own branches; the fatigue law inside has none
+  EXPECT_EQ(fatigue->linear_drive().terms, 0);
+  EXPECT_EQ(visco->nonlocal().radius_m, 0.004);
+  EXPECT_EQ(visco->nonlocal().kind, fatigue->nonlocal().kind);
+  std::vector<double> state(static_cast<std::size_t>(visco->state_size()), -1.0);
+  visco->init_state(state);
+  const std::span<double> base_slice = std::span<double>(state).subspan(18);
+  Mat3 F = Mat3::Identity();
+  F(0, 0) = 1.3;
+  F(0, 1) = 0.1;
+  EXPECT_EQ(visco->nonlocal_driver(F, state), fatigue->nonlocal_driver(F, base_slice));
+  EXPECT_GT(visco->nonlocal_driver(F, state), 0.0);
+  visco->set_nonlocal_driver(state, 2.0 * fp.W_th_Pa, fp.W_th_Pa);  // rho = 0.5 into the fatigue law's slice
+  EXPECT_EQ(base_slice[1], 0.5);
+  for (std::size_t i = 0; i < 18; ++i) EXPECT_EQ(state[i], 0.0) << i;  // its own block untouched (virgin)
+  EXPECT_EQ(visco->jumps_cycles(), fatigue->jumps_cycles());
+  EXPECT_NE(pneufem::test::error_of([] { Viscoelastic(nullptr, ViscoParams{{0.5}, {1.0}}); })
+                .find("viscoelastic: no base material"),
             std::string::npos);
 }
 

@@ -4,7 +4,7 @@ ParaView is not needed to build or test pneufem, so the script cannot be run for
 test runs it end to end against a recording stand-in of the paraview.simple calls it makes, on
 the run directory of a tiny `pneufem simulate` (a few seconds), and checks what the stand-in
 cannot: that every array the script warps or colours by is in the run's last VTU with the
-association the script names, that the stress view's field is the silicone's alone (finite at
+association the script names, that the state shown is the one that bends most (states.csv), that the stress view's field is the silicone's alone (finite at
 every silicone node, NaN at fabric-only nodes, its range far below the fabric's), that the chart's
 columns are in angles.csv, and that a half model is mirrored.
 
@@ -58,15 +58,30 @@ def stand_in(run, calls):
         info = types.SimpleNamespace(GetBounds=lambda: bounds)
         return Proxy("reader", calls, TimestepValues=pvd_times, GetDataInformation=lambda: info, **k)
 
+    grid = last_grid(run)
+    data = {"PointData": grid.GetPointData(), "CellData": grid.GetCellData()}
+
+    class Arrays(dict):
+        def __init__(self, kind):
+            super().__init__()
+            self.kind = kind
+
+        def __missing__(self, name):
+            v = array(data[self.kind], name)
+            v = v[numpy.isfinite(v)]
+            return types.SimpleNamespace(GetRange=lambda: (float(v.min()), float(v.max())))
+
     def source(name):
-        return lambda **k: calls.append((name, (), k)) or Proxy(name, calls, **k)
+        return lambda **k: calls.append((name, (), k)) or Proxy(name, calls, PointData=Arrays("PointData"),
+                                                                CellData=Arrays("CellData"), **k)
 
     layout = Proxy("layout", calls)
     m.PVDReader = reader
     m.WarpByVector = source("WarpByVector")
     m.Reflect = source("Reflect")
     m.CSVReader = source("CSVReader")
-    m.GetAnimationScene = record("GetAnimationScene", lambda: Proxy("scene", calls))
+    scene = Proxy("scene", calls)
+    m.GetAnimationScene = record("GetAnimationScene", scene)
     m.GetActiveViewOrCreate = record("GetActiveViewOrCreate", lambda: Proxy("view", calls))
     m.CreateView = lambda kind: calls.append(("CreateView", (kind,), {})) or Proxy(kind, calls)
     m.GetLayout = record("GetLayout", None)  # as in pvpython: no layout until one is made
@@ -152,6 +167,17 @@ def main():
     for association, field in coloured:
         assert data[association].GetArray(field) is not None, "%s %s not in the VTU" % (association, field)
     check_silicone_field(grid)
+
+    # The state shown is the one that bends most (states.csv), in every render view and the time slider.
+    times = [float(d.get("timestep")) for d in ET.parse(os.path.join(run, "results.pvd")).iter("DataSet")]
+    with open(os.path.join(run, "states.csv")) as f:
+        angle = {float(r["global_time_s"]): abs(float(r["angle_deg"])) for r in csv.DictReader(f)}
+    most_bent = max((t for t in times if t in angle), key=lambda t: (angle[t], t))
+    assert sys.modules["paraview.simple"].GetAnimationScene().AnimationTime == most_bent
+    render_views = {id(c[1][1]): c[1][1] for c in calls if c[0] == "Show" and c[1][1].kind in ("view", "RenderView")}
+    assert len(render_views) == 2, "stress and damage views"
+    for view in render_views.values():
+        assert view.ViewTime == most_bent, "a view shows t = %s, not the most bent state's %s" % (view.ViewTime, most_bent)
 
     chart = next(c for c in calls if c[0] == "Show" and c[1][0].kind == "CSVReader")
     with open(chart[1][0].FileName[0]) as f:
