@@ -3,13 +3,16 @@
 # tutorial on the small actuator of the test recordings: ParaView's views of the first simulation
 # (when pvbatch is installed), a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve;
-# and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data and the
-# gmsh deck against CalculiX.
-# About 7 min on 2 cores (the diagnose about 5 of them).
+# and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data, the
+# gmsh deck against CalculiX, the default actuator against CalculiX, and three made from the lines
+# their tests print (the cylinder's convergence, the creep block, the derivative battery's step).
+# About 8 min on 2 cores (the diagnose about 5 of them). Needs the test executables test_solvers,
+# test_creep and test_materials built beside pneufem (build/tests/...).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 EXE=${1:-build/app/pneufem}
+TESTS=$(dirname "$EXE")/../tests
 RUN=out/tutorial
 DATA=tests/data/hidden/viscoelastic.csv
 rm -rf "$RUN"
@@ -45,4 +48,15 @@ cp "$RUN/treloar/fit/fit.csv" docs/figures/verification_treloar_ogden3.csv
 # ... and of CalculixReference: the gmsh deck of tests/data/ccx_gmsh bent by pneufem against CalculiX.
 "$EXE" simulate tests/data/ccx_gmsh/scene.toml --out "$RUN/ccx_gmsh"
 /usr/bin/python3 docs/figures/calculix_gmsh.py "$RUN/ccx_gmsh/angles.csv" docs/figures/verification_calculix_gmsh.svg
+# ... the default actuator on its own mesh against CalculiX (bench/results/ccx_h4, ccx_h2: committed);
+# and three tests' own series: CylinderInflation.ObservedConvergenceOrderOfTet10 (~15 s), the creep
+# block in both moduli conventions (~5 s) and MaterialBattery.TangentDifferenceErrorIsAVInTheStep (< 1 s).
+FIG=docs/figures/verification_figures.py
+/usr/bin/python3 $FIG calculix docs/figures/verification_calculix_default.svg
+"$TESTS/engine/test_solvers" --gtest_filter=CylinderInflation.ObservedConvergenceOrderOfTet10 > "$RUN/cylinder.txt"
+/usr/bin/python3 $FIG cylinder "$RUN/cylinder.txt" docs/figures/verification_cylinder_convergence.svg
+"$TESTS/engine/test_creep" --gtest_filter='Creep.HomogeneousBlock*:Creep.InstantaneousModuli*' > "$RUN/creep.txt"
+/usr/bin/python3 $FIG creep "$RUN/creep.txt" docs/figures/verification_creep_sls.svg
+"$TESTS/materials/test_materials" --gtest_filter='*TangentDifferenceErrorIsAVInTheStep*' > "$RUN/derivative.txt"
+/usr/bin/python3 $FIG derivative "$RUN/derivative.txt" docs/figures/verification_derivative_step.svg
 echo "figures written to docs/figures (runs in $RUN)"
