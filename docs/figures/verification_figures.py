@@ -140,12 +140,12 @@ def derivative(test_output, out_svg):
     step = next(iter(battery.values()))["step"]
     ax.axvline(step, color=GREY, lw=0.6, ls=":")
     ax.axhline(1e-7, color=GREY, lw=0.6, ls="--")
-    ax.annotate("battery's step ∛ε", (step, 1e-1), textcoords="offset points", xytext=(3, 0), fontsize=7)
-    ax.annotate("tolerance 1e-7", (1e-10, 1e-7), textcoords="offset points", xytext=(0, 3), fontsize=7)
+    ax.annotate("battery's step ∛ε", (step, 1e-13), textcoords="offset points", xytext=(3, 2), fontsize=7)
+    ax.annotate("tolerance 1e-7", (1e-7, 1e-7), textcoords="offset points", xytext=(0, 3), fontsize=7)
     ax.set_xlabel("step h / s (s: the RMS stretch)")
     ax.set_ylabel("tangent error / M")
-    ax.legend(frameon=False, fontsize=6, ncol=2, loc="upper center")
-    ax.set_ylim(top=1e2)
+    ax.legend(frameon=False, fontsize=6, ncol=2, loc="upper left")
+    ax.set_ylim(1e-13, 1e4)
     finish(fig, [ax], out_svg)
     rows += [[name + " (battery's step)", repr(v["step"]), repr(v["error"])] for name, v in sorted(battery.items())]
     write_csv(out_svg, ["law", "step_over_s", "tangent_error_over_M"], rows)
