@@ -4,10 +4,10 @@
 # (when pvbatch is installed), a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve;
 # and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data, the
-# gmsh deck against CalculiX, the default actuator against CalculiX, and three made from the lines
-# their tests print (the cylinder's convergence, the creep block, the derivative battery's step).
-# About 8 min on 2 cores (the diagnose about 5 of them). Needs the test executables test_solvers,
-# test_creep and test_materials built beside pneufem (build/tests/...).
+# gmsh deck against CalculiX, the default actuator against CalculiX, and five made from the lines
+# their tests print (the cylinder's convergence, the creep block, the derivative battery's step,
+# Mullins, fatigue's order). About 7 min on 2 cores (the diagnose about 5 of them). Needs the test
+# executables test_solvers, test_creep, test_materials and test_damage built beside pneufem (build/tests/...).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -49,8 +49,9 @@ cp "$RUN/treloar/fit/fit.csv" docs/figures/verification_treloar_ogden3.csv
 "$EXE" simulate tests/data/ccx_gmsh/scene.toml --out "$RUN/ccx_gmsh"
 /usr/bin/python3 docs/figures/calculix_gmsh.py "$RUN/ccx_gmsh/angles.csv" docs/figures/verification_calculix_gmsh.svg
 # ... the default actuator on its own mesh against CalculiX (bench/results/ccx_h4, ccx_h2: committed);
-# and three tests' own series: CylinderInflation.ObservedConvergenceOrderOfTet10 (~15 s), the creep
-# block in both moduli conventions (~5 s) and MaterialBattery.TangentDifferenceErrorIsAVInTheStep (< 1 s).
+# and five tests' own series: CylinderInflation.ObservedConvergenceOrderOfTet10 (~2 s), the creep
+# block in both moduli conventions, MaterialBattery.TangentDifferenceErrorIsAVInTheStep, Mullins against
+# the 1-D Ogden-Roxburgh curve and fatigue's order of convergence (each < 1 s).
 FIG=docs/figures/verification_figures.py
 /usr/bin/python3 $FIG calculix docs/figures/verification_calculix_default.svg
 "$TESTS/engine/test_solvers" --gtest_filter=CylinderInflation.ObservedConvergenceOrderOfTet10 > "$RUN/cylinder.txt"
@@ -59,4 +60,7 @@ FIG=docs/figures/verification_figures.py
 /usr/bin/python3 $FIG creep "$RUN/creep.txt" docs/figures/verification_creep_sls.svg
 "$TESTS/materials/test_materials" --gtest_filter='*TangentDifferenceErrorIsAVInTheStep*' > "$RUN/derivative.txt"
 /usr/bin/python3 $FIG derivative "$RUN/derivative.txt" docs/figures/verification_derivative_step.svg
+"$TESTS/damage/test_damage" --gtest_filter='Mullins.UniaxialLoadUnloadReload*:Fatigue.ConstantDriverMatches*:Fatigue.SaturatingLawSolves*' > "$RUN/damage.txt"
+/usr/bin/python3 $FIG mullins "$RUN/damage.txt" docs/figures/verification_mullins_or1d.svg
+/usr/bin/python3 $FIG fatigue "$RUN/damage.txt" docs/figures/verification_fatigue_order.svg
 echo "figures written to docs/figures (runs in $RUN)"

@@ -7,11 +7,16 @@
                 against the standard linear solid, in both moduli conventions
     derivative  MaterialBattery.TangentDifferenceErrorIsAVInTheStep: the tangent's
                 central-difference error against the step, for every law, with the battery's step
+    mullins     Mullins.UniaxialLoadUnloadReloadMatchesOgdenRoxburgh1D: load, unload, reload and
+                further load against the 1-D Ogden-Roxburgh curve
+    fatigue     Fatigue.ConstantDriverMatchesExactSolutionAtFirstOrder and
+                Fatigue.SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution: the integrity's
+                error against the number of steps (first order), n = 1 and n = 3
     calculix    the default actuator on pneufem's own mesh (h = 4 and 2 mm) against CalculiX 2.20,
                 from the cross-check's results in bench/results/ccx_h4 and ccx_h2
 
-The first three read the lines the tests print ("cylinder level: ...", "creep series ...",
-"fd series ..."); the fourth reads committed results. Each writes the SVG and, beside it, every
+All but calculix read the lines the tests print ("cylinder level: ...", "creep series ...",
+"fd series ...", "mullins series ...", "fatigue series ..."); calculix reads committed results. Each writes the SVG and, beside it, every
 plotted series as CSV. Made by docs/figures/make_figures.sh; Debian's python3 with matplotlib.
 
     /usr/bin/python3 docs/figures/verification_figures.py cylinder TEST_OUTPUT.txt OUT.svg
@@ -152,6 +157,58 @@ def derivative(test_output, out_svg):
     print("derivative: at the battery's step, worst %.2e of M (tolerance 1e-7)" % max(v["error"] for v in battery.values()))
 
 
+def mullins(test_output, out_svg):
+    legs = {}
+    for name, v in fields(test_output, "mullins series"):
+        legs.setdefault(name, []).append((v["stretch"], v["P11_Pa"] / 1e3, v["reference_Pa"] / 1e3, v["elastic_Pa"] / 1e3))
+    style()
+    fig, ax = plt.subplots(figsize=(3.5, 2.8))
+    colours = [BLUE, VERMILION, GREEN, PURPLE]
+    markers = ["o", "v", "^", "s"]
+    rows, elastic = [], sorted({(r[0], r[3]) for rs in legs.values() for r in rs})
+    ax.plot([x for x, _ in elastic], [p for _, p in elastic], "-", color=GREY, lw=0.8, label="elastic base (Yeoh)")
+    for (name, rs), c, m in zip(legs.items(), colours, markers):
+        ax.plot([r[0] for r in rs], [r[2] for r in rs], "-", color=c, lw=1.0)
+        ax.plot([r[0] for r in rs], [r[1] for r in rs], m, color=c, ms=3, mfc="none", mew=0.8, label=name.replace("->", "→"))
+        rows += [[name, repr(a), repr(b * 1e3), repr(r * 1e3), repr(e * 1e3)] for a, b, r, e in rs]
+    ax.set_xlabel("stretch λ")
+    ax.set_ylabel("nominal stress P₁₁ (kPa)")
+    ax.set_xlim(1.0, None)
+    ax.set_ylim(bottom=0)
+    ax.legend(frameon=False, loc="upper left", fontsize=7, title="pneufem (markers), 1-D reference (lines)", title_fontsize=7)
+    finish(fig, [ax], out_svg)
+    write_csv(out_svg, ["leg", "stretch", "pneufem_P11_Pa", "reference_P11_Pa", "elastic_P11_Pa"], rows)
+    worst = max(abs(float(r[2]) - float(r[3])) for r in rows) / max(abs(float(r[3])) for r in rows)
+    print("mullins: largest |pneufem - reference| %.1e of the largest stress" % worst)
+
+
+def fatigue(test_output, out_svg):
+    series = {}
+    for name, v in fields(test_output, "fatigue series"):
+        series.setdefault(name, []).append(v)
+    style()
+    fig, ax = plt.subplots(figsize=(3.5, 2.7))
+    rows = []
+    for (name, vs), c in zip(sorted(series.items()), (BLUE, VERMILION)):
+        n = [v["steps"] for v in vs]
+        err = [abs(v["integrity"] - v["exact"]) for v in vs]
+        ax.loglog(n, err, "o-", color=c, ms=3.5, lw=1.0, label="backward Euler, " + name)
+        if "leading" in vs[0]:
+            ax.loglog(n, [v["leading"] for v in vs], "--", color=GREY, lw=0.8, label="leading term s (gT/τ)² / 2N")
+        rows += [[name, int(v["steps"]), repr(v["integrity"]), repr(v["exact"]), repr(e), repr(v.get("leading", ""))]
+                 for v, e in zip(vs, err)]
+    ax.set_xticks([10, 20, 40, 80, 160, 320], ["10", "20", "40", "80", "160", "320"])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel("steps N over the history")
+    ax.set_ylabel("|integrity − exact|")
+    ax.legend(frameon=False, loc="lower left", fontsize=7)
+    finish(fig, [ax], out_svg)
+    write_csv(out_svg, ["law", "steps", "integrity", "exact", "abs_error", "leading_term"], rows)
+    for name, vs in sorted(series.items()):
+        e = [abs(v["integrity"] - v["exact"]) for v in vs]
+        print("fatigue %s: observed order on the finest pair %.3f" % (name, math.log2(e[-2] / e[-1])))
+
+
 def calculix(out_svg):
     style()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(3.5, 3.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
@@ -179,7 +236,8 @@ def calculix(out_svg):
 
 def main():
     what = sys.argv[1] if len(sys.argv) > 1 else ""
-    makers = {"cylinder": cylinder, "creep": creep, "derivative": derivative, "calculix": calculix}
+    makers = {"cylinder": cylinder, "creep": creep, "derivative": derivative, "mullins": mullins, "fatigue": fatigue,
+              "calculix": calculix}
     if what not in makers:
         sys.exit(__doc__)
     makers[what](*sys.argv[2:])
