@@ -4,9 +4,9 @@
 # (when pvbatch is installed), a compare of the hidden-creep recording,
 # a diagnose, and a compare of the fitted scene; and the Yeoh fit of the Ecoflex 00-50 tensile curve;
 # and the verification manual's (docs/verification.md): the Ogden-3 fit of Treloar's data, the
-# gmsh deck against CalculiX, the default actuator against CalculiX, and five made from the lines
+# gmsh deck against CalculiX, the default actuator against CalculiX, and six made from the lines
 # their tests print (the cylinder's convergence, the creep block, the derivative battery's step,
-# Mullins, fatigue's order). About 7 min on 2 cores (the diagnose about 5 of them). Needs the test
+# Mullins, fatigue's order, the explicit integrator's energy). About 7 min on 2 cores (the diagnose about 5 of them). Needs the test
 # executables test_solvers, test_creep, test_materials and test_damage built beside pneufem (build/tests/...).
 # Usage: docs/figures/make_figures.sh [path/to/pneufem]   (run from anywhere; writes out/tutorial)
 set -euo pipefail
@@ -49,9 +49,9 @@ cp "$RUN/treloar/fit/fit.csv" docs/figures/verification_treloar_ogden3.csv
 "$EXE" simulate tests/data/ccx_gmsh/scene.toml --out "$RUN/ccx_gmsh"
 /usr/bin/python3 docs/figures/calculix_gmsh.py "$RUN/ccx_gmsh/angles.csv" docs/figures/verification_calculix_gmsh.svg
 # ... the default actuator on its own mesh against CalculiX (bench/results/ccx_h4, ccx_h2: committed);
-# and five tests' own series: CylinderInflation.ObservedConvergenceOrderOfTet10 (~2 s), the creep
+# and six tests' own series: CylinderInflation.ObservedConvergenceOrderOfTet10 (~2 s), the creep
 # block in both moduli conventions, MaterialBattery.TangentDifferenceErrorIsAVInTheStep, Mullins against
-# the 1-D Ogden-Roxburgh curve and fatigue's order of convergence (each < 1 s).
+# the 1-D Ogden-Roxburgh curve, fatigue's order of convergence and the explicit integrator's energy (each < 1 s).
 FIG=docs/figures/verification_figures.py
 /usr/bin/python3 $FIG calculix docs/figures/verification_calculix_default.svg
 "$TESTS/engine/test_solvers" --gtest_filter=CylinderInflation.ObservedConvergenceOrderOfTet10 > "$RUN/cylinder.txt"
@@ -63,4 +63,6 @@ FIG=docs/figures/verification_figures.py
 "$TESTS/damage/test_damage" --gtest_filter='Mullins.UniaxialLoadUnloadReload*:Fatigue.ConstantDriverMatches*:Fatigue.SaturatingLawSolves*' > "$RUN/damage.txt"
 /usr/bin/python3 $FIG mullins "$RUN/damage.txt" docs/figures/verification_mullins_or1d.svg
 /usr/bin/python3 $FIG fatigue "$RUN/damage.txt" docs/figures/verification_fatigue_order.svg
+"$TESTS/engine/test_solvers" --gtest_filter=Explicit.UndampedFreeVibrationConservesEnergyWithoutDrift > "$RUN/energy.txt"
+/usr/bin/python3 $FIG energy "$RUN/energy.txt" docs/figures/verification_explicit_energy.svg
 echo "figures written to docs/figures (runs in $RUN)"

@@ -12,11 +12,13 @@
     fatigue     Fatigue.ConstantDriverMatchesExactSolutionAtFirstOrder and
                 Fatigue.SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution: the integrity's
                 error against the number of steps (first order), n = 1 and n = 3
+    energy      Explicit.UndampedFreeVibrationConservesEnergyWithoutDrift: the cantilever's kinetic
+                and strain energy over three periods of free vibration, and their sum
     calculix    the default actuator on pneufem's own mesh (h = 4 and 2 mm) against CalculiX 2.20,
                 from the cross-check's results in bench/results/ccx_h4 and ccx_h2
 
 All but calculix read the lines the tests print ("cylinder level: ...", "creep series ...",
-"fd series ...", "mullins series ...", "fatigue series ..."); calculix reads committed results. Each writes the SVG and, beside it, every
+"fd series ...", "mullins series ...", "fatigue series ...", "energy series ..."); calculix reads committed results. Each writes the SVG and, beside it, every
 plotted series as CSV. Made by docs/figures/make_figures.sh; Debian's python3 with matplotlib.
 
     /usr/bin/python3 docs/figures/verification_figures.py cylinder TEST_OUTPUT.txt OUT.svg
@@ -209,6 +211,32 @@ def fatigue(test_output, out_svg):
         print("fatigue %s: observed order on the finest pair %.3f" % (name, math.log2(e[-2] / e[-1])))
 
 
+def energy(test_output, out_svg):
+    pts = [v for _, v in fields(test_output, "energy series")]
+    t = [v["t_over_T"] for v in pts]
+    ke, ie = [v["kinetic_over_E0"] for v in pts], [v["internal_over_E0"] for v in pts]
+    dev = [100.0 * (k + i - 1.0) for k, i in zip(ke, ie)]
+    style()
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(3.5, 3.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    top.plot(t, ie, "-", color=BLUE, lw=1.0, label="strain energy")
+    top.plot(t, ke, "-", color=VERMILION, lw=1.0, label="kinetic energy")
+    top.plot(t, [k + i for k, i in zip(ke, ie)], "-", color=BLACK, lw=1.0, label="sum")
+    top.set_ylabel("energy / initial energy")
+    top.set_ylim(0, 1.25)
+    top.legend(frameon=False, loc="upper center", ncol=3, fontsize=7)
+    bottom.plot(t, dev, "-", color=BLACK, lw=0.8)
+    for y in (0.3, -0.3):
+        bottom.axhline(y, color=GREY, lw=0.6, ls=":")
+    bottom.axhline(0.0, color=GREY, lw=0.6)
+    bottom.set_ylabel("sum − 1 (%)")
+    bottom.set_xlabel("time / first period")
+    bottom.set_xlim(0, max(t))
+    finish(fig, [top, bottom], out_svg)
+    write_csv(out_svg, ["t_over_T", "kinetic_over_E0", "internal_over_E0", "sum_minus_1_percent"],
+              [[repr(a), repr(k), repr(i), repr(d)] for a, k, i, d in zip(t, ke, ie, dev)])
+    print("energy: largest |sum - 1| %.3f %% (tolerance 0.3 %%)" % max(abs(d) for d in dev))
+
+
 def calculix(out_svg):
     style()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(3.5, 3.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
@@ -237,6 +265,7 @@ def calculix(out_svg):
 def main():
     what = sys.argv[1] if len(sys.argv) > 1 else ""
     makers = {"cylinder": cylinder, "creep": creep, "derivative": derivative, "mullins": mullins, "fatigue": fatigue,
+              "energy": energy,
               "calculix": calculix}
     if what not in makers:
         sys.exit(__doc__)
