@@ -14,11 +14,13 @@
                 error against the number of steps (first order), n = 1 and n = 3
     energy      Explicit.UndampedFreeVibrationConservesEnergyWithoutDrift: the cantilever's kinetic
                 and strain energy over three periods of free vibration, and their sum
+    lag         PressureLag2.BreakpointsMeetTheToleranceWithoutWaste: the chamber pressure behind a
+                step and a ramp of the inlet, closed forms and the emitted breakpoints, three regimes
     calculix    the default actuator on pneufem's own mesh (h = 4 and 2 mm) against CalculiX 2.20,
                 from the cross-check's results in bench/results/ccx_h4 and ccx_h2
 
 All but calculix read the lines the tests print ("cylinder level: ...", "creep series ...",
-"fd series ...", "mullins series ...", "fatigue series ...", "energy series ..."); calculix reads committed results. Each writes the SVG and, beside it, every
+"fd series ...", "mullins series ...", "fatigue series ...", "energy series ...", "lag ..."); calculix reads committed results. Each writes the SVG and, beside it, every
 plotted series as CSV. Made by docs/figures/make_figures.sh; Debian's python3 with matplotlib.
 
     /usr/bin/python3 docs/figures/verification_figures.py cylinder TEST_OUTPUT.txt OUT.svg
@@ -237,6 +239,40 @@ def energy(test_output, out_svg):
     print("energy: largest |sum - 1| %.3f %% (tolerance 0.3 %%)" % max(abs(d) for d in dev))
 
 
+def lag(test_output, out_svg):
+    exact, points = {}, {}
+    for name, v in fields(test_output, "lag exact"):
+        exact.setdefault(name, []).append(v)
+    for name, v in fields(test_output, "lag breakpoint"):
+        points.setdefault(name, []).append(v)
+    style()
+    fig, axes = plt.subplots(2, 1, figsize=(3.5, 4.0), sharex=True)
+    regimes = sorted({n.split(" trial")[0] for n in exact})  # "zeta 0.450", "zeta 1.000", "zeta 1.250"
+    rows = []
+    for ax, trial, title in ((axes[0], "1", "a step of 5 kPa at 1 s"), (axes[1], "0", "a ramp to 10 kPa over 2 s, then a hold")):
+        inlet = exact[regimes[0] + " trial " + trial]
+        ax.plot([v["t_s"] for v in inlet], [v["inlet_Pa"] / 1e3 for v in inlet], "--", color=GREY, lw=0.8, label="inlet")
+        for regime, c in zip(regimes, (BLUE, VERMILION, GREEN)):
+            key = regime + " trial " + trial
+            label = "ζ = " + regime.split()[1].rstrip("0").rstrip(".")
+            ax.plot([v["t_s"] for v in exact[key]], [v["p_Pa"] / 1e3 for v in exact[key]], "-", color=c, lw=1.0,
+                    label=label)
+            ax.plot([v["t_s"] for v in points[key]], [v["p_Pa"] / 1e3 for v in points[key]], "o", color=c, ms=2.2,
+                    mfc="none", mew=0.7)
+            rows += [[key, "closed form", repr(v["t_s"]), repr(v["p_Pa"]), repr(v["inlet_Pa"])] for v in exact[key]]
+            rows += [[key, "breakpoint", repr(v["t_s"]), repr(v["p_Pa"]), ""] for v in points[key]]
+        ax.set_title(title, fontsize=8)
+        ax.set_ylabel("chamber pressure (kPa)")
+        ax.set_ylim(bottom=0)
+    axes[1].legend(*axes[0].get_legend_handles_labels(), frameon=False, loc="lower right", fontsize=7,
+                   title="lines: closed form\ncircles: breakpoints", title_fontsize=7)
+    axes[1].set_xlabel("time (s)")
+    axes[1].set_xlim(0, 6)
+    finish(fig, axes, out_svg)
+    write_csv(out_svg, ["regime_and_trial", "series", "t_s", "pressure_Pa", "inlet_Pa"], rows)
+    print("lag: %d regimes, %s breakpoints per trial" % (len(regimes), sorted(len(v) for v in points.values())))
+
+
 def calculix(out_svg):
     style()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(3.5, 3.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
@@ -265,7 +301,7 @@ def calculix(out_svg):
 def main():
     what = sys.argv[1] if len(sys.argv) > 1 else ""
     makers = {"cylinder": cylinder, "creep": creep, "derivative": derivative, "mullins": mullins, "fatigue": fatigue,
-              "energy": energy,
+              "energy": energy, "lag": lag,
               "calculix": calculix}
     if what not in makers:
         sys.exit(__doc__)
