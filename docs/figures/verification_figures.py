@@ -16,11 +16,13 @@
                 and strain energy over three periods of free vibration, and their sum
     lag         PressureLag2.BreakpointsMeetTheToleranceWithoutWaste: the chamber pressure behind a
                 step and a ramp of the inlet, closed forms and the emitted breakpoints, three regimes
+    jump        CycleJump.ThreePointRuleBeatsTheLinearOneForGeometricIncrements: the error of a
+                one-cycle jump by either rule against the ratio of successive increments
     calculix    the default actuator on pneufem's own mesh (h = 4 and 2 mm) against CalculiX 2.20,
                 from the cross-check's results in bench/results/ccx_h4 and ccx_h2
 
 All but calculix read the lines the tests print ("cylinder level: ...", "creep series ...",
-"fd series ...", "mullins series ...", "fatigue series ...", "energy series ...", "lag ..."); calculix reads committed results. Each writes the SVG and, beside it, every
+"fd series ...", "mullins series ...", "fatigue series ...", "energy series ...", "lag ...", "jump series ..."); calculix reads committed results. Each writes the SVG and, beside it, every
 plotted series as CSV. Made by docs/figures/make_figures.sh; Debian's python3 with matplotlib.
 
     /usr/bin/python3 docs/figures/verification_figures.py cylinder TEST_OUTPUT.txt OUT.svg
@@ -273,6 +275,26 @@ def lag(test_output, out_svg):
     print("lag: %d regimes, %s breakpoints per trial" % (len(regimes), sorted(len(v) for v in points.values())))
 
 
+def jump(test_output, out_svg):
+    pts = [v for _, v in fields(test_output, "jump series")]
+    r = [v["r"] for v in pts]
+    style()
+    fig, ax = plt.subplots(figsize=(3.5, 2.7))
+    for key, name, c, m in (("linear", "linear rule (1)", VERMILION, "s"), ("three_point", "three-point rule (1′)", BLUE, "o")):
+        ax.semilogy(r, [v[key + "_analytic"] for v in pts], "-", color=c, lw=1.0, label=name + ", analytic")
+        ax.semilogy(r, [v[key] for v in pts], m, color=c, ms=3.5, mfc="none", mew=0.9, label=name + ", computed")
+    ax.axvline(1.0, color=GREY, lw=0.6, ls=":")
+    ax.set_xlabel("ratio r of successive per-cycle increments")
+    ax.set_ylabel("jump error / last increment")
+    ax.legend(frameon=False, loc="lower right", fontsize=6.5)
+    ax.set_ylim(1e-3, 10)
+    finish(fig, [ax], out_svg)
+    write_csv(out_svg, ["r", "three_point", "linear", "three_point_analytic", "linear_analytic"],
+              [[repr(v["r"]), repr(v["three_point"]), repr(v["linear"]), repr(v["three_point_analytic"]),
+                repr(v["linear_analytic"])] for v in pts])
+    print("jump: %d ratios, the three-point rule smaller at every one: %s" % (len(pts), all(v["three_point"] < v["linear"] for v in pts)))
+
+
 def calculix(out_svg):
     style()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(3.5, 3.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
@@ -301,7 +323,7 @@ def calculix(out_svg):
 def main():
     what = sys.argv[1] if len(sys.argv) > 1 else ""
     makers = {"cylinder": cylinder, "creep": creep, "derivative": derivative, "mullins": mullins, "fatigue": fatigue,
-              "energy": energy, "lag": lag,
+              "energy": energy, "lag": lag, "jump": jump,
               "calculix": calculix}
     if what not in makers:
         sys.exit(__doc__)
