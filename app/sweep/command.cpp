@@ -34,6 +34,7 @@
 #include "core/json_writer.h"
 #include "core/version.h"
 #include "scenes/build_model.h"
+#include "scenes/scene_settings.h"
 #include "scenes/scene.h"
 #include "app/sweep/plot.h"
 
@@ -507,8 +508,8 @@ std::string keys_changing_actuator(const Scene& base, const std::vector<ParamSpe
 }
 
 /// --model applied to the points: auto takes the reduced model when every point has one actuator.
-/// `keys` are the points' offline keys (none with --model full).
-ModelPlan plan_model(const SweepOptions& o, const Scene& base, const std::vector<ParamSpec>& params,
+/// `solver` is the base scene's [solver]; `keys` are the points' offline keys (none with --model full).
+ModelPlan plan_model(const SweepOptions& o, const Scene& base, const SolverSettings& solver, const std::vector<ParamSpec>& params,
                      const std::vector<std::vector<std::string>>& overrides,
                      const std::vector<std::optional<OfflineKeys>>& keys) {
   ModelPlan plan;
@@ -516,10 +517,9 @@ ModelPlan plan_model(const SweepOptions& o, const Scene& base, const std::vector
     plan.why = "full FEM (--model full)";
     return plan;
   }
-  const std::string mode = base.string("solver.mode");
-  if (mode != "quasi_static") {
-    const std::string why = "the reduced model runs quasi-static scenes only, and solver.mode = \"" + mode + "\" (" +
-                            base.origin("solver.mode") + ")";
+  if (solver.mode != SolverSettings::Mode::QuasiStatic) {
+    const std::string why = "the reduced model runs quasi-static scenes only, and solver.mode = \"" + mode_name(solver.mode) +
+                            "\" (" + base.origin("solver.mode") + ")";
     if (o.model == "reduced") throw InputError("--model reduced: " + why);
     plan.why = "full FEM: " + why;
     return plan;
@@ -1173,6 +1173,8 @@ SweepResult run_sweep(const SweepOptions& o) {
   const auto wall0 = std::chrono::steady_clock::now();
   check_sweep_options(o);
   const Scene base = Scene::load(o.scene_path, o.sets);
+  // The scene's [solver], checked before anything runs (a scene simulate would refuse is refused here).
+  const SolverSettings solver = solver_settings(base);
   const std::vector<ParamSpec> params = swept_params(o, base);
   const std::vector<std::vector<double>> values = o.lhs > 0 ? lhs_points(params, o.lhs, o.seed) : grid_points(params);
 
@@ -1182,7 +1184,7 @@ SweepResult run_sweep(const SweepOptions& o) {
   add_points(o, base, params, values, result, overrides, keys);
   const std::set<int> fem_points = checked_fem_points(o.fem_points, result.points.size());
   for (int index : fem_points) result.points[static_cast<std::size_t>(index) - 1].fem.emplace();  // pending: sweep.csv's columns
-  const ModelPlan plan = plan_model(o, base, params, overrides, keys);
+  const ModelPlan plan = plan_model(o, base, solver, params, overrides, keys);
   if (!fem_points.empty() && !plan.reduced)
     throw InputError("--fem-points: the points run with the full FEM already (" + plan.why +
                      "); --fem-points compares reduced points with the FEM");
@@ -1191,7 +1193,6 @@ SweepResult run_sweep(const SweepOptions& o) {
   result.offline_parts = plan.offline_parts;
   // --model decides over the scene's own solver.model; every point's resolved scene records it.
   const std::string model_key = std::string("solver.model=\"") + result.model + "\"";
-  const std::string scene_model = base.string("solver.model");
   for (std::vector<std::string>& ov : overrides) ov.push_back(model_key);
   // Each point's resolved scene: what the worker will run, and the key of the resume check.
   std::vector<std::string> scene_text;
@@ -1199,7 +1200,8 @@ SweepResult run_sweep(const SweepOptions& o) {
 
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1, tbb::info::default_concurrency());
   say(o.log, plan.why);
-  if (scene_model != result.model && scene_model != Scene::load("").string("solver.model"))
+  const std::string scene_model = model_name(solver.model);
+  if (scene_model != result.model && solver.model != solver_settings(Scene::load("")).model)
     say(o.log, "--model " + o.model + " decides over the scene's solver.model = \"" + scene_model + "\" (" +
                    base.origin("solver.model") + "): the points run the " + (plan.reduced ? "reduced model" : "full FEM"));
   if (o.scheduler == "slurm") {

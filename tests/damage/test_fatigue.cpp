@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
 #include <string>
@@ -88,6 +89,8 @@ TEST(Fatigue, ConstantDriverMatchesExactSolutionAtFirstOrder) {
     // Backward-Euler error, leading term within 10 % once N is large (the next term is O(1/N^2)).
     const double leading = s_exact * std::pow(g * T / kRate.tau_s, 2) / (2.0 * N);
     err.push_back(s - s_exact);
+    // The series of docs/verification.md's figure (docs/figures/verification_figures.py fatigue).
+    std::printf("fatigue series n = 1: steps %d integrity %.17g exact %.17g leading %.17g\n", N, s, s_exact, leading);
     if (N >= 80) {
       EXPECT_NEAR(err.back(), leading, 0.1 * leading) << "N = " << N;
     }
@@ -126,6 +129,7 @@ TEST(Fatigue, SaturatingLawSolvesItsUpdateAndConvergesToTheExactSolution) {
       s_prev = s;
     }
     err.push_back(s_prev - s_exact);
+    std::printf("fatigue series n = 3: steps %d integrity %.17g exact %.17g\n", N, s_prev, s_exact);
   }
   for (std::size_t i = 2; i < err.size(); ++i) {
     const double order = std::log2(err[i - 1] / err[i]);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -104,6 +105,9 @@ TEST(Mullins, UniaxialLoadUnloadReloadMatchesOgdenRoxburgh1D) {
       leg.P_elastic.push_back(material_P11(elastic, lambda));
       P_scale = std::max(P_scale, std::abs(leg.P.back()));
       const double expected = ref.P11(lambda);
+      // The series of docs/verification.md's figure (docs/figures/verification_figures.py mullins).
+      std::printf("mullins series %s: stretch %.17g P11_Pa %.17g reference_Pa %.17g elastic_Pa %.17g\n", leg.name, lambda,
+                  leg.P.back(), expected, leg.P_elastic.back());
       EXPECT_NEAR(leg.P.back(), expected, 1e-9 * std::max(std::abs(expected), 2.0 * C10))
           << leg.name << " at lambda = " << lambda;
       EXPECT_NEAR(mp.fields().W_max, ref.W_max, 1e-9 * ref.W_max) << leg.name << " at lambda = " << lambda;

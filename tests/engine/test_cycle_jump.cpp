@@ -5,6 +5,7 @@
 // checkpoint written after a jump.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -181,6 +182,9 @@ TEST(CycleJump, ThreePointRuleBeatsTheLinearOneForGeometricIncrements) {
     EXPECT_NEAR(quad_err, expected, 1e-9 * h[3][0]) << "r = " << r;
     EXPECT_NEAR(lin_err, std::abs(1 - r) * Dk, 1e-9 * h[3][0]) << "r = " << r;
     EXPECT_LT(quad_err, lin_err) << "r = " << r;
+    // The series of docs/verification.md's figure (docs/figures/verification_figures.py jump).
+    std::printf("jump series: r %.17g three_point %.17g linear %.17g three_point_analytic %.17g linear_analytic %.17g\n", r,
+                quad_err / Dk, lin_err / Dk, expected / Dk, std::abs(1 - r));
   }
 }
 

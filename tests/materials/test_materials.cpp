@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -163,6 +164,39 @@ TEST_P(MaterialBattery, TangentIsStressGradient) {
       EXPECT_GT(max_abs(r.A_vol), 1e-3 * mu0);
     }
   }
+}
+
+// (c') Why the battery's step is cbrt(eps) s: the tangent's central-difference error against the
+// step is a V, truncation ~h^2 on its right arm and round-off ~eps/h on its left, and the battery's
+// step lies near its bottom. On the first random state, h/s from 1e-1 to 1e-10 (two per decade):
+// the error at the battery's step is within kFdTol and below the error at both ends of the range
+// (where one arm dominates). The series are docs/verification.md's figure
+// (docs/figures/verification_figures.py derivative).
+TEST_P(MaterialBattery, TangentDifferenceErrorIsAVInTheStep) {
+  const auto states = battery_states();
+  const test::State& st = *std::find_if(states.begin(), states.end(), [](const test::State& x) { return x.generic; });
+  const PointResponse r = eval(*material, st.F);
+  const double s = st.F.norm() / std::sqrt(3.0), M = scale_A(r, mu0);
+  const auto error = [&](double h) {
+    Mat9 A_fd;
+    for (int k = 0; k < 3; ++k)
+      for (int L = 0; L < 3; ++L) {
+        Mat3 Fp = st.F, Fm = st.F;
+        Fp(k, L) += h;
+        Fm(k, L) -= h;
+        A_fd.col(flat(k, L)) = flatten(eval(*material, Fp, false).P() - eval(*material, Fm, false).P()) / (2.0 * h);
+      }
+    return max_abs(A_fd - r.A()) / M;
+  };
+  for (int i = 2; i <= 20; ++i) {
+    const double step = std::pow(10.0, -0.5 * i);
+    std::printf("fd series %s: step %.17g error %.17g\n", GetParam().name.c_str(), step, error(step * s));
+  }
+  const double at_battery = error(kStep * s);
+  std::printf("fd battery %s: step %.17g error %.17g\n", GetParam().name.c_str(), kStep, at_battery);
+  EXPECT_LE(at_battery, kFdTol);
+  EXPECT_LT(at_battery, error(1e-1 * s));   // the truncation arm
+  EXPECT_LT(at_battery, error(1e-10 * s));  // the round-off arm
 }
 
 // (d) Hyperelastic, so A is a Hessian: A(iJ, kL) = A(kL, iJ).

@@ -196,6 +196,13 @@ TEST(PressureLag2, BreakpointsMeetTheToleranceWithoutWaste) {
       EXPECT_LE(lag.trials[k].time_s.size(), 200u) << "zeta " << so.zeta() << " trial " << k;
       std::printf("zeta %.3f trial %zu: %zu breakpoints, worst %.3g of the tolerance\n", so.zeta(), k,
                   lag.trials[k].time_s.size(), worst / tol);
+      // The series of docs/verification.md's figure (docs/figures/verification_figures.py lag).
+      for (std::size_t i = 0; i < lag.trials[k].time_s.size(); ++i)
+        std::printf("lag breakpoint zeta %.3f trial %zu: t_s %.17g p_Pa %.17g\n", so.zeta(), k, lag.trials[k].time_s[i],
+                    lag.trials[k].pressure_Pa[i]);
+      for (int i = 0; i <= 150; ++i)
+        std::printf("lag exact zeta %.3f trial %zu: t_s %.17g p_Pa %.17g inlet_Pa %.17g\n", so.zeta(), k, 0.04 * i,
+                    exact_ramp_and_step(so, k, P, 0.04 * i), h.trials[k].pressure(0.04 * i));
     }
     EXPECT_EQ(lag.trials[1].output_s, h.trials[1].output_s);  // reports stay at the inlet command times
   }

@@ -532,6 +532,36 @@ TEST(SweepModel, FemPointsRecordTheFemNrmseAndTheReducedError) {
   fs::remove_all(d);
 }
 
+// The base scene's [solver] is read once into its typed settings (scenes/scene_settings.h): the
+// model plan and its messages use them, with the keys' origins; a [solver] that simulate would
+// refuse is refused before any point runs (before, a bad solver.mode sent every point to fail in
+// its worker, and solver.model = "reduced" in an explicit scene ran as the full FEM unsaid).
+TEST(SweepModel, TheScenesSolverIsReadOnceAndCheckedBeforeAnythingRuns) {
+  const fs::path d = fresh_dir("rom_solver");
+  const std::string sweep = "sweep --param " + kTau + "=100:1000:2 " + kTiny + " --dry-run --out " + d.string() + " ";
+  const std::string why = "the reduced model runs quasi-static scenes only, and solver.mode = \"explicit\" (--set solver.mode)";
+  const Result auto_model = run(sweep + "--set solver.mode=explicit");
+  ASSERT_EQ(auto_model.code, 0) << auto_model.out;
+  EXPECT_NE(auto_model.out.find("full FEM: " + why), std::string::npos) << auto_model.out;
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {"--set solver.mode=explicit --model reduced", "--model reduced: " + why},
+      {"--set solver.mode=explict",
+       "--set solver.mode: key 'solver.mode': must be \"quasi_static\" or \"explicit\", got \"explict\""},
+      {"--set solver.mode=explicit --set solver.model=reduced",
+       "--set solver.model: key 'solver.model': \"reduced\" needs solver.mode = \"quasi_static\""},
+      {"--set solver.rel_tol=-1", "--set solver.rel_tol: key 'solver.rel_tol'"},
+  };
+  for (const Case& c : cases) {
+    const Result r = run(sweep + c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.message), std::string::npos) << c.args << "\n" << r.out;
+  }
+  EXPECT_FALSE(fs::exists(d / "points"));
+}
+
 TEST(SweepModel, BadFemPointsAndModelAreRejectedBeforeAnythingRuns) {
   const fs::path d = fresh_dir("rom_bad");
   struct Case {
