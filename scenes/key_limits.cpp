@@ -117,6 +117,7 @@ std::vector<KeyLimit> make_limits() {
   l.push_back(positive("solver.time_scale", 1e6, "1e6 times faster turns minutes into microseconds"));
   l.push_back(closed("solver.reduced_modes", 1, 1000, "the reduced model uses tens of modes"));
   l.push_back(KeyLimit{"solver.reduced_ecsw_tol", 0.0, 1.0, true, true, "a relative error"});
+  l.push_back(closed("solver.reduced_ecsw_blocks", 0, 10000, "0 = one block per softening cluster; tens of blocks are plenty"));
   l.push_back(closed("solver.reduced_softened_levels", 0, 20, "each level is a nonlinear solve per field and mode sample"));
   l.push_back(positive("solver.reduced_check_deg", 360.0, "an angle error in degrees"));
   l.push_back(closed("solver.reduced_enrich_rounds", 0, 10, "each round is a basis build, a reduced run and a replay"));

@@ -143,6 +143,8 @@ SolverSettings solver_settings(const Scene& s) {
                                                                                           {"sampled", RomBasisOptions::StiffParts::sampled}});
   sv.reduced.release_responses = s.boolean("solver.reduced_release_modes");
   if (sv.reduced.ecsw_tolerance >= 1.0) s.fail("solver.reduced_ecsw_tol", "must lie in (0, 1)");
+  sv.reduced.ecsw_blocks = s.integer("solver.reduced_ecsw_blocks");
+  if (sv.reduced.ecsw_blocks < 0) s.fail("solver.reduced_ecsw_blocks", "must be >= 0 (0: one block per softening cluster)");
   sv.reduced_check_deg = positive(s, "solver.reduced_check_deg");
   sv.reduced_check_at = choice<SolverSettings::CheckAt>(s, "solver.reduced_check_at", {{"tops", SolverSettings::CheckAt::Tops},
                                                                                        {"reports", SolverSettings::CheckAt::Reports}});

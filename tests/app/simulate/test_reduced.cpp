@@ -216,8 +216,8 @@ TEST(SimulateReduced, TheCheckCorrectsAtTheTopsOrAtEveryLoadedReport) {
             std::string::npos);
 }
 
-// solver.reduced_fabric and solver.reduced_release_modes reach the basis (RomBasisOptions::stiff_parts,
-// release_responses): a basis built with them is not taken from the cache of the default one (the
+// solver.reduced_fabric, solver.reduced_release_modes and solver.reduced_ecsw_blocks reach the basis
+// (RomBasisOptions::stiff_parts, release_responses, ecsw_blocks): a basis built with them is not taken from the cache of the default one (the
 // key names them), the release responses add modes of their own, and the run with the fabric exact
 // follows the full FEM as the default does (the 0.1 deg of ReportsTheReducedRunAndReusesItsCacheBitForBit).
 TEST(SimulateReduced, TheFabricAndReleaseKeysReachTheBasis) {
@@ -235,6 +235,13 @@ TEST(SimulateReduced, TheFabricAndReleaseKeysReachTheBasis) {
     EXPECT_NEAR(rk.records[i].angle_deg, rf.records[i].angle_deg, 0.1) << "report " << i;
   EXPECT_NE(error_of([&] { run(keyed, {"solver.model=\"reduced\"", "solver.reduced_fabric=\"cubic\""}); }).find("solver.reduced_fabric"),
             std::string::npos);
+  // solver.reduced_ecsw_blocks: one block per region keeps fewer elements than one per cluster,
+  // and is not the default basis from the cache.
+  const fs::path blocks = temp_dir("keys_blocks");
+  run(blocks, {"solver.model=\"reduced\"", "solver.reduced_ecsw_blocks=1"}, cache.string());
+  const nlohmann::json sb = summary(blocks);
+  EXPECT_EQ(sb["reduced_model"]["offline"]["basis"], "computed");
+  EXPECT_LT(sb["reduced_model"]["offline"]["sampled_elements"].get<double>(), sp["reduced_model"]["offline"]["sampled_elements"].get<double>());
 }
 
 TEST(SimulateReduced, BadReducedKeysAreErrors) {
@@ -243,6 +250,8 @@ TEST(SimulateReduced, BadReducedKeysAreErrors) {
   EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_modes=0"}); }).find("solver.reduced_modes"),
             std::string::npos);
   EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_ecsw_tol=1.5"}); }).find("solver.reduced_ecsw_tol"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.reduced_ecsw_blocks=-1"}); }).find("solver.reduced_ecsw_blocks"),
             std::string::npos);
   EXPECT_NE(error_of([&] { run(dir, {"solver.model=\"reduced\"", "solver.mode=\"explicit\""}); }).find("quasi_static"),
             std::string::npos);
