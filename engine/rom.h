@@ -122,7 +122,7 @@ struct RomBasisOptions {
   /// The blocks whose reduced force ECSW reproduces: 0 = each softening cluster (the default), else
   /// about this many k-means blocks of the soft elements, at least one per region. A block must hold
   /// more elements than its training force has independent components at ecsw_tolerance for the fit
-  /// to leave any out: with 48 clusters of ~70 elements and 64-128 modes it kept ~80 % of the soft
+  /// to leave any out: with 48 clusters of ~70 elements and 64-171 modes it kept ~60 % of the soft
   /// elements of the h = 6 story (bench/results/rom_h6_ceiling section 12); one block per region
   /// (ecsw_blocks = 1) integrates each region's force, the sampled elements then set by the modes,
   /// not the mesh. The stiff parts' sampled blocks follow the same count. Large blocks are fitted

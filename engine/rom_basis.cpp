@@ -1063,7 +1063,7 @@ ReducedBasis build_reduced_basis(const Model& reference, const ElasticPathTrace&
                                                           : std::vector<RemainderState>{};
   set_sampled_elements(reference, A.geometry(), clusters, train, remainder_train, opt, B);
   if (opt.verbose)
-    std::fprintf(stderr, "reduced basis: ECSW kept %zu of %d soft elements (%zu training states, worst cluster residual %.2e), %.1f s\n",
+    std::fprintf(stderr, "reduced basis: ECSW kept %zu elements (soft and stiff) of %d soft (%zu training states, worst block residual %.2e), %.1f s\n",
                  B.elements.size(), B.info.soft_elements, train.size(), B.info.ecsw_worst_residual, seconds_since(t_start));
 
   // 4. The reference's hyper-reduced force at q = 0 on the fine grid, and its Jacobian per sample.
