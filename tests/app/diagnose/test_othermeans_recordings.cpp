@@ -89,6 +89,11 @@ TEST(OtherMeansNull, SmallStaticMisfitsNameNothing) {
     ASSERT_EQ(r.candidates.size(), 1u);
     EXPECT_GE(r.candidates[0].static_change_nrmse, 0.0);
     EXPECT_LT(r.candidates[0].static_change_nrmse, 0.05) << name;
+    // A static misfit grows nothing over the trials: the growth split is not significant (measured
+    // 0.4, 1.3, 1.1 standard errors), so the growth round has nothing to act on.
+    EXPECT_FALSE(r.baseline_growth.significant) << name << ": " << r.baseline_growth.difference_deg << " +- "
+                                                << r.baseline_growth.difference_se_deg;
+    EXPECT_TRUE(r.growth_note.empty()) << name << ": " << r.growth_note;
   }
 }
 
@@ -120,6 +125,10 @@ TEST(OtherMeansNull, AnotherMeshsCurveIsNamedAsStiffnessWithTheRestStatic) {
   ASSERT_EQ(r.selected, std::vector<std::string>{"stiffness"});
   EXPECT_GT(r.candidates[0].static_change_nrmse, 0.05);
   EXPECT_GT(r.static_share, 0.9);
+  // Ten trials of another mesh's curve: no growth over the trials, before or after (measured -0.01 +-
+  // 0.01 deg, 0.7 and 0.6 standard errors).
+  EXPECT_FALSE(r.baseline_growth.significant) << r.baseline_growth.difference_deg << " +- " << r.baseline_growth.difference_se_deg;
+  EXPECT_FALSE(r.final_growth.significant) << r.final_growth.difference_deg << " +- " << r.final_growth.difference_se_deg;
 }
 
 // ---- Item 5 in CI: the first-order lag against the candidates that could stand in for it (a static
