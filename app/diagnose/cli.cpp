@@ -52,6 +52,11 @@ std::unique_ptr<DiagnoseCommand> add_diagnose_command(CLI::App& app) {
   c->cmd->add_flag_callback(
       "--all-rounds", [o = &c->options] { o->stop_at_noise_floor = false; },
       "Run every forward-selection round, even when the residual is already at the noise floor");
+  c->cmd->add_flag_callback(
+      "--no-growth-round", [o = &c->options] { o->growth_round = false; },
+      "Skip the growth round: by default, when the final residual's top holds grow over the trials significantly "
+      "beyond its rests (3 standard errors) and no fatigue is selected, the fatigue forms are tried once more on the "
+      "RSS weighed with that growth's evidence (up to 2 calibrations per form)");
   c->cmd->add_flag("--trust-elastic-model", c->options.trust_elastic_model,
                    "The elastic response is known to be right (converged mesh of the measured geometry, calibrated "
                    "material): an effect after the first may then be one that only corrects the static angle curve "

@@ -150,9 +150,25 @@ struct Signature {
   /// 0 with fewer than three trials having both.
   double top_growth_deg = 0.0, rest_growth_deg = 0.0;
   int growth_trials = 0;              ///< trials the two growths are taken over (0: not computed)
+  /// The growth of the difference top - rest per trial (= top_growth_deg - rest_growth_deg): a
+  /// fatigue's signature is a positive one, a creep recovering slower than modelled a negative one.
+  double split_growth_deg = 0.0;
+  /// Standard errors of the three growths (deg): per trial, the larger of the angle noise's error of
+  /// the trial's mean (noise / sqrt(frames), the top's and the rest's combined for the difference)
+  /// and, from four trials after the first, the scatter of the trial means about their line; then the
+  /// least-squares slope's error times the span (growth_significant judges a growth by it).
+  double top_growth_se_deg = 0.0, rest_growth_se_deg = 0.0, split_growth_se_deg = 0.0;
 };
 
+/// A growth of the split is significant when it is at least kGrowthSigmas standard errors and at
+/// least half the last digit printed (0.005 deg: noise-free data give a zero error).
+constexpr double kGrowthSigmas = 3.0;
+bool growth_significant(double growth_deg, double se_deg);
+
 Signature signature_of(const Comparison& c);
+
+/// The growth split of `s` as the outputs record it (DiagnosisResult::baseline_growth, final_growth).
+GrowthSplit growth_split_of(const Signature& s);
 
 /// The growth split in words: "over the 5 trials after the first the residual (measured - model)
 /// grows by +0.43 deg at the top holds and +0.06 deg at rest"; "" when not computed.

@@ -11,21 +11,39 @@ namespace pneufem::diagnose_detail {
 
 namespace {
 
-/// Least-squares growth of y over its index range (slope x (n - 1)); 0 for fewer than two points.
-double growth_over(const std::vector<double>& y) {
+/// A least-squares growth over the trials: slope x (n - 1) of y against its index, and the standard
+/// error of that growth. The error of each point is the larger of `sigma_noise` (what the angle
+/// tracking noise alone gives a point) and, with two or more degrees of freedom (four points), the
+/// scatter of the points about the line: the trials' own variation (the regulator, the lag's
+/// transients, a model error that changes with the trial) counts when it is larger than the noise.
+struct Growth {
+  double value = 0.0, se = 0.0;
+};
+Growth growth_over(const std::vector<double>& y, double sigma_noise) {
+  Growth g;
   const std::size_t n = y.size();
-  if (n < 2) return 0.0;
+  if (n < 2) return g;
   double mx = 0.5 * static_cast<double>(n - 1), my = 0.0;
   for (double v : y) my += v / static_cast<double>(n);
   double sxy = 0.0, sxx = 0.0;
   for (std::size_t i = 0; i < n; ++i) sxy += (static_cast<double>(i) - mx) * (y[i] - my), sxx += sq(static_cast<double>(i) - mx);
-  return sxy / sxx * static_cast<double>(n - 1);
+  const double slope = sxy / sxx;
+  g.value = slope * static_cast<double>(n - 1);
+  double sigma = sigma_noise;
+  if (n >= 4) {
+    double ss = 0.0;
+    for (std::size_t i = 0; i < n; ++i) ss += sq(y[i] - my - slope * (static_cast<double>(i) - mx));
+    sigma = std::max(sigma, std::sqrt(ss / static_cast<double>(n - 2)));
+  }
+  g.se = sigma / std::sqrt(sxx) * static_cast<double>(n - 1);
+  return g;
 }
 
-/// Signature::top_growth_deg and rest_growth_deg of `c` (see there).
+/// Signature::top_growth_deg, rest_growth_deg, their difference and standard errors of `c` (see there).
 constexpr double kTopHold = 0.95;  // a top hold: at the highest level (a commanded level, within 5 %)
 void add_growth_split(const Comparison& c, double lvl_max, Signature& s) {
-  std::vector<double> top, rest;
+  std::vector<double> top, rest, diff;
+  double var_top = 0.0, var_rest = 0.0;  // mean over the trials of the noise variance of a trial's mean
   for (std::size_t k = 1; k < c.trials.size(); ++k) {
     double t = 0.0, r = 0.0;
     long nt = 0, nr = 0;
@@ -38,10 +56,18 @@ void add_growth_split(const Comparison& c, double lvl_max, Signature& s) {
     if (nt == 0 || nr == 0) continue;
     top.push_back(t / static_cast<double>(nt));
     rest.push_back(r / static_cast<double>(nr));
+    diff.push_back(top.back() - rest.back());
+    const double noise = c.trials[k].noise_deg;
+    var_top += sq(noise) / static_cast<double>(nt);
+    var_rest += sq(noise) / static_cast<double>(nr);
   }
   if (top.size() < 2 || c.trials.size() < 3) return;
-  s.top_growth_deg = growth_over(top);
-  s.rest_growth_deg = growth_over(rest);
+  var_top /= static_cast<double>(top.size()), var_rest /= static_cast<double>(top.size());
+  const Growth gt = growth_over(top, std::sqrt(var_top)), gr = growth_over(rest, std::sqrt(var_rest)),
+               gd = growth_over(diff, std::sqrt(var_top + var_rest));
+  s.top_growth_deg = gt.value, s.top_growth_se_deg = gt.se;
+  s.rest_growth_deg = gr.value, s.rest_growth_se_deg = gr.se;
+  s.split_growth_deg = gd.value, s.split_growth_se_deg = gd.se;
   s.growth_trials = static_cast<int>(top.size());
 }
 
@@ -236,10 +262,33 @@ std::string rest_sentence(const Signature& s) {
 
 }  // namespace
 
+bool growth_significant(double growth_deg, double se_deg) {
+  return std::abs(growth_deg) >= kGrowthSigmas * se_deg && std::abs(growth_deg) >= 0.005;
+}
+
+GrowthSplit growth_split_of(const Signature& s) {
+  GrowthSplit g;
+  g.trials = s.growth_trials;
+  g.top_deg = s.top_growth_deg, g.rest_deg = s.rest_growth_deg, g.difference_deg = s.split_growth_deg;
+  g.top_se_deg = s.top_growth_se_deg, g.rest_se_deg = s.rest_growth_se_deg, g.difference_se_deg = s.split_growth_se_deg;
+  g.significant = s.growth_trials >= 2 && growth_significant(s.split_growth_deg, s.split_growth_se_deg);
+  return g;
+}
+
 std::string growth_split_text(const Signature& s) {
   if (s.growth_trials < 2) return "";
+  const double d = s.split_growth_deg, se = s.split_growth_se_deg;
+  std::string verdict;
+  if (!growth_significant(d, se))
+    verdict = "not significant: the top holds and the rests grow alike";
+  else if (d > 0.0)
+    verdict = "significant: the top holds grow more than the rests, a permanent softening's (fatigue's) signature";
+  else
+    verdict = "significant: the rests grow more than the top holds, a slower recovery than modelled (creep)";
+  const std::string sigmas = se > 0.0 ? fmt("%.1f", std::abs(d) / se) + " standard errors, " : std::string();
   return "over the " + std::to_string(s.growth_trials) + " trials after the first the residual (measured - model) grows by " +
-         fmt("%+.2f", s.top_growth_deg) + " deg at the top holds and " + fmt("%+.2f", s.rest_growth_deg) + " deg at rest";
+         fmt("%+.2f", s.top_growth_deg) + " deg at the top holds and " + fmt("%+.2f", s.rest_growth_deg) +
+         " deg at rest (top minus rest " + fmt("%+.2f", d) + " +- " + fmt("%.2f", se) + " deg: " + sigmas + verdict + ")";
 }
 
 std::string evidence(const std::string& effect, const Signature& s) {

@@ -32,6 +32,10 @@ struct DiagnoseOptions {
   /// (fit_static_discrepancy); true = the elastic response is known to be right (a converged mesh of
   /// the measured geometry, a calibrated material), so a static remainder may be named as an effect.
   bool trust_elastic_model = false;
+  /// After the rounds, when the residual's top holds grow over the trials significantly beyond its
+  /// rests and no fatigue form is selected: the fatigue forms tried on the RSS weighed with that
+  /// growth's evidence (app/diagnose/command.cpp, growth_round). false: --no-growth-round.
+  bool growth_round = true;
   int rom_points = 2000;                ///< material points of the reduced model
   bool verify = false;                  ///< re-run baseline and fitted scene with the full FEM
   /// Space-mapping refinements of the selected constants (app/diagnose/fem.cpp): N refinements cost
@@ -184,6 +188,13 @@ struct RoundCost {
 struct GrowthSplit {
   int trials = 0;  ///< trials after the first it is taken over
   double top_deg = 0.0, rest_deg = 0.0;
+  /// The growth of top - rest (top_deg - rest_deg) and the standard errors (Signature in detail.h):
+  /// `significant` when |difference| >= 3 standard errors (and >= 0.005 deg): positive, the top holds
+  /// grow beyond the rests (a fatigue's signature), negative, the rests beyond the top (a creep's
+  /// recovery slower than modelled).
+  double difference_deg = 0.0;
+  double top_se_deg = 0.0, rest_se_deg = 0.0, difference_se_deg = 0.0;
+  bool significant = false;
 };
 
 struct DiagnosisResult {
@@ -193,6 +204,7 @@ struct DiagnosisResult {
   double noise_floor_nrmse = 0.0;
   GrowthSplit baseline_growth;              ///< of the baseline's residual
   GrowthSplit final_growth;                 ///< of the final model's residual
+  std::string growth_note;                  ///< what a significant final_growth says, in words ("" = not significant)
   std::vector<CandidateResult> candidates;  ///< round 1 best first, then later rounds
   std::vector<std::string> selected;
   std::string missing_effect;               ///< "" = none significant

@@ -27,6 +27,8 @@ namespace {
 std::string growth_split_json(const GrowthSplit& g) {
   json::Object o;
   o.add("trials", g.trials).add("top_deg", g.top_deg).add("rest_deg", g.rest_deg);
+  o.add("difference_deg", g.difference_deg).add("top_se_deg", g.top_se_deg).add("rest_se_deg", g.rest_se_deg);
+  o.add("difference_se_deg", g.difference_se_deg).add("difference_significant", g.significant ? "true" : "false");
   return o.str(4);
 }
 
@@ -195,6 +197,7 @@ std::string diagnosis_json(const Scene& scene, const PathModelEvaluator& rom, co
   root.add("final_rmse_deg_per_trial", json::array(out.final_rmse_deg_per_trial));
   if (out.verified_fitted_nrmse >= 0) root.add("final_nrmse_fem", out.verified_fitted_nrmse);
   if (out.final_growth.trials > 0) root.add("final_growth_split", growth_split_json(out.final_growth));
+  if (!out.growth_note.empty()) root.add_str("growth_note", out.growth_note);
   json::Object sr;
   sr.add("nrmse", out.final_nrmse_beyond_static).add("share_of_excess", out.static_share).add_str("note", out.static_note);
   root.add("static_remainder", sr.str(2));

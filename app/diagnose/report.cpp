@@ -204,13 +204,18 @@ std::string diagnosis_report(const Scene& scene, const Recording& rec, const Pat
     // Where the angle grows over the trials: a creep grows the top holds and the rests alike, a
     // permanent softening (fatigue) the top holds only.
     const auto split = [](const GrowthSplit& g) {
-      return fmt("%+.2f", g.top_deg) + " deg at the top holds, " + fmt("%+.2f", g.rest_deg) + " deg at rest";
+      return fmt("%+.2f", g.top_deg) + " deg at the top holds, " + fmt("%+.2f", g.rest_deg) + " deg at rest (top minus rest " +
+             fmt("%+.2f", g.difference_deg) + " +- " + fmt("%.2f", g.difference_se_deg) + " deg, " +
+             (g.significant ? "significant" : "not significant") + ")";
     };
     s += "Growth over the " + std::to_string(out.baseline_growth.trials) +
          " trials after the first (measured - model): baseline " + split(out.baseline_growth) +
          (out.final_growth.trials > 0 && !out.selected.empty() ? "; final model " + split(out.final_growth) : std::string()) +
-         ". A creep that recovers slower than the rests grows both, a permanent softening (fatigue) the top holds.\n\n";
+         ". A creep that recovers slower than the rests grows both, a permanent softening (fatigue) the top holds; a "
+         "difference is significant at 3 standard errors (per trial, the angle noise's error of the means or their "
+         "scatter about the line, whichever is larger).\n\n";
   }
+  if (!out.growth_note.empty()) s += "What the growth left says: " + out.growth_note + ".\n\n";
   if (!out.fem_error.empty()) s += "Refinement / full FEM: " + out.fem_error + "\n\n";
   s += "## Files\n\n"
        "- `diagnosis.json`: every number of this report (schema in the README).\n"

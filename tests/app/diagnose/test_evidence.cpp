@@ -3,7 +3,11 @@
 // text with the numbers filled in, and a user's ten-trial recording got "the error grows from trial
 // 1 to the last trial (rms 0.55 -> 0.53 deg)" (issue 28). Here each sentence is fed signatures of
 // both signs and of a size within the noise, and must say which.
+#include <cmath>
+#include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -135,6 +139,80 @@ TEST(Evidence, GrowthSplitSeparatesTheTopHoldsFromTheRests) {
   c.trials.resize(2);  // one trial after the first: no growth to take
   EXPECT_EQ(signature_of(c).growth_trials, 0);
   EXPECT_FALSE(says(evidence("fatigue_uniform", signature_of(c)), "at rest"));
+}
+
+/// A comparison of `means.size()` trials at 0-10-20-30 kPa, 90 frames a step and `noise_deg` of angle
+/// noise: the top hold's mean residual (model - measured) of trial k is -top[k], the rest's -rest[k].
+Comparison split_comparison(const std::vector<double>& top, const std::vector<double>& rest, double noise_deg) {
+  Comparison c;
+  for (std::size_t k = 0; k < top.size(); ++k) {
+    TrialComparison t;
+    t.trial = static_cast<int>(k) + 1;
+    t.noise_deg = noise_deg;
+    for (double level : {0.0, 10.0, 20.0, 30.0}) {
+      StepComparison st;
+      st.level_kPa = level, st.frames = 90;
+      st.mean_residual_deg = level == 30.0 ? -top[k] : level == 0.0 ? -rest[k] : 0.0;
+      t.steps.push_back(st);
+    }
+    c.trials.push_back(t);
+  }
+  return c;
+}
+
+// The significance of the split (issue 35: is the top-minus-rest growth more than the trials' noise?).
+// Per trial the noise of a mean of 90 frames at 0.08 deg is 0.0084 deg (0.012 for top minus rest), so
+// over trials 2-6 (slope error x span: 0.012 / sqrt(10) x 4 = 0.015) a growth of 0.2 deg is ~13 standard
+// errors and 0.02 deg is not significant; a static misfit, the same in every trial, grows nothing.
+TEST(Evidence, GrowthSplitSignificanceWeighsTheTrendAgainstTheTrialsNoise) {
+  const double noise = 0.08, se_mean = noise / std::sqrt(90.0);
+  // A fatigue: the top holds grow 0.05 deg a trial, the rests not (trial 1 left out: 5.0 is ignored).
+  Signature s = signature_of(split_comparison({5.0, 0.0, 0.05, 0.10, 0.15, 0.20}, {5.0, 0, 0, 0, 0, 0}, noise));
+  EXPECT_EQ(s.growth_trials, 5);
+  EXPECT_NEAR(s.split_growth_deg, 0.2, 1e-12);
+  EXPECT_NEAR(s.split_growth_se_deg, std::sqrt(2.0) * se_mean / std::sqrt(10.0) * 4.0, 1e-12);  // the noise: no scatter
+  EXPECT_NEAR(s.top_growth_se_deg, se_mean / std::sqrt(10.0) * 4.0, 1e-12);
+  EXPECT_TRUE(growth_significant(s.split_growth_deg, s.split_growth_se_deg));
+  EXPECT_TRUE(growth_split_of(s).significant);
+  EXPECT_TRUE(says(growth_split_text(s), "significant: the top holds grow more than the rests")) << growth_split_text(s);
+  // A creep the model recovers too fast: the rests grow more than the top holds.
+  s = signature_of(split_comparison({0, 0.0, 0.05, 0.10, 0.15, 0.20}, {0, 0.0, 0.1, 0.2, 0.3, 0.4}, noise));
+  EXPECT_NEAR(s.split_growth_deg, -0.2, 1e-12);
+  EXPECT_TRUE(says(growth_split_text(s), "significant: the rests grow more than the top holds")) << growth_split_text(s);
+  // Both alike, and a small top-only growth (0.02 deg, ~1.3 standard errors): not significant.
+  for (const auto& [top, rest] : {std::pair<std::vector<double>, std::vector<double>>{{0, 0, 0.1, 0.2, 0.3, 0.4}, {0, 0, 0.1, 0.2, 0.3, 0.4}},
+                                  {{0, 0, 0.005, 0.01, 0.015, 0.02}, {0, 0, 0, 0, 0, 0}}}) {
+    s = signature_of(split_comparison(top, rest, noise));
+    EXPECT_FALSE(growth_split_of(s).significant) << growth_split_text(s);
+    EXPECT_TRUE(says(growth_split_text(s), "not significant")) << growth_split_text(s);
+  }
+  // A static misfit (the same large offset in every trial, at the top only): no growth.
+  s = signature_of(split_comparison({0.7, 0.7, 0.7, 0.7, 0.7, 0.7}, {0, 0, 0, 0, 0, 0}, noise));
+  EXPECT_NEAR(s.split_growth_deg, 0.0, 1e-12);
+  EXPECT_FALSE(growth_split_of(s).significant);
+  // Trials that scatter more than the noise (a trial-to-trial misfit of +-0.1 deg at the top): the
+  // scatter about the line sets the error, and a 0.2 deg growth through it is not significant.
+  s = signature_of(split_comparison({0, 0.1, -0.05, 0.15, 0.0, 0.3}, {0, 0, 0, 0, 0, 0}, noise));
+  EXPECT_GT(s.split_growth_se_deg, 3.0 * std::sqrt(2.0) * se_mean / std::sqrt(10.0) * 4.0);
+  EXPECT_FALSE(growth_split_of(s).significant) << growth_split_text(s);
+}
+
+// The null: residuals of pure angle noise (the trial means scatter by noise / sqrt(frames)) call a
+// growth significant in few of 2000 draws: at 3 standard errors, two-sided, 0.3 % for a normal
+// statistic; the scatter estimate (from four trials after the first) can only make the error larger.
+TEST(Evidence, GrowthSplitOfPureNoiseIsRarelySignificant) {
+  std::mt19937 rng(35);
+  const double noise = 0.08;
+  std::normal_distribution<double> mean_noise(0.0, noise / std::sqrt(90.0));
+  for (int trials : {3, 6, 10}) {
+    int significant = 0;
+    for (int draw = 0; draw < 2000; ++draw) {
+      std::vector<double> top, rest;
+      for (int k = 0; k < trials; ++k) top.push_back(mean_noise(rng)), rest.push_back(mean_noise(rng));
+      significant += growth_split_of(signature_of(split_comparison(top, rest, noise))).significant ? 1 : 0;
+    }
+    EXPECT_LE(significant, 20) << trials << " trials";  // 1 %, against 0.3 % expected
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <set>
 #include <string>
@@ -40,7 +41,8 @@ namespace {
 const std::vector<std::string> kScene = {"geometry.chambers=5", "mesh.h_mm=6.0",  "load.max_kPa=30.0",
                                          "load.step_kPa=10.0",  "load.hold_s=4.0", "load.trials=3"};
 
-DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candidates = {}, int max_effects = 4) {
+DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candidates = {}, int max_effects = 4,
+                         const std::function<void(DiagnoseOptions&)>& adjust = {}) {
   DiagnoseOptions o;
   o.candidates = std::move(candidates);
   o.max_effects = max_effects;
@@ -48,6 +50,7 @@ DiagnosisResult diagnose(const std::string& name, std::vector<std::string> candi
   o.out_dir = (fs::temp_directory_path() / ("pneufem_diag_othermeans_" + name)).string();
   fs::remove_all(o.out_dir);
   o.cache_dir = (fs::temp_directory_path() / "pneufem_diagnose_cache").string();  // shared elastic work
+  if (adjust) adjust(o);
   return test::run_and_print_diagnosis(name, kScene, o);
 }
 
@@ -89,6 +92,11 @@ TEST(OtherMeansNull, SmallStaticMisfitsNameNothing) {
     ASSERT_EQ(r.candidates.size(), 1u);
     EXPECT_GE(r.candidates[0].static_change_nrmse, 0.0);
     EXPECT_LT(r.candidates[0].static_change_nrmse, 0.05) << name;
+    // A static misfit grows nothing over the trials: the growth split is not significant (measured
+    // 0.4, 1.3, 1.1 standard errors), so the growth round has nothing to act on.
+    EXPECT_FALSE(r.baseline_growth.significant) << name << ": " << r.baseline_growth.difference_deg << " +- "
+                                                << r.baseline_growth.difference_se_deg;
+    EXPECT_TRUE(r.growth_note.empty()) << name << ": " << r.growth_note;
   }
 }
 
@@ -120,6 +128,37 @@ TEST(OtherMeansNull, AnotherMeshsCurveIsNamedAsStiffnessWithTheRestStatic) {
   ASSERT_EQ(r.selected, std::vector<std::string>{"stiffness"});
   EXPECT_GT(r.candidates[0].static_change_nrmse, 0.05);
   EXPECT_GT(r.static_share, 0.9);
+  // Ten trials of another mesh's curve: no growth over the trials, before or after (measured -0.01 +-
+  // 0.01 deg, 0.7 and 0.6 standard errors).
+  EXPECT_FALSE(r.baseline_growth.significant) << r.baseline_growth.difference_deg << " +- " << r.baseline_growth.difference_se_deg;
+  EXPECT_FALSE(r.final_growth.significant) << r.final_growth.difference_deg << " +- " << r.final_growth.difference_se_deg;
+}
+
+// ---- The growth round (issue 35 item 2; app/diagnose/command.cpp, growth_round). The whole-RSS tests
+// are made unpassable here (min_removed 0.999: no effect removes 99.9 % of the error above the floor),
+// so only the growth round can name anything: on the logarithmic fatigue (eight trials; the baseline's
+// top holds grow +0.20 deg against the rests' +0.05, top minus rest 11.9 standard errors) it must name
+// fatigue_uniform, leave no significant split and lower the error; with --no-growth-round nothing is
+// named; and on another mesh's curve (ten trials, no growth: 0.7 standard errors) it must not run.
+TEST(OtherMeansRecording, TheGrowthRoundNamesAFatigueOnItsGrowthAlone) {
+  const auto strict = [](DiagnoseOptions& o) { o.min_removed = 0.999, o.intervals = false; };
+  const DiagnosisResult r = diagnose("fatigue_log", {"fatigue_uniform"}, 1, strict);
+  ASSERT_EQ(r.selected, std::vector<std::string>{"fatigue_uniform"});
+  EXPECT_TRUE(r.baseline_growth.significant);
+  EXPECT_GT(r.baseline_growth.difference_deg, 0.0);
+  EXPECT_FALSE(r.final_growth.significant) << r.final_growth.difference_deg << " +- " << r.final_growth.difference_se_deg;
+  EXPECT_LT(r.final_nrmse, r.baseline_nrmse);
+  ASSERT_EQ(r.candidates.size(), 2u);  // round 1's, not significant, and the growth round's
+  EXPECT_FALSE(r.candidates[0].significant);
+  EXPECT_NE(r.candidates[1].why.find("tried in the growth round"), std::string::npos) << r.candidates[1].why;
+  const DiagnosisResult off = diagnose("fatigue_log", {"fatigue_uniform"}, 1, [&](DiagnoseOptions& o) {
+    strict(o);
+    o.growth_round = false;
+  });
+  EXPECT_TRUE(off.selected.empty());
+  const DiagnosisResult null = diagnose("null_mesh_h4", {"fatigue_uniform"}, 1, strict);
+  EXPECT_TRUE(null.selected.empty());
+  EXPECT_EQ(null.candidates.size(), 1u);  // round 1 only: no growth round
 }
 
 // ---- Item 5 in CI: the first-order lag against the candidates that could stand in for it (a static
@@ -248,6 +287,10 @@ TEST(OtherMeansRecording, UnderDampedSecondOrderLagIsNamedWithItsFrequencyAndDam
 // (round 2's long-term candidate was refused as switching it), most likely fatigue in round 2 (the
 // lowest error beyond a static misfit: 37 deg^2 against Mullins' 53), and round 3 selected a third
 // effect, since round 4 ran: spurious unless it was neither Mullins, stiffness, lag nor gravity.
+// Measured with the candidates one-term and broad creep, fatigue_uniform (max 3; 2026-11-30,
+// bench/notes/2026-11-30-diag8.md, 332 s CPU): the broad creep alone, 0.1422 -> 0.0188; its residual's
+// top holds grow +0.27 +- 0.02 deg beyond the rests (12.1 standard errors), and the growth round's
+// fatigue_uniform takes that to +0.09 only with a = 0.5, its bound, and NRMSE 0.0202: not named. FAILS.
 TEST(OtherMeansRecording, DISABLED_CreepAndFatigueOverTenTrialsAreBothNamed) {
   expect_found(diagnose("creep_fatigue"), {"creep", "fatigue"});
 }
@@ -312,6 +355,12 @@ TEST(OtherMeansRecording, DISABLED_MullinsAndLagAreBothNamed) { expect_found(dia
 // top-only growth); with the one-term creep instead (candidates viscoelastic_instantaneous, lag,
 // fatigue_uniform) the same 0.0136 and +0.20 / +0.06 left, a fatigue's signature that the whole-RSS
 // tests do not see (round 3 fatigue_uniform dAIC +1.7). Still FAILS; the lead is a test on the split.
+// With that test (2026-11-30, bench/notes/2026-11-30-diag8.md): the split after creep and lag is +0.13
+// +- 0.02 deg, 7.0 standard errors, and the growth round names fatigue_uniform (n_eff log RSS + z^2:
+// -35.0; split left +0.07 +- 0.02, not significant): creep + lag + fatigue_uniform, 0.1534 -> 0.0137
+// (0.089x), with the candidates one-term creep, lag, fatigue_uniform (692 s CPU) and with the broad
+// creep too (the swap of forms counts the broad creep's negative split and keeps the one-term one;
+// 962 s CPU). Not yet run with the whole catalog: stays disabled until it is.
 TEST(OtherMeansRecording, DISABLED_CreepFatigueAndLagAreAllNamed) {
   expect_found(diagnose("creep_fatigue_lag"), {"creep", "fatigue", "lag"});
 }
