@@ -747,6 +747,9 @@ double split_chi2(const Signature& g, bool negative_only = false) {
 /// one (680), and the one-term creep, re-fitted beside the lag in round 2, takes the fatigue's growth
 /// over the trials (bench/notes/2026-11-29-diag3.md). A form replaced is not tried again (no cycling).
 /// Costs one calibration and one joint re-fit per other form of a selected effect, per round.
+/// Over 100 lines on purpose: one swap read in the order it happens — the joint vector's layout with
+/// the other form in place, its two fits (alone, then all together), the comparison on the
+/// growth-weighted RSS with the measurements that chose it (14 lines of comment), the swap.
 void try_other_forms(Selection& s, int round) {
   const DiagnoseOptions& opt = s.opt;
   for (std::size_t k = 0; k < s.chosen.size(); ++k) {
@@ -883,6 +886,9 @@ void try_other_forms(Selection& s, int round) {
 /// growth it leaves is no longer significant and no constant is at a bound; else, when its RSS is
 /// within 25 % of the model's and it removes the growth, it is reported as an equivalent model.
 /// Costs up to two calibrations (2 x max_evaluations runs) per fatigue form, only when triggered.
+/// Over 100 lines on purpose: the round's trigger, its two fits per form on the augmented criterion,
+/// and its three outcomes (selected, equivalent, neither) with their reasons are one decision, read in
+/// the order it is made.
 void growth_round(Selection& s, int round) {
   const DiagnoseOptions& opt = s.opt;
   if (!opt.growth_round || static_cast<int>(s.chosen.size()) >= opt.max_effects) return;
