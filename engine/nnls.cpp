@@ -17,6 +17,31 @@ Eigen::VectorXd passive_solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b
   return AP.colPivHouseholderQr().solve(b);
 }
 
+/// Lawson-Hanson's inner step on the passive columns P, z their least-squares weights: with every
+/// z > 0, x = z on P (0 elsewhere) and true; else x moves towards z as far as every weight stays
+/// >= 0, the columns whose weight reaches 0 leave the passive set, and false.
+bool step_towards(const Eigen::VectorXd& z, const std::vector<int>& P, Eigen::VectorXd& x, std::vector<char>& passive) {
+  if (z.size() == 0 || z.minCoeff() > 0.0) {
+    x.setZero();
+    for (std::size_t j = 0; j < P.size(); ++j) x[P[j]] = z[static_cast<Eigen::Index>(j)];
+    return true;
+  }
+  double alpha = 1.0;
+  for (std::size_t j = 0; j < P.size(); ++j) {
+    const double zj = z[static_cast<Eigen::Index>(j)], xj = x[P[j]];
+    if (zj <= 0.0) alpha = std::min(alpha, xj / (xj - zj));
+  }
+  for (std::size_t j = 0; j < P.size(); ++j) {
+    double& xj = x[P[j]];
+    xj += alpha * (z[static_cast<Eigen::Index>(j)] - xj);
+    if (xj <= 1e-15 * (1.0 + std::abs(xj))) {
+      xj = 0.0;
+      passive[static_cast<std::size_t>(P[j])] = 0;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 NnlsResult nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double rel_tol, int max_iterations) {
@@ -55,27 +80,7 @@ NnlsResult nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double rel_t
       std::vector<int> P;
       for (Eigen::Index j = 0; j < n; ++j)
         if (passive[j]) P.push_back(static_cast<int>(j));
-      const Eigen::VectorXd z = passive_solve(A, b, P);
-      bool feasible = true;
-      for (Eigen::Index i = 0; i < z.size(); ++i) feasible = feasible && z[i] > 0.0;
-      if (feasible) {
-        out.x.setZero();
-        for (std::size_t j = 0; j < P.size(); ++j) out.x[P[j]] = z[static_cast<Eigen::Index>(j)];
-        break;
-      }
-      double alpha = 1.0;
-      for (std::size_t j = 0; j < P.size(); ++j) {
-        const double zj = z[static_cast<Eigen::Index>(j)], xj = out.x[P[j]];
-        if (zj <= 0.0) alpha = std::min(alpha, xj / (xj - zj));
-      }
-      for (std::size_t j = 0; j < P.size(); ++j) {
-        double& xj = out.x[P[j]];
-        xj += alpha * (z[static_cast<Eigen::Index>(j)] - xj);
-        if (xj <= 1e-15 * (1.0 + std::abs(xj))) {
-          xj = 0.0;
-          passive[P[j]] = 0;
-        }
-      }
+      if (step_towards(passive_solve(A, b, P), P, out.x, passive)) break;
     }
     if (!passive[best] && out.x[best] == 0.0) {
       tabu[best] = 1;
@@ -180,25 +185,7 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& AtA, const Eigen::VectorXd& Atb, d
     passive[best] = 1;
     for (int inner = 0; inner <= n; ++inner) {
       const std::vector<int>& P = chol.columns();
-      const Eigen::VectorXd z = chol.solve(Atb);
-      if (z.size() == 0 || z.minCoeff() > 0.0) {
-        out.x.setZero();
-        for (std::size_t j = 0; j < P.size(); ++j) out.x[P[j]] = z[static_cast<Eigen::Index>(j)];
-        break;
-      }
-      double alpha = 1.0;
-      for (std::size_t j = 0; j < P.size(); ++j) {
-        const double zj = z[static_cast<Eigen::Index>(j)], xj = out.x[P[j]];
-        if (zj <= 0.0) alpha = std::min(alpha, xj / (xj - zj));
-      }
-      for (std::size_t j = 0; j < P.size(); ++j) {
-        double& xj = out.x[P[j]];
-        xj += alpha * (z[static_cast<Eigen::Index>(j)] - xj);
-        if (xj <= 1e-15 * (1.0 + std::abs(xj))) {
-          xj = 0.0;
-          passive[P[j]] = 0;
-        }
-      }
+      if (step_towards(chol.solve(Atb), P, out.x, passive)) break;
       chol.retain([&](int j) { return passive[static_cast<std::size_t>(j)] != 0; });
       std::vector<char> kept(static_cast<std::size_t>(n), 0);
       for (int j : chol.columns()) kept[static_cast<std::size_t>(j)] = 1;
